@@ -1,0 +1,92 @@
+"""The one place an OpenGL context is made: headless EGL by default, probed and cached.
+
+``get_context()`` returns a process-wide moderngl context (GL >= 4.3 core). Set
+``RELIEFKIT_GL_BACKEND`` to another glcontext backend name (for example ``x11``) to use a
+window system instead of EGL.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+
+from ..errors import GPUError
+
+REQUIRED_VERSION = 430
+_lock = threading.Lock()
+_context = None
+
+# Debian packages that provide EGL + Mesa's software rasterizer (llvmpipe).
+EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri"
+
+
+def create_context(backend: str | None = None):
+    """Create a new standalone moderngl context, raising GPUError with advice on failure."""
+    import moderngl
+
+    backend = backend or os.environ.get("RELIEFKIT_GL_BACKEND", "egl")
+    try:
+        ctx = moderngl.create_context(standalone=True, backend=backend, require=REQUIRED_VERSION)
+    except Exception as exc:  # glcontext raises plain Exceptions with driver text
+        detail = " ".join(str(exc).split()) or type(exc).__name__
+        raise GPUError(
+            f"could not create an OpenGL {REQUIRED_VERSION // 100}.{REQUIRED_VERSION % 100 // 10} "
+            f"context through {backend} ({detail}); on Debian install: "
+            f"sudo apt-get install -y {EGL_PACKAGES}"
+        ) from None
+    return ctx
+
+
+def get_context():
+    """The shared process-wide context, created on first use."""
+    global _context
+    with _lock:
+        if _context is None:
+            _context = create_context()
+        return _context
+
+
+def gl_info(ctx=None) -> dict:
+    """Renderer, version and the limits reliefkit checks before allocating."""
+    ctx = ctx or get_context()
+    info = ctx.info
+    keys = {
+        "renderer": "GL_RENDERER",
+        "vendor": "GL_VENDOR",
+        "version": "GL_VERSION",
+        "max_texture_size": "GL_MAX_TEXTURE_SIZE",
+        "max_3d_texture_size": "GL_MAX_3D_TEXTURE_SIZE",
+        "max_renderbuffer_size": "GL_MAX_RENDERBUFFER_SIZE",
+        "max_viewport_dims": "GL_MAX_VIEWPORT_DIMS",
+        "max_color_attachments": "GL_MAX_COLOR_ATTACHMENTS",
+        "max_texture_image_units": "GL_MAX_TEXTURE_IMAGE_UNITS",
+    }
+    out = {name: info.get(key) for name, key in keys.items()}
+    out["glsl_version"] = info.get("GL_SHADING_LANGUAGE_VERSION")
+    out["version_code"] = ctx.version_code
+    return out
+
+
+def is_llvmpipe(ctx=None) -> bool:
+    """True on Mesa's CPU rasterizer, the reference the pixel tests are written for."""
+    return "llvmpipe" in str((ctx or get_context()).info.get("GL_RENDERER", "")).lower()
+
+
+def check_gl_error(ctx, what: str) -> None:
+    """Raise GPUError if the GL error flag is set (moderngl does not check it for us)."""
+    err = ctx.error
+    if err != "GL_NO_ERROR":
+        raise GPUError(f"OpenGL reported {err} while {what}")
+
+
+def check_framebuffer_size(ctx, width: int, height: int) -> None:
+    """Refuse a render target larger than the renderbuffer and viewport limits."""
+    if width < 1 or height < 1:
+        raise GPUError(f"framebuffer size must be positive, got {width}x{height}")
+    limit = int(ctx.info["GL_MAX_RENDERBUFFER_SIZE"])
+    vw, vh = (int(x) for x in ctx.info["GL_MAX_VIEWPORT_DIMS"])
+    if width > min(limit, vw) or height > min(limit, vh):
+        raise GPUError(
+            f"a {width}x{height} image exceeds this GPU's limit of "
+            f"{min(limit, vw)}x{min(limit, vh)}; render a smaller size"
+        )

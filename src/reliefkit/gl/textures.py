@@ -1,0 +1,86 @@
+"""Textures and render targets, created only after their size is checked against GL limits."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import GPUError
+from .context import check_framebuffer_size, check_gl_error
+
+GL_SRGB8_ALPHA8 = 0x8C43
+
+_DTYPES = {np.dtype(np.uint8): "f1", np.dtype(np.float32): "f4", np.dtype(np.uint16): "u2",
+           np.dtype(np.float16): "f2"}
+
+
+def _check_2d(ctx, width: int, height: int, what: str) -> None:
+    limit = int(ctx.info["GL_MAX_TEXTURE_SIZE"])
+    if width < 1 or height < 1:
+        raise GPUError(f"{what}: texture size must be positive, got {width}x{height}")
+    if width > limit or height > limit:
+        raise GPUError(
+            f"{what}: a {width}x{height} texture exceeds this GPU's limit of {limit}x{limit}; "
+            "use a smaller resolution"
+        )
+
+
+def texture2d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "linear",
+              srgb: bool = False, mipmaps: bool = False, repeat: bool = False):
+    """Upload an (H, W) or (H, W, C) array as a 2D texture; row 0 of the array is v = 0.
+
+    uint8 arrays become normalised textures (sRGB-decoded when ``srgb``), float32 stay float,
+    uint16 become unsigned integer textures (sample them with ``usampler2D``).
+    """
+    import moderngl
+
+    arr = np.ascontiguousarray(array)
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    if arr.ndim != 3 or not 1 <= arr.shape[2] <= 4:
+        raise GPUError(f"{what}: expected an (H, W) or (H, W, 1..4) array, got {array.shape}")
+    if arr.dtype not in _DTYPES:
+        raise GPUError(f"{what}: unsupported texture dtype {arr.dtype}")
+    height, width, comps = arr.shape
+    _check_2d(ctx, width, height, what)
+    kwargs = {}
+    if srgb:
+        if arr.dtype != np.uint8 or comps != 4:
+            raise GPUError(f"{what}: sRGB textures must be (H, W, 4) uint8")
+        kwargs["internal_format"] = GL_SRGB8_ALPHA8
+    tex = ctx.texture((width, height), comps, arr.tobytes(), dtype=_DTYPES[arr.dtype], **kwargs)
+    integer = arr.dtype == np.uint16
+    nearest = filter == "nearest" or integer
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST) if nearest else (
+        (moderngl.LINEAR_MIPMAP_LINEAR if mipmaps else moderngl.LINEAR), moderngl.LINEAR)
+    if mipmaps and not nearest:
+        tex.build_mipmaps()
+    tex.repeat_x = tex.repeat_y = repeat
+    check_gl_error(ctx, f"creating {what} ({width}x{height}x{comps} {arr.dtype})")
+    return tex
+
+
+def render_target(ctx, width: int, height: int, color_attachments: int):
+    """A framebuffer of ``color_attachments`` RGBA32F textures plus a float depth texture."""
+    check_framebuffer_size(ctx, width, height)
+    limit = int(ctx.info["GL_MAX_COLOR_ATTACHMENTS"])
+    if color_attachments > limit:
+        raise GPUError(f"{color_attachments} colour attachments exceed this GPU's limit of {limit}")
+    colors = [ctx.texture((width, height), 4, dtype="f4") for _ in range(color_attachments)]
+    depth = ctx.depth_texture((width, height))
+    fbo = ctx.framebuffer(color_attachments=colors, depth_attachment=depth)
+    check_gl_error(ctx, f"creating a {width}x{height} render target")
+    return fbo
+
+
+def read_rgba(fbo, attachment: int) -> np.ndarray:
+    """Read one RGBA32F attachment as an (H, W, 4) array with row 0 at the top."""
+    width, height = fbo.size
+    data = fbo.read(attachment=attachment, components=4, dtype="f4")
+    return np.frombuffer(data, np.float32).reshape(height, width, 4)[::-1].copy()
+
+
+def read_depth(fbo) -> np.ndarray:
+    """Read the depth attachment as an (H, W) float32 array with row 0 at the top."""
+    width, height = fbo.size
+    data = fbo.depth_attachment.read()
+    return np.frombuffer(data, np.float32).reshape(height, width)[::-1].copy()

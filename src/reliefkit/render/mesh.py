@@ -1,0 +1,53 @@
+"""Ground truth: rasterize the original mesh into a Frame with every AOV."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..gl.context import check_gl_error, get_context
+from ..gl.shaders import program
+from ..gl.textures import texture2d
+from ..scene.light import DirectionalLight
+from ..scene.mesh import RenderMesh
+from .registry import register_renderer
+from .targets import camera_uniforms, draw_into_frame, set_uniforms
+
+
+class MeshDrawable:
+    """GPU buffers of a RenderMesh, drawable many times (turntables, benchmarks)."""
+
+    def __init__(self, ctx, mesh: RenderMesh):
+        self.ctx, self.mesh = ctx, mesh
+        textured = mesh.texture is not None
+        self.prog = program(ctx, "mesh.glsl", {"HAS_TEXTURE": textured})
+        uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2), np.float32)
+        interleaved = np.hstack([mesh.positions, mesh.normals, mesh.colors, uvs]).astype(np.float32)
+        self.vbo = ctx.buffer(interleaved.tobytes())
+        self.ibo = ctx.buffer(mesh.indices.tobytes())
+        layout = (("in_position", 3), ("in_normal", 3), ("in_color", 4), ("in_uv", 2))
+        attributes = [name for name, _ in layout if name in self.prog]
+        fmt = " ".join(f"{n}f" if name in self.prog else f"{n}x4" for name, n in layout)
+        self.vao = ctx.vertex_array(self.prog, [(self.vbo, fmt, *attributes)], self.ibo,
+                                    index_element_size=4)
+        self.texture = texture2d(ctx, mesh.texture, what=f"{mesh.name} texture", srgb=True,
+                                 mipmaps=True, repeat=True) if textured else None
+        check_gl_error(ctx, f"uploading mesh {mesh.name}")
+
+    def draw(self, camera, light: DirectionalLight) -> None:
+        set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms())
+        if self.texture is not None:
+            self.texture.use(0)
+            set_uniforms(self.prog, {"u_texture": 0})
+        self.vao.render()
+
+
+def render_mesh(mesh: RenderMesh, camera, *, light: DirectionalLight | None = None, ctx=None):
+    """Rasterize ``mesh`` seen by ``camera`` with Phong shading; returns a Frame."""
+    ctx = ctx or get_context()
+    drawable = MeshDrawable(ctx, mesh)
+    frame = draw_into_frame(ctx, camera, lambda: drawable.draw(camera, light or DirectionalLight()))
+    frame.stats["triangles"] = mesh.triangle_count
+    return frame
+
+
+register_renderer(RenderMesh, render_mesh)
