@@ -46,6 +46,17 @@ def get_context():
         return _context
 
 
+def bind_home_framebuffer(ctx) -> None:
+    """Bind a persistent 1x1 framebuffer. Call before releasing a bound framebuffer:
+    moderngl rebinds the last used one when it creates the next, and a deleted one is
+    GL_INVALID_OPERATION (a headless context has no default framebuffer to fall back to)."""
+    extra = ctx.extra if isinstance(ctx.extra, dict) else {}
+    if "home_fbo" not in extra:
+        extra["home_fbo"] = ctx.simple_framebuffer((1, 1))
+        ctx.extra = extra
+    extra["home_fbo"].use()
+
+
 def gl_info(ctx=None) -> dict:
     """Renderer, version and the limits reliefkit checks before allocating."""
     ctx = ctx or get_context()
@@ -62,7 +73,6 @@ def gl_info(ctx=None) -> dict:
         "max_texture_image_units": "GL_MAX_TEXTURE_IMAGE_UNITS",
     }
     out = {name: info.get(key) for name, key in keys.items()}
-    out["glsl_version"] = info.get("GL_SHADING_LANGUAGE_VERSION")
     out["version_code"] = ctx.version_code
     return out
 

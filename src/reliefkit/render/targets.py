@@ -6,7 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..gl.context import check_gl_error
+from ..gl.context import bind_home_framebuffer, check_gl_error
 from ..gl.textures import read_depth, read_rgba, render_target
 from .frame import Frame, frame_from_targets
 
@@ -57,6 +57,7 @@ def draw_into_frame(ctx, camera, draw: Callable[[], None], *, extra_attachments:
                                   for i in range(extra_attachments)]
         return frame
     finally:
+        bind_home_framebuffer(ctx)
         for attachment in (*fbo.color_attachments, fbo.depth_attachment):
             attachment.release()
         fbo.release()

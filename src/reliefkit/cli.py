@@ -1,0 +1,200 @@
+"""The `reliefkit` command line: parses arguments, calls the library, prints results.
+
+Every failure is one line ``error: ...`` on stderr and a non-zero exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from .errors import ReliefkitError, UsageError
+from .scene.views import DEFAULT_SIZE, DEFAULT_VIEW
+
+EXAMPLES = """\
+examples:
+  reliefkit demo --out out                          contact sheet of every demo asset
+  reliefkit render bunny.ply -o bunny.png           one view (default --view 30,25,2.6)
+  reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs side.npz
+  reliefkit render demo:tree --turntable 36 -o spin.gif
+  reliefkit info --gl                               the OpenGL renderer and its limits
+  reliefkit info model.obj                          counts and bounds of a mesh (or an .rk)
+
+inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, or demo:NAME
+(demo assets: terrain, blob, tree, vehicle).
+"""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports errors as one `error:` line (exit status 2)."""
+
+    def error(self, message: str):  # noqa: D102
+        self.exit(2, f"error: {message} (see {self.prog} --help)\n")
+
+
+def _add_view_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--view", default=",".join(f"{x:g}" for x in DEFAULT_VIEW),
+                   metavar="AZ,EL,DIST",
+                   help="orbit the bounding-box centre: azimuth and elevation in degrees, "
+                        "distance in bounding-sphere radii (default: %(default)s)")
+    p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
+                   help="image size in pixels (default: %(default)s)")
+    p.add_argument("--fov", type=float, default=40.0, help="vertical field of view in degrees")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
+                     epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=_version())
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("render", help="render a mesh or an .rk representation to PNG / GIF",
+                       description="Render a mesh (ground truth) or an .rk representation.",
+                       epilog="examples:\n  reliefkit render model.glb -o model.png --aovs model.npz"
+                              "\n  reliefkit render demo:vehicle --turntable 24 -o spin.gif",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("input", help="mesh file, .rk file or demo:NAME")
+    _add_view_args(p)
+    p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable)")
+    p.add_argument("--aovs", metavar="OUT.npz",
+                   help="also write color, mask, depth, position, normal, view, proj, viewport")
+    p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
+    p.add_argument("--background", default="transparent",
+                   help="'transparent' or a grey level 0..1 to composite over")
+    p.set_defaults(run=cmd_render)
+
+    p = sub.add_parser("info", help="GL capabilities, or the contents of a mesh / .rk file",
+                       description="Print the OpenGL renderer and limits (--gl) and/or "
+                                   "summarise a mesh or .rk file.")
+    p.add_argument("file", nargs="?", help="mesh file, .rk file or demo:NAME")
+    p.add_argument("--gl", action="store_true", help="print renderer, GL version and limits")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(run=cmd_info)
+
+    p = sub.add_parser("demo", help="render the demo assets into a titled contact sheet",
+                       description="Render every demo asset (and representation) into "
+                                   "OUT/demo.png plus one PNG per tile.")
+    p.add_argument("--out", default="out", help="output folder (default: %(default)s)")
+    p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
+    p.set_defaults(run=cmd_demo)
+    return parser
+
+
+def _version() -> str:
+    from . import __version__
+
+    return f"reliefkit {__version__}"
+
+
+def _background(text: str):
+    if text == "transparent":
+        return None
+    try:
+        level = float(text)
+    except ValueError:
+        raise UsageError(f"--background must be 'transparent' or a number, got {text!r}") from None
+    return (level, level, level)
+
+
+def cmd_render(args) -> int:
+    from .inputs import load_input
+    from .pictures import save_gif
+    from .render import render
+    from .scene.views import orbit_bounds, parse_size, parse_view, turntable
+
+    az, el, dist = parse_view(args.view)
+    size = parse_size(args.size)
+    background = _background(args.background)
+    suffix = Path(args.output).suffix.lower()
+    if args.turntable is not None and suffix != ".gif":
+        raise UsageError("--turntable writes an animated .gif: name the output *.gif")
+    if args.turntable is None and suffix != ".png":
+        raise UsageError(f"output must be a .png file, got {args.output}")
+    obj = load_input(args.input)
+    if args.turntable is not None:
+        from .progress import progress_bar
+
+        cameras = turntable(obj.bounds, args.turntable, el, dist, size, args.fov)
+        frames = []
+        with progress_bar("turntable", len(cameras)) as advance:
+            for k, camera in enumerate(cameras):
+                frames.append(render(obj, camera).rgba8(background or (0.12, 0.12, 0.13)))
+                advance(k + 1)
+        save_gif(frames, args.output)
+        print(f"wrote {args.output} ({len(frames)} views)")
+        return 0
+    frame = render(obj, orbit_bounds(obj.bounds, az, el, dist, size, args.fov))
+    frame.save(args.output, background)
+    print(f"wrote {args.output} ({size[0]}x{size[1]}, {int(frame.mask.sum())} pixels covered)")
+    if args.aovs:
+        frame.save_aovs(args.aovs)
+        print(f"wrote {args.aovs}")
+    return 0
+
+
+def cmd_info(args) -> int:
+    if not args.gl and not args.file:
+        raise UsageError("info needs --gl and/or a FILE")
+    report = {}
+    if args.gl:
+        from .gl.context import gl_info
+
+        report["gl"] = gl_info()
+    if args.file:
+        if Path(args.file).suffix.lower() == ".rk":
+            from .formats import read_manifest
+
+            report["file"] = read_manifest(args.file)
+        else:
+            from .inputs import describe, load_input
+
+            report["file"] = describe(load_input(args.file))
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        for section in report.values():
+            for key, value in section.items():
+                print(f"{key:>24}: {json.dumps(value) if isinstance(value, dict | list) else value}")
+    return 0
+
+
+def cmd_demo(args) -> int:
+    from .demo import build_demo
+    from .scene.views import parse_size
+
+    sheet = build_demo(Path(args.out), tile_size=parse_size(args.size))
+    print(f"wrote {sheet}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "run", None):
+        parser.print_help()
+        return 2
+    try:
+        return args.run(args)
+    except ReliefkitError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        name = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"error: cannot access{name}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # a bug, not bad input: still one line, details on request
+        if os.environ.get("RELIEFKIT_DEBUG"):
+            raise
+        print(f"error: internal error ({type(exc).__name__}: {exc}); "
+              "rerun with RELIEFKIT_DEBUG=1 for a traceback", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())
