@@ -7,7 +7,8 @@ A program lives in one file with ``#if defined VERTEX_SHADER`` / ``FRAGMENT_SHAD
 
 and, when it needs more than the draw-path default (GLSL 3.30), ``//! version: 430``.
 Includes are resolved here (``#include "include/raybox.glsl"``, depth-limited) and every
-piece is preceded by ``#line 1 N`` so compiler messages name the right file and line: a
+piece is preceded by a ``#line`` whose number encodes file and line (file k's line n is
+reported as k * 100000 + n: Mesa ignores the source-string argument of ``#line``), so a
 compile error raises GPUError("shaders/relief.glsl:42: ...").
 """
 
@@ -22,6 +23,7 @@ from ..errors import GPUError
 STAGES = ("VERTEX_SHADER", "GEOMETRY_SHADER", "FRAGMENT_SHADER", "COMPUTE_SHADER")
 DEFAULT_VERSION = "330 core"
 MAX_INCLUDE_DEPTH = 8
+LINE_BASE = 100000  # reported line = file index * LINE_BASE + line in that file
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 _DEFINES = re.compile(r"^//!\s*defines:(.*)$", re.M)
@@ -39,6 +41,11 @@ def read_shader_file(name: str) -> str:
     return path.read_text(encoding="utf-8")
 
 
+def _line_directive(file_id: int, line: int) -> str:
+    """``#line`` making the next line report as file ``file_id``, line ``line``."""
+    return f"#line {file_id * LINE_BASE + line} {file_id}"
+
+
 def _expand(name: str, files: list[str], depth: int = 0) -> str:
     """Inline includes recursively, emitting ``#line`` so each piece keeps its numbering."""
     if depth > MAX_INCLUDE_DEPTH:
@@ -46,12 +53,12 @@ def _expand(name: str, files: list[str], depth: int = 0) -> str:
     if name not in files:
         files.append(name)
     file_id = files.index(name)
-    out = [f"#line 1 {file_id}"]
+    out = [_line_directive(file_id, 1)]
     for lineno, line in enumerate(read_shader_file(name).splitlines(), start=1):
         match = _INCLUDE.match(line)
         if match:
             out.append(_expand(match.group(1), files, depth + 1))
-            out.append(f"#line {lineno + 1} {file_id}")
+            out.append(_line_directive(file_id, lineno + 1))
         else:
             out.append(line)
     return "\n".join(out)
@@ -99,9 +106,10 @@ def _explain(exc: Exception, files: list[str]) -> str:
     """Turn a driver's compile log into 'shaders/file.glsl:LINE: message'."""
     text = str(exc)
     match = _ERROR_LOC.search(text)
-    if match and int(match.group(1)) < len(files):
-        fname, line, msg = files[int(match.group(1))], match.group(2), match.group(3).strip()
-        return f"shaders/{fname}:{line}: {msg}"
+    if match:
+        file_id, line = divmod(int(match.group(2)), LINE_BASE)
+        if file_id < len(files):
+            return f"shaders/{files[file_id]}:{line}: {match.group(3).strip()}"
     return " ".join(text.split())[:400]
 
 
