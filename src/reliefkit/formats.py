@@ -1,0 +1,742 @@
+"""The .rk container: one baked representation in a zip that plain numpy can open.
+
+An .rk file is an uncompressed (``ZIP_STORED``) zip holding ``manifest.json`` and one
+``NAME.npy`` member per array, so ``numpy.load(path, allow_pickle=False)`` reads it. The
+manifest names the format and its version, the representation *kind* and the kind's version,
+the bake parameters, the source file's SHA-256 and, per array, its dtype, shape and the
+SHA-256 of its ``.npy`` member.
+
+Kinds are a registry of `Codec` objects: a representation module registers one and `save` /
+`load` find it, by the representation's type and by the manifest's ``kind``. Writing is
+atomic (temp file in the same folder, fsync, ``os.replace``). Reading validates everything it
+can from the manifest and the ``.npy`` headers *before* allocating any array, then verifies
+checksums and finiteness. Every problem raises `FormatError`. See ``docs/format.md``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import io
+import json
+import math
+import os
+import re
+import tempfile
+import zipfile
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.lib import format as npy
+
+from .errors import FormatError, ReliefkitError
+from .scene.mesh import RenderMesh
+
+__all__ = [
+    "ArraySpec", "Codec", "RkFile", "register", "unregister", "registered_kinds",
+    "save", "load", "read_manifest", "write_rk", "read_rk", "file_sha256",
+    "FORMAT_NAME", "FORMAT_VERSION", "DEFAULT_MAX_BYTES",
+]
+
+FORMAT_NAME = "reliefkit"
+FORMAT_VERSION = 1
+MANIFEST_NAME = "manifest.json"
+MAX_MANIFEST_BYTES = 1 << 20
+DEFAULT_MAX_BYTES = 4 << 30
+
+_MAX_NPY_HEADER = 4096                 # ours are ~128 bytes; numpy's own default is 10000
+_HEADER_PEEK = _MAX_NPY_HEADER + 16    # magic + version (8) + length field (<= 4) + header
+_CHUNK = 1 << 20
+_FORCE_ZIP64 = 1 << 30                 # members this large get zip64 headers up front
+_ZIP_DATE = (1980, 1, 1, 0, 0, 0)      # fixed, so equal inputs give byte-identical files
+_KIND_RE = re.compile(r"[a-z][a-z0-9_.-]*\Z")
+_NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_SHA_RE = re.compile(r"[0-9a-f]{64}\Z")
+
+
+# --------------------------------------------------------------------------- registry
+
+
+@dataclass(frozen=True)
+class ArraySpec:
+    """What one array of a kind may look like.
+
+    Attributes
+    ----------
+    dtypes : allowed numpy dtype names, e.g. ``("float32",)`` or ``("uint8", "uint16")``;
+        stored little-endian.
+    ndim : allowed number of dimensions (one int or a tuple of them).
+    required : whether every file of the kind must hold the array.
+    finite : whether NaN and Inf are forbidden (checked on write and after reading).
+    trailing : fixed trailing dimensions, ``None`` for a free one, e.g. ``(4, 4)``.
+    """
+
+    dtypes: tuple[str, ...]
+    ndim: int | tuple[int, ...]
+    required: bool = True
+    finite: bool = False
+    trailing: tuple[int | None, ...] | None = None
+
+
+@dataclass(frozen=True)
+class Codec:
+    """How one representation class maps to arrays and JSON parameters.
+
+    Attributes
+    ----------
+    kind : the manifest's ``kind`` string (lower case, e.g. ``"mesh"``).
+    cls : the representation class it encodes; `save` finds the codec by this type.
+    arrays : array name -> `ArraySpec`.
+    to_arrays : ``rep -> (arrays, params)``; optional arrays may be left out or None.
+    from_arrays : ``(arrays, params) -> rep``; gets validated arrays only.
+    version : the kind's own version; files with a newer one are refused.
+    """
+
+    kind: str
+    cls: type
+    arrays: dict[str, ArraySpec]
+    to_arrays: Callable[[object], tuple[dict[str, np.ndarray], dict]]
+    from_arrays: Callable[[dict[str, np.ndarray], dict], object]
+    version: int = 1
+
+
+@dataclass(frozen=True)
+class RkFile:
+    """The validated content of an .rk file (what `read_rk` returns)."""
+
+    kind: str
+    manifest: dict
+    params: dict
+    arrays: dict[str, np.ndarray]
+
+
+_CODECS: dict[str, Codec] = {}
+_BY_CLASS: dict[type, Codec] = {}
+
+
+def register(codec: Codec) -> None:
+    """Make a representation kind loadable and savable.
+
+    Registering the same kind for the same class again replaces the codec (module reloads);
+    a kind or class that is already taken by another raises `FormatError`.
+    """
+    if not isinstance(codec, Codec):
+        raise FormatError(f"register() needs a Codec, got {type(codec).__name__}")
+    if not isinstance(codec.kind, str) or not _KIND_RE.match(codec.kind):
+        raise FormatError(f"invalid kind {codec.kind!r}: use lower-case letters, digits, _.-")
+    if type(codec.version) is not int or codec.version < 1:
+        raise FormatError(f"kind '{codec.kind}': version must be an int >= 1")
+    for name, spec in codec.arrays.items():
+        _check_spec(codec.kind, name, spec)
+    old = _CODECS.get(codec.kind)
+    if old is not None and old.cls is not codec.cls:
+        raise FormatError(f"kind '{codec.kind}' is already registered for "
+                          f"{old.cls.__qualname__}; pick another kind name")
+    other = _BY_CLASS.get(codec.cls)
+    if other is not None and other.kind != codec.kind:
+        raise FormatError(f"{codec.cls.__qualname__} is already registered as kind "
+                          f"'{other.kind}'; unregister it first")
+    _CODECS[codec.kind] = codec
+    _BY_CLASS[codec.cls] = codec
+
+
+def unregister(kind: str) -> None:
+    """Remove a registered kind (no error if it is not registered)."""
+    codec = _CODECS.pop(kind, None)
+    if codec is not None:
+        _BY_CLASS.pop(codec.cls, None)
+
+
+def registered_kinds() -> tuple[str, ...]:
+    """The kinds this process can read and write, sorted."""
+    return tuple(sorted(_CODECS))
+
+
+def _check_spec(kind: str, name: str, spec: ArraySpec) -> None:
+    where = f"kind '{kind}', array {name!r}"
+    if not isinstance(name, str) or not _NAME_RE.match(name):
+        raise FormatError(f"{where}: array names must be Python identifiers")
+    if not isinstance(spec, ArraySpec) or not spec.dtypes:
+        raise FormatError(f"{where}: needs an ArraySpec with at least one dtype")
+    for text in spec.dtypes:
+        try:
+            dtype = np.dtype(text)
+        except TypeError:
+            raise FormatError(f"{where}: {text!r} is not a numpy dtype") from None
+        if dtype.hasobject or dtype.fields is not None or dtype.subdtype is not None:
+            raise FormatError(f"{where}: dtype {text!r} is not a plain numeric dtype")
+    tail = len(spec.trailing or ())
+    if any(type(n) is not int or n < tail for n in _ndims(spec)):
+        raise FormatError(f"{where}: ndim must be ints >= the number of trailing dims")
+
+
+def _ndims(spec: ArraySpec) -> tuple[int, ...]:
+    return spec.ndim if isinstance(spec.ndim, tuple) else (spec.ndim,)
+
+
+def _codec_for_kind(kind) -> Codec:
+    codec = _CODECS.get(kind) if isinstance(kind, str) else None
+    if codec is None:
+        known = ", ".join(registered_kinds()) or "none"
+        raise FormatError(f"unknown kind {kind!r} (known kinds: {known}); import the module "
+                          "that registers it, or upgrade reliefkit")
+    return codec
+
+
+def _codec_for_object(rep) -> Codec:
+    for cls in type(rep).__mro__:
+        if cls in _BY_CLASS:
+            return _BY_CLASS[cls]
+    raise FormatError(f"cannot save a {type(rep).__qualname__}: no .rk kind is registered for "
+                      "it; register a Codec with reliefkit.formats.register")
+
+
+# --------------------------------------------------------------------- shared checks
+
+
+def _expected_shape(spec: ArraySpec) -> str:
+    tail = ["*" if t is None else str(t) for t in (spec.trailing or ())]
+    forms = []
+    for n in _ndims(spec):
+        dims = ["*"] * (n - len(tail)) + tail
+        forms.append("(" + ", ".join(dims) + ("," if n == 1 else "") + ")")
+    return " or ".join(forms)
+
+
+def _check_array(kind: str, name: str, spec: ArraySpec, dtype: np.dtype, shape: tuple) -> None:
+    """Dtype and shape of one array against its spec (no data needed)."""
+    if dtype.hasobject:
+        raise FormatError(f"array '{name}' has an object dtype (pickled Python objects); "
+                          "reliefkit never stores or loads pickles")
+    allowed = [np.dtype(d).newbyteorder("<") for d in spec.dtypes]
+    if dtype not in allowed:
+        names = ", ".join(spec.dtypes)
+        raise FormatError(f"array '{name}' has dtype {dtype.str}; kind '{kind}' allows {names} "
+                          "(little-endian)")
+    tail = spec.trailing or ()
+    ok = len(shape) in _ndims(spec) and all(
+        t is None or s == t for s, t in zip(shape[len(shape) - len(tail):], tail, strict=True))
+    if not ok:
+        raise FormatError(f"array '{name}' has shape {tuple(shape)}; kind '{kind}' expects "
+                          f"{_expected_shape(spec)}")
+
+
+def _check_array_set(codec: Codec, names: Iterable[str]) -> None:
+    names = set(names)
+    missing = [n for n, s in codec.arrays.items() if s.required and n not in names]
+    if missing:
+        raise FormatError(f"missing required array '{missing[0]}' (kind '{codec.kind}' needs "
+                          f"{', '.join(n for n, s in codec.arrays.items() if s.required)})")
+    unknown = sorted(names - set(codec.arrays))
+    if unknown:
+        raise FormatError(f"unknown array {unknown[0]!r} for kind '{codec.kind}' (it has: "
+                          f"{', '.join(codec.arrays)})")
+
+
+def _check_finite(name: str, arr: np.ndarray) -> None:
+    if arr.dtype.kind in "fc" and not np.isfinite(arr).all():
+        bad = int(np.count_nonzero(~np.isfinite(arr)))
+        raise FormatError(f"array '{name}' has {bad} NaN or Inf values where finite values "
+                          "are required")
+
+
+def _check_json(value, where: str = "params") -> None:
+    """Allow only what JSON stores faithfully (tuples come back as lists)."""
+    if value is None or isinstance(value, (str, bool, int)):
+        return
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise FormatError(f"{where} is {value}; JSON cannot store NaN or Inf")
+        return
+    if isinstance(value, (list, tuple)):
+        for i, item in enumerate(value):
+            _check_json(item, f"{where}[{i}]")
+        return
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise FormatError(f"{where} has key {key!r}; JSON keys must be strings")
+            _check_json(item, f"{where}[{key!r}]")
+        return
+    raise FormatError(f"{where} is a {type(value).__name__}, which JSON cannot store; convert "
+                      "it (float(), int(), .tolist()) or store it as an array")
+
+
+def _check_source_hash(value) -> None:
+    if value is not None and not (isinstance(value, str) and _SHA_RE.match(value)):
+        raise FormatError(f"source_hash must be None or 64 lower-case hex digits, got {value!r}"
+                          "; use reliefkit.formats.file_sha256")
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def save(path, representation, *, source_hash: str | None = None) -> Path:
+    """Write a representation to an .rk file atomically.
+
+    Parameters
+    ----------
+    path : destination file; its folder must exist.
+    representation : an object whose type (or a base class) has a registered `Codec`.
+    source_hash : SHA-256 hex of the mesh or heightmap it was baked from (`file_sha256`).
+
+    Returns
+    -------
+    Path : the path written.
+    """
+    codec = _codec_for_object(representation)
+    arrays, params = codec.to_arrays(representation)
+    return write_rk(path, codec.kind, arrays, params, source_hash=source_hash)
+
+
+def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
+             source_hash: str | None = None) -> Path:
+    """Validate arrays and params against a registered kind, then write atomically.
+
+    Arrays are stored C-contiguous and little-endian; values are kept bit for bit. On any
+    failure nothing is left behind and an existing file at `path` is unchanged.
+    """
+    path = Path(path)
+    try:
+        codec = _codec_for_kind(kind)
+        arrays = _prepare_arrays(codec, arrays)
+        if not isinstance(params, dict):
+            raise FormatError(f"params must be a dict, got {type(params).__name__}")
+        _check_json(params)
+        _check_source_hash(source_hash)
+    except FormatError as exc:
+        raise FormatError(f"cannot write {path}: {exc}") from None
+    from . import __version__
+
+    head = {"format": FORMAT_NAME, "format_version": FORMAT_VERSION, "kind": codec.kind,
+            "kind_version": codec.version, "params": params, "source_hash": source_hash,
+            "created_by": f"reliefkit {__version__}"}
+    _atomic_write(path, lambda fh: _write_zip(fh, head, arrays))
+    return path
+
+
+def _prepare_arrays(codec: Codec, arrays) -> dict[str, np.ndarray]:
+    if not isinstance(arrays, Mapping):
+        raise FormatError(f"arrays must be a dict of numpy arrays, got {type(arrays).__name__}")
+    present = {name: value for name, value in arrays.items() if value is not None}
+    _check_array_set(codec, present)
+    out = {}
+    for name, spec in codec.arrays.items():
+        if name not in present:
+            continue
+        arr = np.asarray(present[name])
+        _check_array(codec.kind, name, spec, arr.dtype.newbyteorder("<"), arr.shape)
+        if spec.finite:
+            _check_finite(name, arr)
+        out[name] = arr.astype(arr.dtype.newbyteorder("<"), order="C", copy=False)
+    return out
+
+
+class _HashingWriter:
+    """A write-only file that hashes what passes through it."""
+
+    def __init__(self, raw) -> None:
+        self.raw = raw
+        self.sha = hashlib.sha256()
+
+    def write(self, data) -> int:
+        self.sha.update(data)
+        return self.raw.write(data)
+
+
+def _zipinfo(name: str) -> zipfile.ZipInfo:
+    info = zipfile.ZipInfo(name, date_time=_ZIP_DATE)
+    info.compress_type = zipfile.ZIP_STORED
+    info.external_attr = 0o644 << 16
+    return info
+
+
+def _write_zip(fh, head: dict, arrays: dict[str, np.ndarray]) -> None:
+    entries = {}
+    with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+        for name, arr in arrays.items():
+            big = arr.nbytes > _FORCE_ZIP64
+            with zf.open(_zipinfo(f"{name}.npy"), "w", force_zip64=big) as raw:
+                out = _HashingWriter(raw)
+                npy.write_array(out, arr, allow_pickle=False)
+            entries[name] = {"dtype": arr.dtype.str, "shape": list(arr.shape),
+                             "sha256": out.sha.hexdigest()}
+        manifest = {**head, "arrays": entries}
+        zf.writestr(_zipinfo(MANIFEST_NAME), json.dumps(manifest, indent=2) + "\n")
+
+
+def _atomic_write(path: Path, write: Callable) -> None:
+    """Run ``write(file)`` on a temp file next to `path`, fsync it, then rename it over."""
+    folder = path.parent
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise FormatError(f"cannot write {path}: {exc.strerror or exc}; check that the folder "
+                          "exists and is writable") from exc
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise FormatError(f"cannot write {path}: {exc.strerror or exc}; nothing was "
+                              "written") from exc
+        raise
+    _fsync_folder(folder)
+
+
+@functools.cache
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _fsync_folder(folder: Path) -> None:
+    """Make the rename durable where the OS allows syncing a directory."""
+    if os.name != "posix":
+        return
+    with contextlib.suppress(OSError):
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+# --------------------------------------------------------------------------- reading
+
+
+@dataclass(frozen=True)
+class _Member:
+    """One .npy member whose header passed every check; nothing read yet."""
+
+    info: zipfile.ZipInfo
+    dtype: np.dtype
+    shape: tuple[int, ...]
+    fortran: bool
+    header_len: int
+    sha256: str
+
+    @property
+    def nbytes(self) -> int:
+        return math.prod(self.shape) * self.dtype.itemsize
+
+
+def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
+    """Read an .rk file and rebuild its representation.
+
+    Parameters
+    ----------
+    path : the .rk file.
+    max_bytes : refuse files whose arrays declare more bytes than this in total.
+
+    Raises
+    ------
+    FormatError : the file is missing, malformed, forged, corrupt or of an unknown kind, or
+        the representation rejects its data (the message names the file).
+    """
+    path = Path(path)
+    rk = read_rk(path, max_bytes=max_bytes)
+    codec = _codec_for_kind(rk.kind)
+    try:
+        return codec.from_arrays(dict(rk.arrays), dict(rk.params))
+    except FormatError as exc:
+        raise FormatError(f"{path}: {exc}") from exc
+    except (ReliefkitError, KeyError, TypeError, ValueError) as exc:
+        raise FormatError(f"{path}: invalid {rk.kind} data ({exc}); the file is corrupt or "
+                          "forged") from exc
+
+
+def read_manifest(path) -> dict:
+    """The manifest of an .rk file, after every check that needs no array data.
+
+    The manifest, the member list and every ``.npy`` header are validated; array data and
+    checksums are not read, so this is cheap for any file size.
+    """
+    with _open_rk(path) as (zf, size):
+        manifest, _, _ = _inspect(zf, size, None)
+    return manifest
+
+
+def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> RkFile:
+    """Validate an .rk file completely and return its arrays without building the object.
+
+    Checks run before any array is allocated: manifest, kind, member set, ``.npy`` headers,
+    declared sizes against stored sizes and `max_bytes`. Then each member is read with its
+    SHA-256 verified, and finite-required arrays are checked.
+    """
+    with _open_rk(path) as (zf, size):
+        manifest, codec, members = _inspect(zf, size, max_bytes)
+        arrays = {name: _read_member(zf, name, m) for name, m in members.items()}
+        for name, arr in arrays.items():
+            if codec.arrays[name].finite:
+                _check_finite(name, arr)
+    return RkFile(codec.kind, manifest, manifest["params"], arrays)
+
+
+@contextlib.contextmanager
+def _open_rk(path):
+    """Open the zip; prefix every FormatError with the path and map zip/IO errors."""
+    path = Path(path)
+    if not path.is_file():
+        why = "is not a file" if path.exists() else "no such file"
+        raise FormatError(f"{path}: {why}; check the path")
+    if not zipfile.is_zipfile(path):
+        raise FormatError(f"{path}: not a .rk file (not a zip archive, or truncated); "
+                          "re-create it with reliefkit")
+    try:
+        size = path.stat().st_size
+        with zipfile.ZipFile(path) as zf:
+            yield zf, size
+    except FormatError as exc:
+        raise FormatError(f"{path}: {exc}") from None
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError,
+            NotImplementedError) as exc:
+        raise FormatError(f"{path}: the zip is corrupt or truncated ({exc}); re-create it "
+                          "with reliefkit") from exc
+
+
+def _inspect(zf: zipfile.ZipFile, archive_size: int, max_bytes: int | None):
+    """All checks that need no array data; returns (manifest, codec, members)."""
+    infos = _member_table(zf)
+    manifest = _read_manifest_json(zf, infos)
+    codec = _check_manifest(manifest)
+    entries = manifest["arrays"]
+    _check_array_set(codec, entries)
+    _check_member_set(entries, infos)
+    members = {name: _inspect_member(zf, codec, name, entry, infos[f"{name}.npy"],
+                                     archive_size)
+               for name, entry in entries.items()}
+    total = sum(m.nbytes for m in members.values())
+    if max_bytes is not None and total > max_bytes:
+        raise FormatError(f"arrays declare {total / 2**30:.2f} GiB, over the "
+                          f"{max_bytes / 2**30:.2f} GiB limit; pass a larger max_bytes if you "
+                          "trust this file")
+    return manifest, codec, members
+
+
+def _member_table(zf: zipfile.ZipFile) -> dict[str, zipfile.ZipInfo]:
+    infos = zf.infolist()
+    table = {info.filename: info for info in infos}
+    if len(table) != len(infos):
+        raise FormatError("the zip has duplicate member names; the file is corrupt or forged")
+    encrypted = [info.filename for info in infos if info.flag_bits & 0x1]
+    if encrypted:
+        raise FormatError(f"zip member {encrypted[0]!r} is encrypted; .rk files never are")
+    return table
+
+
+def _read_manifest_json(zf: zipfile.ZipFile, infos: dict) -> dict:
+    info = infos.get(MANIFEST_NAME)
+    if info is None:
+        raise FormatError(f"no {MANIFEST_NAME} in the zip; this is not a .rk file (a plain "
+                          ".npz?) — write it with reliefkit.formats.save")
+    if info.file_size > MAX_MANIFEST_BYTES:
+        raise FormatError(f"{MANIFEST_NAME} is {info.file_size} bytes, over the 1 MiB limit; "
+                          "the file is corrupt or forged")
+    with zf.open(info) as fp:
+        raw = fp.read(MAX_MANIFEST_BYTES + 1)
+    if len(raw) > MAX_MANIFEST_BYTES:
+        raise FormatError(f"{MANIFEST_NAME} is over the 1 MiB limit; the file is corrupt")
+    try:
+        manifest = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise FormatError(f"{MANIFEST_NAME} is not valid JSON ({exc}); the file is "
+                          "corrupt") from None
+    if not isinstance(manifest, dict):
+        raise FormatError(f"{MANIFEST_NAME} is not a JSON object; the file is corrupt")
+    return manifest
+
+
+def _check_manifest(manifest: dict) -> Codec:
+    """The manifest's top-level fields, in order; returns the kind's codec."""
+    if manifest.get("format") != FORMAT_NAME:
+        raise FormatError(f"manifest format is {manifest.get('format')!r}, not "
+                          f"'{FORMAT_NAME}'; this is not a .rk file")
+    version = manifest.get("format_version")
+    _check_version(version, FORMAT_VERSION, "format_version")
+    codec = _codec_for_kind(manifest.get("kind"))
+    _check_version(manifest.get("kind_version"), codec.version,
+                   f"kind '{codec.kind}' version")
+    if not isinstance(manifest.get("params"), dict):
+        raise FormatError("manifest params is not a JSON object; the file is corrupt")
+    _check_source_hash(manifest.get("source_hash"))
+    entries = manifest.get("arrays")
+    if not isinstance(entries, dict):
+        raise FormatError("manifest arrays is not a JSON object; the file is corrupt")
+    for name, entry in entries.items():
+        _check_entry(name, entry)
+    return codec
+
+
+def _check_version(value, supported: int, what: str) -> None:
+    if type(value) is not int or value < 1:
+        raise FormatError(f"unsupported {what} {value!r}; expected an integer from 1 to "
+                          f"{supported}")
+    if value > supported:
+        raise FormatError(f"{what} {value} was written by a newer reliefkit (this one reads "
+                          f"up to {supported}); upgrade reliefkit")
+
+
+def _check_entry(name, entry) -> None:
+    if not _NAME_RE.match(name):
+        raise FormatError(f"manifest lists an invalid array name {name!r}; the file is forged")
+    ok = (isinstance(entry, dict) and isinstance(entry.get("dtype"), str)
+          and isinstance(entry.get("shape"), list)
+          and all(type(d) is int and d >= 0 for d in entry["shape"])
+          and isinstance(entry.get("sha256"), str) and _SHA_RE.match(entry["sha256"]))
+    if not ok:
+        raise FormatError(f"manifest entry for array '{name}' needs dtype, shape (non-negative "
+                          "ints) and sha256 (64 hex digits); the file is corrupt")
+
+
+def _check_member_set(entries: dict, infos: dict) -> None:
+    for name in entries:
+        if f"{name}.npy" not in infos:
+            raise FormatError(f"array '{name}' is listed in the manifest but {name}.npy is not "
+                              "in the zip; the file is incomplete")
+    expected = {f"{name}.npy" for name in entries} | {MANIFEST_NAME}
+    extra = sorted(set(infos) - expected)
+    if extra:
+        raise FormatError(f"zip member {extra[0]!r} is not listed in the manifest; the file is "
+                          "corrupt or forged")
+
+
+def _inspect_member(zf, codec: Codec, name: str, entry: dict, info: zipfile.ZipInfo,
+                    archive_size: int) -> _Member:
+    """Check one member's zip entry and .npy header; read at most a few KiB."""
+    if info.compress_type != zipfile.ZIP_STORED:
+        raise FormatError(f"array '{name}' is compressed; .rk members must be stored "
+                          "uncompressed (write the file with reliefkit.formats.save)")
+    if info.compress_size != info.file_size or \
+            info.header_offset + info.compress_size > archive_size:
+        raise FormatError(f"array '{name}' claims {info.file_size} bytes, more than the zip "
+                          "holds; the file is truncated or forged")
+    with _member_stream(zf, info, name) as fp:
+        head = fp.read(min(info.file_size, _HEADER_PEEK))
+    dtype, shape, fortran, header_len = _parse_npy_header(name, head)
+    _check_array(codec.kind, name, codec.arrays[name], dtype, shape)
+    if dtype.str != entry["dtype"] or list(shape) != entry["shape"]:
+        raise FormatError(f"array '{name}': the .npy header says {dtype.str} {shape} but the "
+                          f"manifest says {entry['dtype']} {tuple(entry['shape'])}; the file is "
+                          "corrupt")
+    member = _Member(info, dtype, shape, fortran, header_len, entry["sha256"])
+    if header_len + member.nbytes != info.file_size:
+        raise FormatError(f"array '{name}' declares shape {shape} {dtype.str} "
+                          f"({member.nbytes} bytes) but its member holds "
+                          f"{info.file_size - header_len} bytes of data; the file is truncated "
+                          "or forged")
+    return member
+
+
+@contextlib.contextmanager
+def _member_stream(zf: zipfile.ZipFile, info: zipfile.ZipInfo, name: str):
+    """Open a member for reading; a failed zip CRC-32 becomes a checksum error.
+
+    zipfile reads small members whole on the first read, so the CRC can fail at any read.
+    """
+    try:
+        with zf.open(info) as fp:
+            yield fp
+    except zipfile.BadZipFile:
+        raise FormatError(f"checksum mismatch for array '{name}' (zip CRC-32): the file is "
+                          "corrupt") from None
+
+
+def _parse_npy_header(name: str, head: bytes) -> tuple[np.dtype, tuple, bool, int]:
+    """(dtype, shape, fortran_order, header length) from the first bytes of a .npy."""
+    fp = io.BytesIO(head)
+    readers = {(1, 0): npy.read_array_header_1_0, (2, 0): npy.read_array_header_2_0}
+    try:
+        version = npy.read_magic(fp)
+        if version in readers:
+            shape, fortran, dtype = readers[version](fp, max_header_size=_MAX_NPY_HEADER)
+    except Exception as exc:  # noqa: BLE001 - untrusted bytes; numpy's parser raises many types
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise FormatError(f"array '{name}' has a malformed .npy header ({first}); the file "
+                          "is corrupt") from None
+    if version not in readers:
+        raise FormatError(f"array '{name}' uses .npy format version {version}; .rk files use "
+                          "1.0 or 2.0")
+    if not all(type(d) is int and d >= 0 for d in shape):
+        raise FormatError(f"array '{name}' has an invalid shape {shape}; the file is corrupt")
+    return dtype, shape, fortran, fp.tell()
+
+
+def _read_member(zf: zipfile.ZipFile, name: str, member: _Member) -> np.ndarray:
+    """Read one validated member into a fresh array, hashing the bytes on the way."""
+    arr = np.empty(member.shape, member.dtype, order="F" if member.fortran else "C")
+    flat = arr.ravel(order="K").view(np.uint8)
+    sha = hashlib.sha256()
+    with _member_stream(zf, member.info, name) as fp:
+        sha.update(fp.read(member.header_len))
+        pos = 0
+        while pos < flat.size:
+            chunk = fp.read(min(_CHUNK, flat.size - pos))
+            if not chunk:
+                raise FormatError(f"array '{name}' ends early; the file is truncated")
+            sha.update(chunk)
+            flat[pos:pos + len(chunk)] = np.frombuffer(chunk, np.uint8)
+            pos += len(chunk)
+    if sha.hexdigest() != member.sha256:
+        raise FormatError(f"checksum mismatch for array '{name}': the file is corrupt")
+    return np.ascontiguousarray(arr) if member.fortran else arr
+
+
+def file_sha256(path) -> str:
+    """SHA-256 hex digest of a file, read in 1 MiB blocks (for ``source_hash``)."""
+    sha = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(_CHUNK), b""):
+                sha.update(block)
+    except OSError as exc:
+        raise FormatError(f"{path}: cannot read ({exc.strerror or exc}); check the path") \
+            from exc
+    return sha.hexdigest()
+
+
+# ------------------------------------------------------------------ built-in: mesh
+
+
+def _mesh_to_arrays(mesh: RenderMesh) -> tuple[dict[str, np.ndarray], dict]:
+    arrays = {"positions": mesh.positions, "indices": mesh.indices, "normals": mesh.normals,
+              "colors": mesh.colors, "uvs": mesh.uvs, "texture": mesh.texture}
+    return arrays, {"name": mesh.name}
+
+
+def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh:
+    name = params.get("name", "mesh")
+    if not isinstance(name, str):
+        raise FormatError(f"mesh param 'name' must be a string, got {type(name).__name__}")
+    return RenderMesh(name=name, **arrays)
+
+
+def _rows(dtype: str, cols: int, **options) -> ArraySpec:
+    """Spec of an (N, cols) per-vertex or per-triangle table."""
+    return ArraySpec((dtype,), ndim=2, trailing=(cols,), **options)
+
+
+register(Codec(
+    kind="mesh",
+    cls=RenderMesh,
+    arrays={
+        "positions": _rows("float32", 3, finite=True),
+        "indices": _rows("uint32", 3),
+        "normals": _rows("float32", 3, finite=True),
+        "colors": _rows("float32", 4, finite=True),
+        "uvs": _rows("float32", 2, finite=True, required=False),
+        "texture": ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False),
+    },
+    to_arrays=_mesh_to_arrays,
+    from_arrays=_mesh_from_arrays,
+))
