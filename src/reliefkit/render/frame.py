@@ -84,3 +84,14 @@ def frame_from_targets(camera, color, position, normal, depth, stats=None) -> Fr
     return Frame(color=col, mask=mask, depth=depth.astype(np.float32), position=pos, normal=nrm,
                  view=camera.view, proj=camera.proj, viewport=camera.viewport,
                  stats=dict(stats or {}))
+
+
+def window_depth(position: np.ndarray, view: np.ndarray, proj: np.ndarray,
+                 fallback: np.ndarray) -> np.ndarray:
+    """Window depth of world positions (H, W, 3); ``fallback`` where position is NaN."""
+    valid = np.isfinite(position).all(axis=-1)
+    p = np.where(valid[..., None], position, 0.0).astype(np.float64)
+    clip = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1) @ (proj @ view).T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        depth = 0.5 * clip[..., 2] / clip[..., 3] + 0.5
+    return np.where(valid, depth, fallback).astype(np.float32)

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..gl.context import check_gl_error, get_context
+from ..gl.context import check_gl_error
 from ..gl.shaders import program
 from ..gl.textures import texture2d
 from ..scene.light import DirectionalLight
 from ..scene.mesh import RenderMesh
 from .registry import register_renderer
-from .targets import camera_uniforms, draw_into_frame, set_uniforms
+from .targets import camera_uniforms, set_uniforms
 
 
 class MeshDrawable:
@@ -41,13 +41,20 @@ class MeshDrawable:
         self.vao.render()
 
 
+    def finish(self, frame) -> None:
+        frame.stats["triangles"] = frame.stats.get("triangles", 0) + self.mesh.triangle_count
+
+    def release(self) -> None:
+        for obj in (self.vao, self.vbo, self.ibo, self.texture):
+            if obj is not None:
+                obj.release()
+
+
 def render_mesh(mesh: RenderMesh, camera, *, light: DirectionalLight | None = None, ctx=None):
     """Rasterize ``mesh`` seen by ``camera`` with Phong shading; returns a Frame."""
-    ctx = ctx or get_context()
-    drawable = MeshDrawable(ctx, mesh)
-    frame = draw_into_frame(ctx, camera, lambda: drawable.draw(camera, light or DirectionalLight()))
-    frame.stats["triangles"] = mesh.triangle_count
-    return frame
+    from .registry import render
+
+    return render(mesh, camera, light=light, ctx=ctx)
 
 
-register_renderer(RenderMesh, render_mesh)
+register_renderer(RenderMesh, MeshDrawable)

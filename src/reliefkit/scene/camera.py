@@ -153,3 +153,31 @@ def _unproject(inv: np.ndarray, x: np.ndarray, y: np.ndarray, z: float) -> np.nd
     clip = np.stack([x, y, np.full_like(x, z), np.ones_like(x)], axis=-1)
     world = clip @ inv.T
     return world[..., :3] / world[..., 3:4]
+
+
+@dataclass(frozen=True, eq=False)
+class MatrixCamera:
+    """A camera given directly by its matrices (projective ``view`` allowed), for baking.
+
+    Shading treats it as orthographic looking along ``view_dir`` (scene towards viewer).
+    """
+
+    view: np.ndarray
+    proj: np.ndarray
+    size: tuple
+    view_dir: tuple = (0.0, 0.0, 1.0)
+    near: float = 0.0
+
+    orthographic = True
+
+    @property
+    def eye(self) -> tuple:
+        return tuple(float(x) for x in self.view_dir)
+
+    @property
+    def target(self) -> tuple:
+        return (0.0, 0.0, 0.0)
+
+    @property
+    def viewport(self) -> np.ndarray:
+        return np.array([0, 0, self.size[0], self.size[1]], dtype=np.int32)

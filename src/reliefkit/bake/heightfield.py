@@ -1,0 +1,217 @@
+"""Baking relief textures: project a mesh onto the bottom face of a box or reverse frustum.
+
+The projection runs on the GPU: the mesh is rasterized through a matrix that maps box
+coordinates (u, v, h) to clip space (x = 2u - 1, y = 2v - 1, z = 1 - 2h), so the depth
+buffer keeps the highest surface and height = 1 - window depth (§3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..colorspace import to_rgba8
+from ..errors import UsageError
+from ..represent.relief import ReliefTexture
+from ..scene.camera import MatrixCamera
+from ..scene.light import DirectionalLight
+from ..scene.mesh import RenderMesh
+
+AXES = {"x": 0, "y": 1, "z": 2}
+BORDER_TEXELS = 1.5      # empty margin around the footprint (the border ring must be 0)
+HEIGHT_MARGIN = 0.01     # the box bottom lies this fraction of the height below the mesh
+FLAT_LIGHT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
+
+# box (u, v, h) -> clip: x = 2u - 1, y = 2v - 1, z = 1 - 2h (the top is nearest)
+BOX_TO_CLIP = np.array([[2.0, 0, 0, -1], [0, 2.0, 0, -1], [0, 0, -2.0, 1], [0, 0, 0, 1]])
+
+
+def axis_frame(axis: str) -> np.ndarray:
+    """Rows u, v, h: a right-handed frame whose h points along ``axis`` ('y', '-z', ...)."""
+    sign = -1.0 if axis.startswith("-") else 1.0
+    name = axis.lstrip("+-")
+    if name not in AXES:
+        raise UsageError(f"axis must be one of x, y, z, -x, -y, -z; got {axis!r}")
+    h = np.zeros(3)
+    h[AXES[name]] = sign
+    u = np.zeros(3)
+    u[0 if name != "x" else 2] = 1.0
+    return np.stack([u, np.cross(h, u), h])
+
+
+def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, tuple[int, int]]:
+    """box_to_world of the bounding box seen along ``axis`` and the (W, H) of its heightfield.
+
+    The longer side gets ``depth_res`` square texels; a ring of empty texels surrounds the
+    footprint and the bottom sits slightly below the mesh so that every covered texel has
+    a positive height.
+    """
+    if depth_res < 8:
+        raise UsageError(f"depth resolution must be at least 8, got {depth_res}")
+    frame = axis_frame(axis)
+    local = mesh.positions.astype(np.float64) @ frame.T
+    lo, hi = local.min(axis=0), local.max(axis=0)
+    ext = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1e-30))
+    texel = max(ext[0], ext[1]) / (depth_res - 2 * BORDER_TEXELS)
+    size = [depth_res if ext[k] >= ext[1 - k] else
+            int(min(depth_res, np.ceil(ext[k] / texel + 2 * BORDER_TEXELS))) for k in (0, 1)]
+    size = [max(s, 4) for s in size]
+    centre = (lo + hi) / 2
+    span = np.array([size[0] * texel, size[1] * texel, ext[2] * (1 + 2 * HEIGHT_MARGIN)])
+    origin_local = np.array([centre[0] - span[0] / 2, centre[1] - span[1] / 2,
+                             lo[2] - ext[2] * HEIGHT_MARGIN])
+    box_to_world = np.eye(4)
+    box_to_world[:3, :3] = frame.T * span
+    box_to_world[:3, 3] = frame.T @ origin_local
+    return box_to_world, (size[0], size[1])
+
+
+def project_mesh(mesh: RenderMesh, box_to_world: np.ndarray, size: tuple[int, int], ctx=None):
+    """Rasterize ``mesh`` through the box: (height, linear RGBA, world normal, coverage)."""
+    from ..render import render
+
+    world_to_box = np.linalg.inv(box_to_world)
+    up = box_to_world[:3, 2] - box_to_world[3, 2] * box_to_world[:3, 3] / box_to_world[3, 3]
+    camera = MatrixCamera(view=world_to_box, proj=BOX_TO_CLIP, size=tuple(size),
+                          view_dir=tuple(up / np.linalg.norm(up)))
+    frame = render(mesh, camera, light=FLAT_LIGHT, ctx=ctx)
+    rows = slice(None, None, -1)  # frames have row 0 at the top (v = 1); textures at v = 0
+    mask = frame.mask[rows]
+    height = np.where(mask, 1.0 - frame.depth[rows], 0.0).astype(np.float32)
+    return height, frame.color[rows], frame.normal[rows], mask
+
+
+def _orient_normals(normal: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
+    """Unit normals turned to face the viewer of the bake (up the box's h lines)."""
+    h, w = normal.shape[:2]
+    u, v = np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
+    top = _to_world(box_to_world, np.stack([u, v, np.full_like(u, 0.9)], -1))
+    bottom = _to_world(box_to_world, np.stack([u, v, np.full_like(u, 0.1)], -1))
+    up = top - bottom
+    n = normal.astype(np.float64)
+    flip = (n * up).sum(-1) < 0
+    n[flip] *= -1
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    up_unit = up / np.linalg.norm(up, axis=-1, keepdims=True)
+    return np.where(length > 1e-6, n / np.maximum(length, 1e-12), up_unit).astype(np.float32)
+
+
+def _to_world(box_to_world: np.ndarray, uvh: np.ndarray) -> np.ndarray:
+    hom = np.concatenate([uvh, np.ones(uvh.shape[:-1] + (1,))], -1) @ box_to_world.T
+    return hom[..., :3] / hom[..., 3:4]
+
+
+def _zero_border(height: np.ndarray) -> np.ndarray:
+    height = height.copy()
+    height[0, :] = height[-1, :] = 0.0
+    height[:, 0] = height[:, -1] = 0.0
+    return height
+
+
+def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int, int]:
+    if color_res is None:
+        return tuple(depth_size)
+    scale = color_res / depth_res
+    return tuple(max(2, int(round(s * scale))) for s in depth_size)
+
+
+def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
+                 safety: bool = True, tolerance: float = 0.0, progress=None,
+                 params: dict | None = None, ctx=None) -> ReliefTexture:
+    """Bake ``mesh`` through any box/frustum matrix at the given resolutions."""
+    for label, (w, h) in (("depth", depth_size), ("color", color_size)):
+        if w > 8192 or h > 8192:
+            raise UsageError(f"{label} resolution {w}x{h} is above 8192")
+    height, _, _, _ = project_mesh(mesh, box_to_world, depth_size, ctx)
+    _, color, normal, mask = project_mesh(mesh, box_to_world, color_size, ctx)
+    height = _zero_border(np.clip(height, 0.0, 1.0))
+    relief = ReliefTexture(height=height, color=to_rgba8(color * mask[..., None]),
+                           normal=_orient_normals(normal, box_to_world),
+                           box_to_world=box_to_world, params=dict(params or {}))
+    if safety:
+        from .safety import safety_radii
+
+        relief.safety = safety_radii(height, tolerance=tolerance, progress=progress)
+        relief.params["safety_tolerance"] = float(tolerance)
+    return relief
+
+
+def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = None,
+                axis: str = "y", *, safety: bool = True, tolerance: float = 0.0,
+                progress=None, ctx=None) -> ReliefTexture:
+    """Orthographic relief texture of ``mesh`` seen from above along ``axis`` (§3)."""
+    box_to_world, depth_size = ortho_box(mesh, axis, depth_res)
+    color_size = _color_size(depth_size, depth_res, color_res)
+    params = {"projection": "orthographic", "axis": axis, "depth_res": depth_res,
+              "color_res": color_res or depth_res, "source": mesh.name}
+    return bake_through(mesh, box_to_world, depth_size, color_size, safety=safety,
+                        tolerance=tolerance, progress=progress, params=params, ctx=ctx)
+
+
+def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bool = True,
+                        tolerance: float = 0.0, progress=None) -> ReliefTexture:
+    """A relief texture straight from a height array (values scaled to [0, 1]).
+
+    ``size`` is the world extent (x, y, z) of the box: u along +x, v along -z, h along +y,
+    centred on the origin with the bottom at y = 0. ``color`` is an (H', W', 3|4) uint8 sRGB
+    or float linear image; by default the heights are shaded with a terrain colour ramp.
+    """
+    h = np.asarray(heights, dtype=np.float64)
+    if h.ndim != 2 or min(h.shape) < 4:
+        raise UsageError(f"a heightmap must be a 2D array of at least 4x4, got {h.shape}")
+    if not np.isfinite(h).all():
+        raise UsageError("the heightmap contains NaN or Inf values")
+    span = h.max() - h.min()
+    h = (h - h.min()) / span if span > 0 else np.zeros_like(h)
+    h = np.clip(h * (1 - HEIGHT_MARGIN) + HEIGHT_MARGIN, 0, 1).astype(np.float32)
+    sx, sy, sz = (float(s) for s in size)
+    box_to_world = np.array([[sx, 0, 0, -sx / 2], [0, 0, sy, 0], [0, -sz, 0, sz / 2],
+                             [0, 0, 0, 1.0]])
+    color8 = _heightmap_color(h, color)
+    normal = heightfield_normals(h, box_to_world)
+    relief = ReliefTexture(height=h, color=color8, normal=normal, box_to_world=box_to_world,
+                           params={"projection": "orthographic", "source": "heightmap"})
+    if safety:
+        from .safety import safety_radii
+
+        relief.safety = safety_radii(h, tolerance=tolerance, progress=progress)
+        relief.params["safety_tolerance"] = float(tolerance)
+    return relief
+
+
+def heightfield_normals(height: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
+    """World-space normals of an affine-box heightfield by central differences."""
+    rows, cols = height.shape
+    dh_dv, dh_du = np.gradient(height.astype(np.float64), 1.0 / rows, 1.0 / cols)
+    axes = box_to_world[:3, :3]
+    tangent_u = axes[:, 0][None, None] + dh_du[..., None] * axes[:, 2]
+    tangent_v = axes[:, 1][None, None] + dh_dv[..., None] * axes[:, 2]
+    n = np.cross(tangent_u, tangent_v)
+    if np.linalg.det(axes) < 0:
+        n = -n
+    return (n / np.linalg.norm(n, axis=-1, keepdims=True)).astype(np.float32)
+
+
+# sRGB colour stops for heightmaps without a colour image: water, grass, rock, snow
+_RAMP_STOPS = np.array([0.0, 0.25, 0.55, 0.8, 1.0])
+_RAMP_SRGB = np.array([[40, 90, 110], [90, 140, 60], [140, 120, 80], [150, 150, 150],
+                       [245, 245, 250]]) / 255.0
+
+
+def height_ramp(h: np.ndarray) -> np.ndarray:
+    """(H, W, 3) linear colours for heights in [0, 1]."""
+    from ..colorspace import srgb_decode
+
+    rgb = np.stack([np.interp(h, _RAMP_STOPS, _RAMP_SRGB[:, k]) for k in range(3)], -1)
+    return srgb_decode(rgb)
+
+
+def _heightmap_color(h: np.ndarray, color) -> np.ndarray:
+    if color is None:
+        return to_rgba8(np.concatenate([height_ramp(h), np.ones(h.shape + (1,))], -1))
+    c = np.asarray(color)
+    if c.ndim != 3 or c.shape[2] not in (3, 4):
+        raise UsageError(f"color must be an (H, W, 3|4) image, got {c.shape}")
+    if c.shape[2] == 3:
+        alpha = np.full(c.shape[:2] + (1,), 255 if c.dtype == np.uint8 else 1.0, c.dtype)
+        c = np.concatenate([c, alpha], -1)
+    return c.astype(np.uint8) if c.dtype == np.uint8 else to_rgba8(c.astype(np.float32))

@@ -1,0 +1,86 @@
+"""Proxy geometry for relief textures: the box or frustum, optionally clipped (§4.1).
+
+A proxy is a convex polyhedron in world space with outward counter-clockwise triangles.
+The relief shader rebuilds each pixel's ray from the window position, so any convex proxy
+that contains the visible surface works: the whole box (frustum), or the frustum intersected
+with the object's bounding box, which rasterizes far fewer fragments.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import ConvexHull, HalfspaceIntersection
+
+
+@dataclass(frozen=True)
+class Proxy:
+    positions: np.ndarray   # (V, 3) float32 world
+    triangles: np.ndarray   # (F, 3) uint32, outward CCW
+    planes: np.ndarray      # (P, 4) inside where planes @ (x, y, z, 1) <= 0
+
+    def contains(self, point, tolerance: float = 1e-9) -> bool:
+        return bool(np.all(self.planes @ np.append(point, 1.0) <= tolerance))
+
+
+def box_planes(world_to_box: np.ndarray) -> np.ndarray:
+    """The six planes of the unit cube pulled back to world space (rows a, b, c, d)."""
+    m = np.asarray(world_to_box, dtype=np.float64)
+    w = m[3]
+    if np.dot(w, np.append(np.linalg.inv(m)[:3, :] @ [0.5, 0.5, 0.5, 1.0], 1.0)) < 0:
+        m, w = -m, -w  # keep the box centre on the w > 0 side
+    planes = []
+    for k in range(3):
+        planes.append(-m[k])         # coordinate >= 0  ->  -row_k . X <= 0
+        planes.append(m[k] - w)      # coordinate <= 1  ->  (row_k - w) . X <= 0
+    return _normalise(np.array(planes))
+
+
+def aabb_planes(bounds) -> np.ndarray:
+    lo, hi = np.asarray(bounds, dtype=np.float64)
+    planes = []
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = 1.0
+        planes.append(np.append(-e, lo[k]))
+        planes.append(np.append(e, -hi[k]))
+    return np.array(planes)
+
+
+def _normalise(planes: np.ndarray) -> np.ndarray:
+    return planes / np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+
+
+def convex_proxy(planes: np.ndarray) -> Proxy:
+    """Triangulated intersection of halfspaces ``planes @ (x, 1) <= 0``."""
+    planes = _normalise(np.asarray(planes, dtype=np.float64))
+    interior = _interior_point(planes)
+    vertices = HalfspaceIntersection(planes, interior).intersections
+    hull = ConvexHull(vertices)
+    tris = hull.simplices.copy()
+    centre = vertices[hull.vertices].mean(axis=0)
+    a, b, c = (vertices[tris[:, k]] for k in range(3))
+    outward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - centre) > 0
+    tris[~outward] = tris[~outward][:, ::-1]
+    return Proxy(vertices.astype(np.float32), tris.astype(np.uint32), planes)
+
+
+def _interior_point(planes: np.ndarray) -> np.ndarray:
+    """Chebyshev centre of the halfspaces (a point strictly inside)."""
+    from scipy.optimize import linprog
+
+    norms = np.linalg.norm(planes[:, :3], axis=1)
+    result = linprog(np.array([0, 0, 0, -1.0]), A_ub=np.hstack([planes[:, :3], norms[:, None]]),
+                     b_ub=-planes[:, 3], bounds=[(None, None)] * 3 + [(0, None)])
+    if not result.success or result.x[3] <= 0:
+        raise ValueError("the proxy's halfspaces have an empty interior")
+    return result.x[:3]
+
+
+def relief_proxy(world_to_box: np.ndarray, clip_bounds=None) -> Proxy:
+    """The box (frustum) of a relief texture, intersected with ``clip_bounds`` when given."""
+    planes = box_planes(world_to_box)
+    if clip_bounds is not None:
+        planes = np.vstack([planes, aabb_planes(clip_bounds)])
+    return convex_proxy(planes)

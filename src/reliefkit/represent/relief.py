@@ -1,0 +1,133 @@
+"""`ReliefTexture`: a texture with depth over the bottom face of a box (or a reverse frustum)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import UsageError
+
+
+@dataclass(eq=False)
+class ReliefTexture:
+    """A heightfield with colour and normals, mapped into the world by ``box_to_world``.
+
+    Box coordinates are (u, v, h) in [0, 1]^3. ``height[j, i]`` is the surface height at
+    u = (i + 0.5) / W, v = (j + 0.5) / H, interpolated bilinearly between texel centres and
+    clamped at the border; the solid lies below the surface. Height 0 means *empty*: a ray
+    that reaches the bottom face where the height is 0 misses (so the bottom face of the box
+    is not drawn), which is why bakes keep a ring of zero texels around the footprint.
+
+    Attributes
+    ----------
+    height : (H, W) float32 in [0, 1].
+    color : (Hc, Wc, 4) uint8 sRGB base colour with alpha; its own resolution (§4.3).
+    normal : (Hc, Wc, 3) float32 world-space unit normals, at the colour resolution.
+    box_to_world : (4, 4) float64 map from box coordinates to world (projective for a
+        reverse-perspective frustum; affine for a box).
+    safety : (H, W) uint8/uint16 safety radii in texels, or None (then only the binary and
+        exact methods can render it).
+    params : bake parameters (JSON), kept in the .rk manifest.
+    """
+
+    height: np.ndarray
+    color: np.ndarray
+    normal: np.ndarray
+    box_to_world: np.ndarray
+    safety: np.ndarray | None = None
+    params: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.height = np.ascontiguousarray(self.height, dtype=np.float32)
+        if self.height.ndim != 2 or min(self.height.shape) < 2:
+            raise UsageError(f"height must be an (H, W) array with H, W >= 2, got "
+                             f"{self.height.shape}")
+        if not np.isfinite(self.height).all() or self.height.min() < 0 or self.height.max() > 1:
+            raise UsageError("height values must be finite and within [0, 1]")
+        self.color = np.ascontiguousarray(self.color, dtype=np.uint8)
+        if self.color.ndim != 3 or self.color.shape[2] != 4:
+            raise UsageError(f"color must be (H, W, 4) uint8, got {self.color.shape}")
+        self.normal = np.ascontiguousarray(self.normal, dtype=np.float32)
+        if self.normal.shape != self.color.shape[:2] + (3,):
+            raise UsageError(f"normal must be {self.color.shape[:2] + (3,)}, got "
+                             f"{self.normal.shape}")
+        self.box_to_world = np.asarray(self.box_to_world, dtype=np.float64)
+        if self.box_to_world.shape != (4, 4) or abs(np.linalg.det(self.box_to_world)) < 1e-300:
+            raise UsageError("box_to_world must be an invertible 4x4 matrix")
+        if self.safety is not None:
+            self.safety = np.ascontiguousarray(self.safety)
+            if self.safety.shape != self.height.shape or self.safety.dtype not in (
+                    np.uint8, np.uint16):
+                raise UsageError("safety must be uint8/uint16 with the height's shape")
+
+    @property
+    def depth_resolution(self) -> tuple[int, int]:
+        """(W, H) of the height texture."""
+        return self.height.shape[1], self.height.shape[0]
+
+    @property
+    def color_resolution(self) -> tuple[int, int]:
+        return self.color.shape[1], self.color.shape[0]
+
+    @property
+    def world_to_box(self) -> np.ndarray:
+        return np.linalg.inv(self.box_to_world)
+
+    @property
+    def corners(self) -> np.ndarray:
+        """(8, 3) world positions of the box (frustum) corners, index = u + 2v + 4h."""
+        unit = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1, 1.0] for i in range(8)])
+        world = unit @ self.box_to_world.T
+        return world[:, :3] / world[:, 3:4]
+
+    @property
+    def bounds(self) -> np.ndarray:
+        c = self.corners
+        return np.stack([c.min(axis=0), c.max(axis=0)])
+
+    def to_world(self, uvh: np.ndarray) -> np.ndarray:
+        """Box coordinates (..., 3) -> world positions (..., 3)."""
+        uvh = np.asarray(uvh, dtype=np.float64)
+        hom = np.concatenate([uvh, np.ones(uvh.shape[:-1] + (1,))], axis=-1) @ self.box_to_world.T
+        return hom[..., :3] / hom[..., 3:4]
+
+    def to_box(self, world: np.ndarray) -> np.ndarray:
+        """World positions (..., 3) -> box coordinates (..., 3)."""
+        world = np.asarray(world, dtype=np.float64)
+        hom = np.concatenate([world, np.ones(world.shape[:-1] + (1,))], axis=-1)
+        hom = hom @ self.world_to_box.T
+        return hom[..., :3] / hom[..., 3:4]
+
+    def memory_bytes(self) -> dict:
+        """Bytes of each array as stored."""
+        arrays = {"height": self.height, "color": self.color, "normal": self.normal}
+        if self.safety is not None:
+            arrays["safety"] = self.safety
+        return {name: int(a.nbytes) for name, a in arrays.items()}
+
+    def summary(self) -> dict:
+        w, h = self.depth_resolution
+        cw, ch = self.color_resolution
+        lo, hi = self.bounds
+        return {"kind": "relief", "depth_resolution": f"{w}x{h}",
+                "color_resolution": f"{cw}x{ch}", "has_safety": self.safety is not None,
+                "bounds_min": lo.tolist(), "bounds_max": hi.tolist(),
+                "bytes": self.memory_bytes(), "params": self.params}
+
+
+@dataclass(eq=False)
+class ReliefObject:
+    """Several relief textures drawn together (the six frusta of a cube, §4.2)."""
+
+    parts: list[ReliefTexture]
+    params: dict = field(default_factory=dict)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        b = np.stack([p.bounds for p in self.parts])
+        return np.stack([b[:, 0].min(axis=0), b[:, 1].max(axis=0)])
+
+    def summary(self) -> dict:
+        return {"kind": "relief-object", "parts": len(self.parts),
+                "part_summaries": [p.summary() for p in self.parts], "params": self.params}

@@ -1,0 +1,125 @@
+// Ray vs heightfield, in texel coordinates: p(s) = o + s * d for s in [s0, s1].
+// One method is compiled in (Baboud & Decoret 2006, section 3):
+//   METHOD_BINARY  fixed linear steps, then binary search (Policarpo et al. 2005)
+//   METHOD_EXACT   walk from centreline to centreline (Amanatides-Woo in 2D, section 3.3)
+//   METHOD_ROBUST  jump by safety radii along the major axis, then binary search (section 3.4)
+// `iters` counts loop iterations (one height evaluation each) for the benchmarks.
+#include "include/heightfield.glsl"
+
+#define HARD_CAP 16384
+uniform int u_linear_steps;   // binary: number of fixed pre-steps
+uniform int u_binary_steps;   // binary search steps once the hit is bracketed
+uniform int u_max_iterations; // bound on every walk (besides HARD_CAP)
+
+// Bisection between sa (above) and sb (below), then the linear root of the last bracket.
+float refine_hit(vec3 o, vec3 d, float sa, float sb, inout int iters) {
+    float fa = hf_above(o + sa * d), fb = hf_above(o + sb * d);
+    for (int k = 0; k < HARD_CAP && k < u_binary_steps; ++k) {
+        float sm = 0.5 * (sa + sb);
+        float fm = hf_above(o + sm * d);
+        iters++;
+        if (fm < 0.0) { sb = sm; fb = fm; } else { sa = sm; fa = fm; }
+    }
+    return (fa - fb) > 0.0 ? sa + (sb - sa) * fa / (fa - fb) : sb;
+}
+
+#if defined METHOD_BINARY
+bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
+    s_hit = s0;
+    if (hf_above(o + s0 * d) < 0.0) return true;
+    float ds = (s1 - s0) / float(max(u_linear_steps, 1));
+    float sa = s0;
+    for (int k = 1; k < HARD_CAP && k <= u_linear_steps; ++k) {
+        float sb = (k == u_linear_steps) ? s1 : s0 + float(k) * ds;
+        iters++;
+        if (hf_above(o + sb * d) < 0.0) {
+            s_hit = refine_hit(o, d, sa, sb, iters);
+            return true;
+        }
+        sa = sb;
+    }
+    return false;
+}
+#endif
+
+#if defined METHOD_EXACT || defined METHOD_ROBUST
+// Parameter of the next centreline (x = k + 0.5) strictly after coordinate x moving with dx.
+float next_centerline(float x, float ox, float dx) {
+    if (dx == 0.0) return 3.0e38;
+    float c = dx > 0.0 ? floor(x - 0.5) + 1.5 : ceil(x - 0.5) - 0.5;
+    return (c - ox) / dx;
+}
+
+// Walk centreline crossings from sa (above) to s_end; true with s_hit on the first point below.
+bool walk_exact(vec3 o, vec3 d, float sa, float s_end, out float s_hit, inout int iters) {
+    vec3 p = o + sa * d;
+    vec2 t = vec2(next_centerline(p.x, o.x, d.x), next_centerline(p.y, o.y, d.y));
+    vec2 dt = vec2(d.x != 0.0 ? 1.0 / abs(d.x) : 3.0e38, d.y != 0.0 ? 1.0 / abs(d.y) : 3.0e38);
+    for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
+        float sb = min(min(t.x, t.y), s_end);
+        iters++;
+        if (hf_above(o + sb * d) < 0.0) {
+            s_hit = refine_hit(o, d, sa, sb, iters);
+            return true;
+        }
+        if (sb >= s_end) break;
+        if (t.x <= t.y) t.x += dt.x; else t.y += dt.y;
+        sa = sb;
+    }
+    s_hit = s_end;
+    return false;
+}
+#endif
+
+#if defined METHOD_EXACT
+bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
+    s_hit = s0;
+    if (hf_above(o + s0 * d) < 0.0) return true;
+    return walk_exact(o, d, s0, s1, s_hit, iters);
+}
+#endif
+
+#if defined METHOD_ROBUST
+uniform sampler2D u_safety;   // R32F radii in texels (0: non-concave peak)
+uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (else clamp to 1)
+
+bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
+    s_hit = s0;
+    if (hf_above(o + s0 * d) < 0.0) return true;
+    bool x_major = abs(d.x) >= abs(d.y);
+    float om = x_major ? o.x : o.y;
+    float dm = x_major ? d.x : d.y;
+    if (dm == 0.0) return walk_exact(o, d, s0, s1, s_hit, iters);  // vertical ray
+    // index of the last major centreline (x = ci + 0.5) at or before the entry point
+    float xm = om + s0 * dm;
+    float dir = dm > 0.0 ? 1.0 : -1.0;
+    float ci = dm > 0.0 ? floor(xm - 0.5) : ceil(xm - 0.5);
+    float sa = s0;  // last parameter known to be above the surface
+    for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
+        float s = (ci + 0.5 - om) / dm;
+        float minor = x_major ? o.y + s * d.y : o.x + s * d.x;
+        ivec2 texel = x_major ? ivec2(int(ci), int(floor(minor)))
+                              : ivec2(int(floor(minor)), int(ci));
+        float r = texelFetch(u_safety, clamp(texel, ivec2(0), u_hf_size - 1), 0).r;
+        if (r < 0.5 && u_zero_exact) {  // exact walk up to the next major centreline
+            ci += dir;
+            float s_next = min((ci + 0.5 - om) / dm, s1);
+            if (walk_exact(o, d, max(s, s0), s_next, s_hit, iters)) return true;
+            if (s_next >= s1) return false;
+            sa = s_next;
+            continue;
+        }
+        ci += dir * max(r, 1.0);
+        float s_new = (ci + 0.5 - om) / dm;
+        float sb = min(s_new, s1);
+        iters++;
+        if (hf_above(o + sb * d) < 0.0) {
+            s_hit = refine_hit(o, d, max(sa, s0), sb, iters);
+            return true;
+        }
+        if (s_new >= s1) return false;
+        sa = s_new;
+    }
+    return false;
+}
+#endif

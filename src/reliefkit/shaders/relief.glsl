@@ -1,0 +1,128 @@
+// Relief texture (Baboud & Decoret 2006): rasterize the box (or reverse frustum) and
+// intersect each pixel's ray with the heightfield in normalized box coordinates.
+//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST WRITE_DEPTH SHADOWS COUNT_ITERATIONS
+
+#if defined VERTEX_SHADER
+uniform mat4 u_view;
+uniform mat4 u_proj;
+in vec3 in_position;   // proxy vertex in world space (render/proxy.py)
+
+void main() {
+    gl_Position = u_proj * u_view * vec4(in_position, 1.0);
+}
+#endif
+
+#if defined FRAGMENT_SHADER
+#include "include/relief_intersect.glsl"
+#include "include/shading.glsl"
+#include "include/frame_outputs.glsl"
+#if defined COUNT_ITERATIONS
+layout(location = 3) out vec4 f_iterations;  // (primary, shadow, 1 = fragment ran, hit)
+#endif
+uniform mat4 u_view;
+uniform mat4 u_proj;
+uniform mat4 u_inv_view_proj;
+uniform mat4 u_world_to_box;
+uniform mat4 u_box_to_world;
+uniform vec2 u_viewport;
+uniform vec3 u_eye;
+uniform bool u_orthographic;
+uniform vec3 u_view_dir;
+uniform sampler2D u_color;    // sRGB base colour (decoded to linear by the sampler)
+uniform sampler2D u_normal;   // world-space normals
+
+vec3 to_box(vec3 world) {
+    vec4 b = u_world_to_box * vec4(world, 1.0);
+    return b.xyz / b.w;
+}
+
+vec3 to_world(vec3 box) {
+    vec4 w = u_box_to_world * vec4(box, 1.0);
+    return w.xyz / w.w;
+}
+
+vec3 unproject(vec2 ndc_xy, float ndc_z) {
+    vec4 w = u_inv_view_proj * vec4(ndc_xy, ndc_z, 1.0);
+    return w.xyz / w.w;
+}
+
+// Parameter interval where o + s * d lies in the unit cube (empty when s_exit < s_enter).
+vec2 unit_cube_interval(vec3 o, vec3 d) {
+    vec3 inv = 1.0 / d;
+    vec3 ta = (vec3(0.0) - o) * inv, tb = (vec3(1.0) - o) * inv;
+    vec3 lo = min(ta, tb), hi = max(ta, tb);
+    return vec2(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
+}
+
+// World normal of the box face that box point p lies on (the side walls of the solid).
+vec3 box_face_normal(vec3 p) {
+    vec3 dist = min(p, 1.0 - p);
+    int k = dist.x < dist.y ? (dist.x < dist.z ? 0 : 2) : (dist.y < dist.z ? 1 : 2);
+    vec4 w = vec4(u_world_to_box[0][3], u_world_to_box[1][3], u_world_to_box[2][3], 0.0);
+    vec4 row = vec4(u_world_to_box[0][k], u_world_to_box[1][k], u_world_to_box[2][k], 0.0);
+    vec3 grad = (row - p[k] * w).xyz;   // gradient of box coordinate k in world space
+    return normalize(p[k] < 0.5 ? -grad : grad);
+}
+
+void main() {
+    vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
+    // two points of the pixel's ray in box coordinates: the near plane and the proxy surface
+    // (a projective box_to_world maps lines to lines, so the ray stays a line there)
+    vec3 a = to_box(unproject(ndc, -1.0));
+    vec3 b = to_box(unproject(ndc, gl_FragCoord.z * 2.0 - 1.0));
+    vec3 d = b - a;
+    vec2 span = unit_cube_interval(a, d);
+    float s0 = max(span.x, 0.0), s1 = span.y;
+    if (s1 <= s0) discard;
+    vec3 scale = vec3(vec2(u_hf_size), 1.0);  // box -> texel coordinates
+    vec3 o_t = a * scale, d_t = d * scale;
+    int iters = 0;
+    float s_hit;
+    if (!relief_intersect(o_t, d_t, s0, s1, s_hit, iters)) {
+#if defined COUNT_ITERATIONS
+        // the instrumented pass keeps misses (uncovered: coverage 0) to count their work
+        f_color = vec4(0.0); f_position = vec4(0.0); f_normal = vec4(0.0);
+        f_iterations = vec4(float(iters), 0.0, 1.0, 0.0);
+        return;
+#else
+        discard;
+#endif
+    }
+    vec3 hit_box = clamp(a + s_hit * d, 0.0, 1.0);
+    vec3 hit = to_world(hit_box);
+    vec4 base = texture(u_color, hit_box.xy);
+    vec3 n = normalize(texture(u_normal, hit_box.xy).xyz);
+    if (s_hit <= s0 && span.x >= 0.0) n = box_face_normal(hit_box);  // a side wall of the box
+    vec3 to_eye = u_orthographic ? u_view_dir : normalize(u_eye - hit);
+    if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
+
+    float lit = 1.0;
+    int shadow_iters = 0;
+#if defined SHADOWS
+    // Cast from where the light enters the box towards the hit: that ray is unblocked until
+    // its first hit, as the safety radii assume; the point is lit if that first hit is it.
+    vec3 towards_light = to_box(hit + u_light_dir * 1e-3 * length(u_box_to_world[0].xyz)) - hit_box;
+    vec3 ld = -towards_light;
+    vec2 lspan = unit_cube_interval(hit_box, ld);   // s = 0 at the hit; entry at lspan.x < 0
+    vec3 l_origin = hit_box + lspan.x * ld;
+    // stop 1.5 texels short of the hit so the surface does not shadow itself
+    float texel_len = length(ld * vec3(scale.xy, float(max(u_hf_size.x, u_hf_size.y))));
+    float l_end = -lspan.x - 1.5 / max(texel_len, 1e-20);
+    float l_hit;
+    if (dot(n, u_light_dir) <= 0.0) {
+        lit = 0.0;  // facing away from the light
+    } else if (l_end > 0.0 &&
+               relief_intersect(l_origin * scale, ld * scale, 0.0, l_end, l_hit, shadow_iters)) {
+        lit = 0.0;
+    }
+#endif
+    write_frame(vec4(shade_phong(base.rgb, n, to_eye, lit), base.a), hit, n);
+#if defined COUNT_ITERATIONS
+    f_iterations = vec4(float(iters), float(shadow_iters), 1.0, 1.0);
+#endif
+#if defined WRITE_DEPTH
+    vec4 clip = u_proj * u_view * vec4(hit, 1.0);
+    gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+#endif
+}
+#endif
