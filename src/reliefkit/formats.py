@@ -177,7 +177,13 @@ def _ndims(spec: ArraySpec) -> tuple[int, ...]:
     return spec.ndim if isinstance(spec.ndim, tuple) else (spec.ndim,)
 
 
+def _load_builtin_codecs() -> None:
+    """Register the representations' kinds (their module imports this one, not vice versa)."""
+    from . import codecs  # noqa: F401
+
+
 def _codec_for_kind(kind) -> Codec:
+    _load_builtin_codecs()
     codec = _CODECS.get(kind) if isinstance(kind, str) else None
     if codec is None:
         known = ", ".join(registered_kinds()) or "none"
@@ -187,6 +193,7 @@ def _codec_for_kind(kind) -> Codec:
 
 
 def _codec_for_object(rep) -> Codec:
+    _load_builtin_codecs()
     for cls in type(rep).__mro__:
         if cls in _BY_CLASS:
             return _BY_CLASS[cls]

@@ -1,0 +1,73 @@
+"""The .rk kinds of the representations (the ``mesh`` kind lives in formats.py).
+
+``relief``: one ReliefTexture, arrays named as DESIGN.md says. ``relief-object``: several
+parts (the six frusta of a cube), each part's arrays prefixed ``pK_``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import FormatError
+from .formats import ArraySpec, Codec, register
+from .represent.relief import ReliefObject, ReliefTexture
+
+MAX_PARTS = 6
+
+RELIEF_ARRAYS = {
+    "height": ArraySpec(("float32",), ndim=2, finite=True),
+    "color": ArraySpec(("uint8",), ndim=3, trailing=(None, 4)),
+    "normal": ArraySpec(("float32",), ndim=3, trailing=(None, 3), finite=True),
+    "safety": ArraySpec(("uint8", "uint16"), ndim=2, required=False),
+    "box_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
+}
+
+
+def _relief_arrays(relief: ReliefTexture, prefix: str = "") -> dict[str, np.ndarray]:
+    arrays = {"height": relief.height, "color": relief.color, "normal": relief.normal,
+              "box_to_world": relief.box_to_world}
+    if relief.safety is not None:
+        arrays["safety"] = relief.safety
+    return {prefix + name: a for name, a in arrays.items()}
+
+
+def _relief_from(arrays: dict, params: dict, prefix: str = "") -> ReliefTexture:
+    get = {name: arrays.get(prefix + name) for name in RELIEF_ARRAYS}
+    try:
+        return ReliefTexture(params=dict(params), **get)
+    except Exception as exc:  # UsageError from the representation's own validation
+        raise FormatError(f"invalid relief texture: {exc}") from None
+
+
+def _object_arrays(obj: ReliefObject):
+    arrays = {}
+    for k, part in enumerate(obj.parts):
+        arrays |= _relief_arrays(part, f"p{k}_")
+    params = dict(obj.params) | {"parts": len(obj.parts),
+                                 "part_params": [p.params for p in obj.parts]}
+    return arrays, params
+
+
+def _object_from(arrays: dict, params: dict) -> ReliefObject:
+    count = params.get("parts")
+    if not isinstance(count, int) or not 1 <= count <= MAX_PARTS:
+        raise FormatError(f"relief-object needs 1..{MAX_PARTS} parts, manifest says {count!r}")
+    part_params = params.get("part_params") or [{}] * count
+    parts = []
+    for k in range(count):
+        if f"p{k}_height" not in arrays:
+            raise FormatError(f"relief-object part {k} is missing its arrays")
+        parts.append(_relief_from(arrays, part_params[k], f"p{k}_"))
+    rest = {key: v for key, v in params.items() if key not in ("parts", "part_params")}
+    return ReliefObject(parts=parts, params=rest)
+
+
+register(Codec(kind="relief", cls=ReliefTexture, arrays=RELIEF_ARRAYS,
+               to_arrays=lambda r: (_relief_arrays(r), dict(r.params)),
+               from_arrays=_relief_from))
+register(Codec(
+    kind="relief-object", cls=ReliefObject,
+    arrays={f"p{k}_{name}": ArraySpec(spec.dtypes, spec.ndim, required=False,
+                                      finite=spec.finite, trailing=spec.trailing)
+            for k in range(MAX_PARTS) for name, spec in RELIEF_ARRAYS.items()},
+    to_arrays=_object_arrays, from_arrays=_object_from))
