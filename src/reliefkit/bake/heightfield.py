@@ -116,14 +116,21 @@ def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int,
 
 def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
                  safety: bool = True, tolerance: float = 0.0, progress=None,
-                 params: dict | None = None, ctx=None) -> ReliefTexture:
-    """Bake ``mesh`` through any box/frustum matrix at the given resolutions."""
+                 params: dict | None = None, zero_border: bool = True,
+                 ctx=None) -> ReliefTexture:
+    """Bake ``mesh`` through any box/frustum matrix at the given resolutions.
+
+    ``zero_border`` empties the outer ring of texels so every ray enters above the surface
+    (§3, footnote 1); the six frusta of a cube share their sides and keep it.
+    """
     for label, (w, h) in (("depth", depth_size), ("color", color_size)):
         if w > 8192 or h > 8192:
             raise UsageError(f"{label} resolution {w}x{h} is above 8192")
     height, _, _, _ = project_mesh(mesh, box_to_world, depth_size, ctx)
     _, color, normal, mask = project_mesh(mesh, box_to_world, color_size, ctx)
-    height = _zero_border(np.clip(height, 0.0, 1.0))
+    height = np.clip(height, 0.0, 1.0)
+    if zero_border:
+        height = _zero_border(height)
     relief = ReliefTexture(height=height, color=to_rgba8(color * mask[..., None]),
                            normal=_orient_normals(normal, box_to_world),
                            box_to_world=box_to_world, params=dict(params or {}))

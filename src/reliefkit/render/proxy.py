@@ -27,9 +27,10 @@ class Proxy:
 def box_planes(world_to_box: np.ndarray) -> np.ndarray:
     """The six planes of the unit cube pulled back to world space (rows a, b, c, d)."""
     m = np.asarray(world_to_box, dtype=np.float64)
+    centre = np.linalg.inv(m) @ [0.5, 0.5, 0.5, 1.0]
+    if m[3] @ np.append(centre[:3] / centre[3], 1.0) < 0:
+        m = -m  # keep the box centre on the w > 0 side
     w = m[3]
-    if np.dot(w, np.append(np.linalg.inv(m)[:3, :] @ [0.5, 0.5, 0.5, 1.0], 1.0)) < 0:
-        m, w = -m, -w  # keep the box centre on the w > 0 side
     planes = []
     for k in range(3):
         planes.append(-m[k])         # coordinate >= 0  ->  -row_k . X <= 0
