@@ -20,11 +20,15 @@ examples:
   reliefkit render bunny.ply -o bunny.png           one view (default --view 30,25,2.6)
   reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs side.npz
   reliefkit render demo:tree --turntable 36 -o spin.gif
+  reliefkit bake demo:terrain --as relief --depth-res 256 -o terrain.rk
+  reliefkit render terrain.rk --method robust --shadows -o terrain.png
+  reliefkit compare demo:vehicle --as relief-frustum --out cmp
   reliefkit info --gl                               the OpenGL renderer and its limits
   reliefkit info model.obj                          counts and bounds of a mesh (or an .rk)
 
-inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, or demo:NAME
-(demo assets: terrain, blob, tree, vehicle).
+inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME
+(demo assets: terrain, blob, tree, vehicle), or for `bake --as relief` a heightmap
+(8/16-bit greyscale .png or a 2D .npy array).
 """
 
 
@@ -64,7 +68,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
     p.add_argument("--background", default="transparent",
                    help="'transparent' or a grey level 0..1 to composite over")
+    _add_relief_args(p)
     p.set_defaults(run=cmd_render)
+
+    p = sub.add_parser("bake", help="bake a mesh or heightmap into an .rk representation",
+                       description="Bake a mesh (or a heightmap) into a representation.",
+                       epilog="examples:\n  reliefkit bake model.glb --as relief --depth-res 256 "
+                              "--color-res 512 -o model.rk\n  reliefkit bake demo:vehicle --as "
+                              "relief-frustum -o van.rk\n  reliefkit bake height.png --as relief "
+                              "--box 2,0.4,2 -o terrain.rk",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_bake_args(p)
+    p.add_argument("-o", "--output", required=True, help="output .rk file")
+    p.set_defaults(run=cmd_bake)
 
     p = sub.add_parser("info", help="GL capabilities, or the contents of a mesh / .rk file",
                        description="Print the OpenGL renderer and limits (--gl) and/or "
@@ -81,6 +97,85 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
     p.set_defaults(run=cmd_demo)
     return parser
+
+
+def _add_relief_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("relief textures")
+    g.add_argument("--method", default="robust", choices=("binary", "exact", "robust"),
+                   help="ray/heightfield intersection (default: %(default)s)")
+    g.add_argument("--depth-mode", default="conservative", choices=("conservative", "exact"),
+                   help="keep the box depth, or write the hit's depth (default: %(default)s)")
+    g.add_argument("--shadows", action="store_true", help="self-shadowing (a ray to the light)")
+    g.add_argument("--zero-radius", default="exact", choices=("exact", "clamp"),
+                   help="robust method at zero safety radius (default: %(default)s)")
+    g.add_argument("--linear-steps", type=int, default=16, help="binary: fixed pre-steps")
+    g.add_argument("--binary-steps", type=int, default=8, help="binary search steps")
+
+
+def _relief_options(args, obj) -> dict:
+    from .represent.relief import ReliefObject, ReliefTexture
+
+    if not isinstance(obj, ReliefTexture | ReliefObject):
+        return {}
+    return {"method": args.method, "depth_mode": args.depth_mode, "shadows": args.shadows,
+            "zero_radius": args.zero_radius, "linear_steps": args.linear_steps,
+            "binary_steps": args.binary_steps}
+
+
+def _add_bake_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("input", help="mesh file, demo:NAME, or a heightmap (.png/.npy)")
+    p.add_argument("--as", dest="kind", default="relief",
+                   choices=("relief", "relief-frustum", "relief-cube"),
+                   help="representation to bake (default: %(default)s)")
+    p.add_argument("--depth-res", type=int, help="heightfield resolution (longest side)")
+    p.add_argument("--color-res", type=int, help="colour/normal resolution (default: depth)")
+    p.add_argument("--safety-tolerance", type=float, default=0.0, metavar="E",
+                   help="allowed silhouette error (height units) for larger safety radii")
+    p.add_argument("--no-safety", action="store_true", help="skip the safety radii")
+    p.add_argument("--axis", default="y", help="projection axis: x, y, z, -x, -y, -z")
+    p.add_argument("--spread", type=float, default=30.0,
+                   help="relief-frustum: side tilt in degrees (default: %(default)s)")
+    p.add_argument("--box", default="2,0.5,2", metavar="SX,SY,SZ",
+                   help="heightmaps: world size of the box (default: %(default)s)")
+
+
+def _bake_input(args):
+    from .bake import bake
+    from .progress import progress_bar
+    from .scene.heightmap import is_heightmap, load_heightmap
+
+    if args.safety_tolerance < 0 or args.safety_tolerance > 1:
+        raise UsageError("--safety-tolerance must be within [0, 1]")
+    extra = {}
+    if is_heightmap(args.input):
+        source = load_heightmap(args.input)
+        try:
+            extra["size"] = tuple(float(x) for x in args.box.split(","))
+            assert len(extra["size"]) == 3 and min(extra["size"]) > 0
+        except (ValueError, AssertionError):
+            raise UsageError(f"--box must be three positive sizes, got {args.box!r}") from None
+    else:
+        from .inputs import load_input
+
+        source = load_input(args.input)
+        if args.kind == "relief-frustum":
+            extra["spread_deg"] = args.spread
+    with progress_bar("safety radii", 1, enabled=not args.no_safety) as advance:
+        return bake(source, args.kind, depth_res=args.depth_res, color_res=args.color_res,
+                    tolerance=args.safety_tolerance, safety=not args.no_safety,
+                    axis=args.axis, progress=advance, **extra)
+
+
+def cmd_bake(args) -> int:
+    from .formats import file_sha256, save
+
+    if Path(args.output).suffix.lower() != ".rk":
+        raise UsageError(f"output must be an .rk file, got {args.output}")
+    rep = _bake_input(args)
+    source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
+    save(args.output, rep, source_hash=source_hash)
+    print(f"wrote {args.output} ({json.dumps(rep.summary().get('bytes', {}))})")
+    return 0
 
 
 def _version() -> str:
@@ -114,6 +209,7 @@ def cmd_render(args) -> int:
     if args.turntable is None and suffix != ".png":
         raise UsageError(f"output must be a .png file, got {args.output}")
     obj = load_input(args.input)
+    options = _relief_options(args, obj)
     if args.turntable is not None:
         from .progress import progress_bar
 
@@ -121,12 +217,13 @@ def cmd_render(args) -> int:
         frames = []
         with progress_bar("turntable", len(cameras)) as advance:
             for k, camera in enumerate(cameras):
-                frames.append(render(obj, camera).rgba8(background or (0.12, 0.12, 0.13)))
+                frames.append(render(obj, camera, **options).rgba8(
+                    background or (0.12, 0.12, 0.13)))
                 advance(k + 1)
         save_gif(frames, args.output)
         print(f"wrote {args.output} ({len(frames)} views)")
         return 0
-    frame = render(obj, orbit_bounds(obj.bounds, az, el, dist, size, args.fov))
+    frame = render(obj, orbit_bounds(obj.bounds, az, el, dist, size, args.fov), **options)
     frame.save(args.output, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {int(frame.mask.sum())} pixels covered)")
     if args.aovs:

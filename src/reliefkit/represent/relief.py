@@ -83,8 +83,13 @@ class ReliefTexture:
 
     @property
     def bounds(self) -> np.ndarray:
+        """World bounding box: of the box (frustum), cut to ``params['clip_bounds']``."""
         c = self.corners
-        return np.stack([c.min(axis=0), c.max(axis=0)])
+        lo, hi = c.min(axis=0), c.max(axis=0)
+        clip = self.params.get("clip_bounds")
+        if clip is not None:
+            lo, hi = np.maximum(lo, clip[0]), np.minimum(hi, clip[1])
+        return np.stack([lo, hi])
 
     def to_world(self, uvh: np.ndarray) -> np.ndarray:
         """Box coordinates (..., 3) -> world positions (..., 3)."""

@@ -1,0 +1,68 @@
+"""Heightmap files for terrain-like inputs: 8/16-bit greyscale PNG or a 2D .npy array."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+
+HEIGHTMAP_SUFFIXES = (".png", ".npy")
+MAX_SIDE = 8192
+
+
+def is_heightmap(path) -> bool:
+    return Path(str(path)).suffix.lower() in HEIGHTMAP_SUFFIXES
+
+
+def load_heightmap(path) -> np.ndarray:
+    """(H, W) float64 heights; row 0 of the file becomes v = 0 (the image's top row)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FormatError(f"{path}: no such file")
+    if path.suffix.lower() == ".npy":
+        heights = _load_npy(path)
+    else:
+        heights = _load_png(path)
+    if heights.ndim != 2 or min(heights.shape) < 4 or max(heights.shape) > MAX_SIDE:
+        raise FormatError(f"{path}: a heightmap must be 2D, between 4 and {MAX_SIDE} texels "
+                          f"per side; got shape {heights.shape}")
+    if not np.isfinite(heights).all():
+        raise FormatError(f"{path}: the heightmap contains NaN or Inf values")
+    return heights
+
+
+def _load_npy(path: Path) -> np.ndarray:
+    try:
+        with open(path, "rb") as fh:
+            version = np.lib.format.read_magic(fh)
+            read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                           else np.lib.format.read_array_header_2_0)
+            shape, _, dtype = read_header(fh)
+            if dtype.hasobject or dtype.kind not in "biuf":
+                raise FormatError(f"{path}: heightmap must be a numeric array, got {dtype}")
+            if len(shape) != 2 or max(shape, default=0) > MAX_SIDE:
+                raise FormatError(f"{path}: a heightmap must be 2D and at most {MAX_SIDE} "
+                                  f"per side; got shape {shape}")
+        return np.load(path, allow_pickle=False).astype(np.float64)
+    except FormatError:
+        raise
+    except Exception as exc:
+        raise FormatError(f"{path}: not a readable .npy array ({exc})") from None
+
+
+def _load_png(path: Path) -> np.ndarray:
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as image:
+            if max(image.size) > MAX_SIDE:
+                raise FormatError(f"{path}: heightmap larger than {MAX_SIDE} per side")
+            if image.mode in ("I;16", "I;16B", "I;16L", "I"):
+                return np.asarray(image, dtype=np.float64) / 65535.0
+            return np.asarray(image.convert("L"), dtype=np.float64) / 255.0
+    except FormatError:
+        raise
+    except (UnidentifiedImageError, OSError, ValueError) as exc:
+        raise FormatError(f"{path}: not a readable PNG image ({exc})") from None
