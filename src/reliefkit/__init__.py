@@ -1,6 +1,25 @@
-"""reliefkit: render geometry from textures with depth."""
+"""reliefkit: render geometry from textures with depth.
 
+>>> import reliefkit as rk
+>>> mesh = rk.load_mesh("model.glb")
+>>> frame = rk.render(mesh, rk.Camera.orbit(mesh.center, 30, 25, 3 * mesh.radius))
+"""
+
+from . import metrics
+from .bake import bake, bake_relief, bake_relief_cube, bake_relief_frustum, relief_from_heights
 from .errors import FormatError, GPUError, MeshError, ReliefkitError, UsageError
+from .formats import load, save
+from .render import Frame, render
+from .represent.relief import ReliefObject, ReliefTexture
+from .scene.camera import Camera
+from .scene.light import DirectionalLight
+from .scene.loader import load_mesh
+from .scene.mesh import RenderMesh
 
-__all__ = ["ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError"]
+__all__ = [
+    "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
+    "metrics", "bake", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
+    "relief_from_heights", "ReliefTexture", "ReliefObject",
+    "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
+]
 __version__ = "0.1.0"

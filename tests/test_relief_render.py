@@ -1,0 +1,142 @@
+"""Relief texture rendering on analytic scenes: planes, depth modes, camera inside the box."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from reliefkit.bake.heightfield import heightfield_normals
+from reliefkit.render import render
+from reliefkit.represent.relief import ReliefTexture
+from reliefkit.scene.camera import Camera
+from reliefkit.scene.mesh import RenderMesh, vertex_normals
+
+# box [-1, 1] x [0, 1] x [-1, 1]: u along +x, v along -z, h along +y
+BOX = np.array([[2.0, 0, 0, -1], [0, 0, 1.0, 0], [0, -2.0, 0, 1], [0, 0, 0, 1]])
+METHODS = ["binary", "exact", "robust"]
+
+
+def make_relief(height, box_to_world=BOX, safety=None, rgb=(0.2, 0.6, 0.3)):
+    height = np.asarray(height, np.float32)
+    color = np.zeros(height.shape + (4,), np.uint8)
+    color[..., :3] = np.round(np.array(rgb) * 255)
+    color[..., 3] = 255
+    if safety is None:
+        safety = np.ones(height.shape, np.uint8)
+    return ReliefTexture(height=height, color=color,
+                         normal=heightfield_normals(height, box_to_world),
+                         box_to_world=box_to_world, safety=safety)
+
+
+def flat(level, n=32):
+    h = np.full((n, n), level, np.float32)
+    h[0, :] = h[-1, :] = h[:, 0] = h[:, -1] = 0.0
+    return h
+
+
+def plane_hits(camera, y):
+    origins, dirs = camera.pixel_rays()
+    t = (y - origins[..., 1]) / dirs[..., 1]
+    return origins + t[..., None] * dirs, t
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_flat_surface_positions_lie_on_the_plane(gl, method):
+    relief = make_relief(flat(0.5))
+    camera = Camera.orbit((0, 0.5, 0), 30, 40, 3.5, size=(64, 64))
+    frame = render(relief, camera, method=method)
+    hits, _ = plane_hits(camera, 0.5)
+    inner = (np.abs(hits[..., 0]) < 0.85) & (np.abs(hits[..., 2]) < 0.85)
+    assert inner.sum() > 500 and frame.mask[inner].all()
+    # 2 texels of 1/16 each: the border ring ramps from 0.5 down to 0 there
+    assert not frame.mask[(np.abs(hits[..., 0]) > 1.1) & (np.abs(hits[..., 2]) > 1.1)].any()
+    err = np.linalg.norm(frame.position[inner] - hits[inner], axis=-1)
+    assert err.max() < 1e-3
+    core = (np.abs(hits[..., 0]) < 0.7) & (np.abs(hits[..., 2]) < 0.7)  # normals off the rim
+    np.testing.assert_allclose(frame.normal[core], np.tile([0, 1.0, 0], (core.sum(), 1)),
+                               atol=1e-4)
+
+
+def _sphere(center, radius, rgb=(0.9, 0.1, 0.1)):
+    s = trimesh.creation.icosphere(subdivisions=4, radius=radius)
+    p = (s.vertices + center).astype(np.float32)
+    return RenderMesh(p, s.faces, vertex_normals(p, s.faces), np.tile([*rgb, 1.0], (len(p), 1)))
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_penetrating_object_is_hidden_correctly_only_in_exact_depth_mode(gl, method):
+    relief = make_relief(flat(0.5))
+    center, radius = np.array([0.0, 0.5, 0.0]), 0.3
+    sphere = _sphere(center, radius)
+    camera = Camera.orbit((0, 0.5, 0), 10, 35, 3.0, size=(64, 64))
+    origins, dirs = camera.pixel_rays()
+    to_c = center - origins
+    b = (to_c * dirs).sum(-1)
+    disc = b**2 - (to_c**2).sum(-1) + radius**2
+    t_sphere = np.where(disc > 0, b - np.sqrt(np.maximum(disc, 0)), np.inf)
+    hits, t_plane = plane_hits(camera, 0.5)
+    on_plane = (np.abs(hits[..., 0]) < 0.85) & (np.abs(hits[..., 2]) < 0.85)
+    # pixels whose first hit is clearly the sphere's upper cap, or clearly the plane
+    sphere_first = (disc > 0.02) & (t_sphere < t_plane - 0.05)
+    plane_first = on_plane & (t_plane < t_sphere - 0.05)
+    assert sphere_first.sum() > 50 and plane_first.sum() > 20
+    for order in ([relief, sphere], [sphere, relief]):
+        exact = render(order, camera, method=method, depth_mode="exact")
+        red = exact.color[..., 0] > 2 * exact.color[..., 1]
+        assert red[sphere_first].all() and not red[plane_first].any()
+        conservative = render(order, camera, method=method, depth_mode="conservative")
+        red = conservative.color[..., 0] > 2 * conservative.color[..., 1]
+        assert not red[sphere_first].any()  # the box's front faces hide the cap
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_camera_inside_the_box(gl, method):
+    tall = BOX @ np.diag([1.0, 1.0, 4.0, 1.0])  # box height 4: the camera fits inside
+    relief = make_relief(flat(0.125), tall)  # surface at y = 0.5
+    camera = Camera(eye=(0.1, 2.0, 0.2), target=(0.3, 0.5, -0.2), size=(48, 48), fov_deg=60,
+                    near=0.01, far=10.0)
+    frame = render(relief, camera, method=method)
+    hits, t = plane_hits(camera, 0.5)
+    inner = (np.abs(hits[..., 0]) < 0.85) & (np.abs(hits[..., 2]) < 0.85) & (t > 0)
+    assert inner.mean() > 0.5 and frame.mask[inner].all()
+    assert np.linalg.norm(frame.position[inner] - hits[inner], axis=-1).max() < 1e-3
+
+
+def test_robust_needs_safety_radii(gl):
+    from reliefkit.errors import UsageError
+
+    relief = make_relief(flat(0.5))
+    relief.safety = None
+    with pytest.raises(UsageError, match="no safety radii"):
+        render(relief, Camera.orbit((0, 0, 0), 0, 30, 3.0, size=(8, 8)), method="robust")
+
+
+def test_unknown_option_and_method_are_errors(gl):
+    from reliefkit.errors import UsageError
+
+    relief = make_relief(flat(0.5))
+    camera = Camera.orbit((0, 0, 0), 0, 30, 3.0, size=(8, 8))
+    with pytest.raises(UsageError, match="unknown method"):
+        render(relief, camera, method="magic")
+    with pytest.raises(UsageError, match="unknown render option"):
+        render(relief, camera, colour="red")
+
+
+def test_shadows_darken_the_lee_of_a_wall(gl):
+    from reliefkit.scene.light import DirectionalLight
+
+    h = flat(0.1, 64)
+    h[8:56, 30:34] = 0.9  # a wall across the field
+    relief = make_relief(h)
+    light = DirectionalLight(direction=(-1.0, 1.0, 0.0), specular=0.0)  # from -x, 45 deg up
+    camera = Camera(eye=(0, 3.0, 0.001), target=(0, 0, 0), size=(64, 64), fov_deg=45)
+    lit = render(relief, camera, method="exact", light=light)
+    shaded = render(relief, camera, method="exact", light=light, shadows=True)
+    x = shaded.position[..., 0]
+    floor = shaded.mask & (shaded.position[..., 1] < 0.15) & (np.abs(shaded.position[..., 2])
+                                                               < 0.5)
+    lee = floor & (x > 0.15) & (x < 0.6)      # within the wall's shadow (length 0.8)
+    open_side = floor & (x < -0.2)
+    assert lee.sum() > 20 and open_side.sum() > 20
+    ratio = shaded.color[..., 1][lee].mean() / lit.color[..., 1][lee].mean()
+    assert ratio < 0.5
+    np.testing.assert_allclose(shaded.color[open_side], lit.color[open_side], atol=1e-5)
