@@ -108,6 +108,9 @@ def _add_relief_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--shadows", action="store_true", help="self-shadowing (a ray to the light)")
     g.add_argument("--zero-radius", default="exact", choices=("exact", "clamp"),
                    help="robust method at zero safety radius (default: %(default)s)")
+    g.add_argument("--cell-test", default="quadratic", choices=("quadratic", "linear"),
+                   help="exact/robust: test each cell's exact quadratic, or assume heights "
+                        "linear between centrelines as the paper does (default: %(default)s)")
     g.add_argument("--linear-steps", type=int, default=16, help="binary: fixed pre-steps")
     g.add_argument("--binary-steps", type=int, default=8, help="binary search steps")
 
@@ -118,7 +121,8 @@ def _relief_options(args, obj) -> dict:
     if not isinstance(obj, ReliefTexture | ReliefObject):
         return {}
     return {"method": args.method, "depth_mode": args.depth_mode, "shadows": args.shadows,
-            "zero_radius": args.zero_radius, "linear_steps": args.linear_steps,
+            "zero_radius": args.zero_radius, "cell_test": args.cell_test,
+            "linear_steps": args.linear_steps,
             "binary_steps": args.binary_steps}
 
 

@@ -33,13 +33,34 @@ def _asset(name: str) -> Callable[[], object]:
     return make
 
 
+def _baked(name: str, kind: str, **bake_options) -> Callable[[], object]:
+    def make():
+        from .bake import bake
+        from .scene.assets import make_asset
+
+        return bake(make_asset(name), kind, **bake_options)
+
+    return make
+
+
 def demo_tiles() -> list[DemoTile]:
     """Every tile of the demo sheet, in order (representations add theirs here)."""
+    terrain_view, vehicle_view, blob_view = (30.0, 35.0, 2.2), (40.0, 20.0, 2.2), (35, 25, 2.5)
+    robust_shadows = {"method": "robust", "shadows": True}
     return [
-        DemoTile("terrain (mesh)", "terrain-mesh", _asset("terrain"), (30.0, 35.0, 2.2)),
-        DemoTile("blob (mesh)", "blob-mesh", _asset("blob"), (35.0, 25.0, 2.5)),
+        DemoTile("terrain (mesh)", "terrain-mesh", _asset("terrain"), terrain_view),
+        DemoTile("blob (mesh)", "blob-mesh", _asset("blob"), blob_view),
         DemoTile("tree (mesh)", "tree-mesh", _asset("tree"), (20.0, 10.0, 2.4)),
-        DemoTile("vehicle (mesh)", "vehicle-mesh", _asset("vehicle"), (40.0, 20.0, 2.2)),
+        DemoTile("vehicle (mesh)", "vehicle-mesh", _asset("vehicle"), vehicle_view),
+        DemoTile("terrain: relief 256, robust + shadows", "terrain-relief",
+                 _baked("terrain", "relief", depth_res=256), terrain_view, robust_shadows),
+        DemoTile("vehicle: orthographic relief", "vehicle-relief",
+                 _baked("vehicle", "relief", depth_res=128, color_res=256), vehicle_view),
+        DemoTile("vehicle: reverse-perspective relief", "vehicle-frustum",
+                 _baked("vehicle", "relief-frustum", depth_res=128, color_res=256),
+                 vehicle_view),
+        DemoTile("blob: six reverse frusta", "blob-cube",
+                 _baked("blob", "relief-cube", depth_res=128), blob_view),
     ]
 
 

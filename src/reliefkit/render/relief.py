@@ -17,25 +17,33 @@ from .targets import camera_uniforms, set_uniforms
 METHODS = ("binary", "exact", "robust")
 DEPTH_MODES = ("conservative", "exact")
 ZERO_RADIUS_MODES = ("exact", "clamp")
+CELL_TESTS = ("quadratic", "linear")
 OPTIONS = ("method", "depth_mode", "shadows", "count_iterations", "linear_steps",
-           "binary_steps", "max_iterations", "zero_radius")
+           "binary_steps", "max_iterations", "zero_radius", "cell_test")
 
-def validate_options(method: str, depth_mode: str, zero_radius: str) -> None:
+def validate_options(method: str, depth_mode: str, zero_radius: str, cell_test: str) -> None:
     for value, allowed, label in ((method, METHODS, "method"),
                                   (depth_mode, DEPTH_MODES, "depth mode"),
-                                  (zero_radius, ZERO_RADIUS_MODES, "zero-radius mode")):
+                                  (zero_radius, ZERO_RADIUS_MODES, "zero-radius mode"),
+                                  (cell_test, CELL_TESTS, "cell test")):
         if value not in allowed:
             raise UsageError(f"unknown {label} {value!r} (choose from {', '.join(allowed)})")
 
 
 class ReliefDrawable:
-    """GPU textures and proxy of one ReliefTexture, drawn with one intersection method."""
+    """GPU textures and proxy of one ReliefTexture, drawn with one intersection method.
+
+    ``cell_test="linear"`` is the paper's exact walk (heights linear between centreline
+    crossings, §3.3); ``"quadratic"`` (default) also tests the exact quadratic inside each
+    cell with one more fetch per step, so saddle grazes (Fig. 3) are found too.
+    """
 
     def __init__(self, ctx, relief: ReliefTexture, *, method: str = "robust",
                  depth_mode: str = "conservative", shadows: bool = False,
                  count_iterations: bool = False, linear_steps: int = 16, binary_steps: int = 8,
-                 max_iterations: int | None = None, zero_radius: str = "exact"):
-        validate_options(method, depth_mode, zero_radius)
+                 max_iterations: int | None = None, zero_radius: str = "exact",
+                 cell_test: str = "quadratic"):
+        validate_options(method, depth_mode, zero_radius, cell_test)
         if method == "robust" and relief.safety is None:
             raise UsageError("this relief texture has no safety radii: bake it with them or "
                              "render with --method binary or exact")
@@ -68,6 +76,7 @@ class ReliefDrawable:
             "u_binary_steps": int(binary_steps),
             "u_max_iterations": int(max_iterations or 4 * (w + h) + 64),
             "u_zero_exact": zero_radius == "exact",
+            "u_quadratic_cells": cell_test == "quadratic",
         }
         check_gl_error(ctx, "uploading a relief texture")
 

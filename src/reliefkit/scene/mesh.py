@@ -116,9 +116,9 @@ def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
     p = np.asarray(positions, dtype=np.float64)
     tri = p[np.asarray(indices, dtype=np.int64)]
     face = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    n = np.zeros_like(p)
-    for k in range(3):
-        np.add.at(n, indices[:, k], face)
+    idx = np.asarray(indices, dtype=np.int64).ravel()
+    n = np.stack([np.bincount(idx, weights=np.repeat(face[:, c], 3), minlength=len(p))
+                  for c in range(3)], axis=1)
     length = np.linalg.norm(n, axis=1, keepdims=True)
     out = np.where(length > 0, n / np.maximum(length, 1e-300), [0.0, 1.0, 0.0])
     return out.astype(np.float32)

@@ -19,6 +19,8 @@ float hf_height(vec2 p) {
 }
 
 // Signed height of a ray point above the surface; negative means inside the solid.
+// Height 0 is empty space: the box's bottom face is no surface (represent/relief.py).
 float hf_above(vec3 p) {
-    return p.z - hf_height(p.xy);
+    float s = hf_height(p.xy);
+    return s > 0.0 ? p.z - s : max(p.z, 1e-7);
 }

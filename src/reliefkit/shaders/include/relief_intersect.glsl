@@ -50,21 +50,46 @@ float next_centerline(float x, float ox, float dx) {
     return (c - ox) / dx;
 }
 
-// Walk centreline crossings from sa (above) to s_end; true with s_hit on the first point below.
+uniform bool u_quadratic_cells;  // test the exact quadratic inside each cell (see below)
+
+// Inside one cell the bilinear surface along the ray is a quadratic in s, so F = above()
+// sampled at both ends and the middle is known exactly on [sa, sb]. Returns the parameter
+// of a point below the surface if the parabola dips below zero between the samples, else -1.
+// The paper's exact walk (section 3.3) assumes F linear there and misses such grazes (Fig. 3).
+float cell_dip(vec3 o, vec3 d, float sa, float fa, float sb, float fb) {
+    float fm = hf_above(o + 0.5 * (sa + sb) * d);
+    float a = 2.0 * fa - 4.0 * fm + 2.0 * fb;   // F(tau) = fa + b tau + a tau^2, tau in [0,1]
+    float b = -3.0 * fa + 4.0 * fm - fb;
+    if (fm < 0.0) return 0.5 * (sa + sb);
+    if (a <= 0.0) return -1.0;
+    float tau = -b / (2.0 * a);
+    if (tau <= 0.0 || tau >= 1.0 || fa + tau * (b + a * tau) >= 0.0) return -1.0;
+    return sa + tau * (sb - sa);
+}
+
+// Walk centreline crossings from sa (above) to s_end; true with s_hit on the first hit.
 bool walk_exact(vec3 o, vec3 d, float sa, float s_end, out float s_hit, inout int iters) {
     vec3 p = o + sa * d;
+    float fa = hf_above(p);
     vec2 t = vec2(next_centerline(p.x, o.x, d.x), next_centerline(p.y, o.y, d.y));
     vec2 dt = vec2(d.x != 0.0 ? 1.0 / abs(d.x) : 3.0e38, d.y != 0.0 ? 1.0 / abs(d.y) : 3.0e38);
     for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
         float sb = min(min(t.x, t.y), s_end);
+        float fb = hf_above(o + sb * d);
         iters++;
-        if (hf_above(o + sb * d) < 0.0) {
+        if (fb < 0.0) {
             s_hit = refine_hit(o, d, sa, sb, iters);
+            return true;
+        }
+        float s_dip = u_quadratic_cells ? cell_dip(o, d, sa, fa, sb, fb) : -1.0;
+        if (s_dip >= 0.0) {
+            s_hit = refine_hit(o, d, sa, s_dip, iters);
             return true;
         }
         if (sb >= s_end) break;
         if (t.x <= t.y) t.x += dt.x; else t.y += dt.y;
         sa = sb;
+        fa = fb;
     }
     s_hit = s_end;
     return false;
