@@ -82,6 +82,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="output .rk file")
     p.set_defaults(run=cmd_bake)
 
+    p = sub.add_parser("compare", help="bake, then render mesh and every method side by side",
+                       description="Bake INPUT, render the mesh and each intersection method "
+                                   "from one view; write compare.png, metrics.md, metrics.json.",
+                       epilog="examples:\n  reliefkit compare demo:terrain --as relief --out cmp"
+                              "\n  reliefkit compare car.glb --as relief-frustum --view 60,15,2"
+                              " --out cmp",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_bake_args(p)
+    _add_view_args(p)
+    p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
+    p.set_defaults(run=cmd_compare)
+
     p = sub.add_parser("info", help="GL capabilities, or the contents of a mesh / .rk file",
                        description="Print the OpenGL renderer and limits (--gl) and/or "
                                    "summarise a mesh or .rk file.")
@@ -233,6 +245,26 @@ def cmd_render(args) -> int:
     if args.aovs:
         frame.save_aovs(args.aovs)
         print(f"wrote {args.aovs}")
+    return 0
+
+
+def cmd_compare(args) -> int:
+    from .compare import compare_relief, metrics_markdown, write_comparison
+    from .inputs import load_input
+    from .scene.views import orbit_bounds, parse_size, parse_view
+
+    az, el, dist = parse_view(args.view)
+    size = parse_size(args.size)
+    mesh = load_input(args.input)
+    if not hasattr(mesh, "triangle_count"):
+        raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not an .rk file")
+    relief = _bake_input(args)
+    result = compare_relief(mesh, relief, orbit_bounds(mesh.bounds, az, el, dist, size,
+                                                       args.fov))
+    title = f"{mesh.name} as {args.kind}, view {args.view}"
+    paths = write_comparison(result, Path(args.out), title)
+    print(metrics_markdown(result["metrics"], title))
+    print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0
 
 
