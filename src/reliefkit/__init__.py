@@ -6,7 +6,7 @@
 """
 
 from . import metrics
-from .bake import bake, bake_relief, bake_relief_cube, bake_relief_frustum, relief_from_heights
+from .bake import bake_relief, bake_relief_cube, bake_relief_frustum, relief_from_heights
 from .errors import FormatError, GPUError, MeshError, ReliefkitError, UsageError
 from .formats import load, save
 from .render import Frame, render
@@ -18,7 +18,7 @@ from .scene.mesh import RenderMesh
 
 __all__ = [
     "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
-    "metrics", "bake", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
+    "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
     "relief_from_heights", "ReliefTexture", "ReliefObject",
     "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
 ]

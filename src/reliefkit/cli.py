@@ -94,6 +94,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
     p.set_defaults(run=cmd_compare)
 
+    p = sub.add_parser("bench", help="reproduce a paper's tables (speed, iterations, errors)",
+                       description="Benchmarks measured side by side in one run.",
+                       epilog="examples:\n  reliefkit bench relief --quick\n"
+                              "  reliefkit bench relief --out docs/bench",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("name", choices=("relief",), help="which benchmark")
+    p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
+    p.set_defaults(run=cmd_bench)
+
     p = sub.add_parser("info", help="GL capabilities, or the contents of a mesh / .rk file",
                        description="Print the OpenGL renderer and limits (--gl) and/or "
                                    "summarise a mesh or .rk file.")
@@ -265,6 +275,18 @@ def cmd_compare(args) -> int:
     paths = write_comparison(result, Path(args.out), title)
     print(metrics_markdown(result["metrics"], title))
     print("wrote " + ", ".join(str(p) for p in paths.values()))
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from .bench import relief
+
+    out = Path(args.out)
+    cfg = relief.BenchConfig.quick(out) if args.quick else relief.BenchConfig(out=out)
+    results = relief.run(cfg, log=lambda msg: print(msg, file=sys.stderr, flush=True))
+    paths = relief.write(results, out)
+    print(relief.markdown(results))
+    print("wrote " + ", ".join(map(str, paths)))
     return 0
 
 

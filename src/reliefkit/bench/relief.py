@@ -1,0 +1,249 @@
+"""`reliefkit bench relief`: Table 1, Fig. 12 and the correctness study of Baboud & Décoret.
+
+Everything is measured side by side in one run on one machine: frame times are medians of
+repeated draws (wall clock after glFinish, plus GL timer queries), iteration counts come
+from the instrumented shader variant and do not depend on the machine.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..fileio import atomic_path
+
+METHODS = ("exact", "robust", "binary")
+
+
+@dataclass
+class BenchConfig:
+    models: tuple = ("terrain", "blob", "tree", "vehicle")
+    resolutions: tuple = (32, 64, 128, 256, 512, 1024)
+    size: tuple = (800, 600)
+    repeats: int = 3
+    tolerances: tuple = (0.0, 0.002, 0.005, 0.01, 0.02, 0.05)
+    tolerance_res: int = 256
+    correctness_res: int = 256
+    correctness_views: tuple = ((30, 45), (120, 20), (200, 10), (300, 5))
+    correctness_size: tuple = (400, 300)
+    safety_resolutions: tuple = (128, 256, 512, 1024)
+    out: Path = field(default_factory=lambda: Path("docs"))
+
+    @classmethod
+    def quick(cls, out: Path) -> BenchConfig:
+        return cls(models=("terrain", "vehicle"), resolutions=(32, 64, 128), size=(320, 240),
+                   repeats=1, tolerances=(0.0, 0.01, 0.05), tolerance_res=64,
+                   correctness_res=64, correctness_views=((30, 45), (200, 10)),
+                   correctness_size=(160, 120), safety_resolutions=(64, 128), out=out)
+
+
+def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
+    """Orbit camera at ``elevation`` whose view of the box fills ``fill`` of the image."""
+    from ..scene.views import orbit_bounds
+
+    corners = np.array([[bounds[i & 1][0], bounds[(i >> 1) & 1][1], bounds[(i >> 2) & 1][2]]
+                        for i in range(8)])
+    lo, hi = 0.5, 20.0
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        cam = orbit_bounds(bounds, azimuth, elevation, mid, size)
+        clip = np.c_[corners, np.ones(8)] @ (cam.proj @ cam.view).T
+        ndc = clip[:, :2] / clip[:, 3:4]
+        extent = max(np.ptp(ndc[:, 0]), np.ptp(ndc[:, 1])) / 2
+        lo, hi = (mid, hi) if extent > fill else (lo, mid)
+    return orbit_bounds(bounds, azimuth, elevation, hi, size)
+
+
+def table1(cfg: BenchConfig, log) -> list[dict]:
+    """Frame time per method and for the mesh, iterations per covered pixel (Table 1)."""
+    from ..bake import bake_relief
+    from ..render import render
+    from ..scene.assets import make_asset
+    from .timing import time_render
+
+    rows = []
+    for name in cfg.models:
+        mesh = make_asset(name)
+        camera = fit_camera(mesh.bounds, cfg.size)
+        mesh_ms = time_render(mesh, camera, repeats=cfg.repeats)["wall_ms"]
+        for res in cfg.resolutions:
+            relief = bake_relief(mesh, depth_res=res)
+            row = {"model": name, "res": res, "mesh_ms": mesh_ms,
+                   "triangles": mesh.triangle_count}
+            for method in METHODS:
+                row[f"{method}_ms"] = time_render(relief, camera, method=method,
+                                                  repeats=cfg.repeats)["wall_ms"]
+                stats = render(relief, camera, method=method, count_iterations=True).stats
+                row[f"{method}_it_mean"] = stats["iterations_mean"]
+                row[f"{method}_it_max"] = stats["iterations_max"]
+                row["fragments"] = stats["fragments"]
+            rows.append(row)
+            log(f"table 1: {name} {res}^2: " + ", ".join(
+                f"{m} {row[m + '_ms']:.0f} ms / {row[m + '_it_mean']:.1f} it" for m in METHODS))
+    return rows
+
+
+def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
+    """Fig. 12: tolerance vs mean radius vs iterations vs silhouette (wrong-hit) error."""
+    from ..bake import bake_relief
+    from ..bake.safety import safety_radii
+    from ..reference.relief import wrong_hits
+    from ..render import render
+    from ..scene.assets import make_asset
+
+    mesh = make_asset("terrain")
+    relief = bake_relief(mesh, depth_res=cfg.tolerance_res, safety=False)
+    camera = fit_camera(mesh.bounds, cfg.correctness_size, elevation=20.0)
+    rows = []
+    for tol in cfg.tolerances:
+        relief.safety = safety_radii(relief.height, tolerance=tol)
+        for zero in ("clamp", "exact"):
+            frame = render(relief, camera, method="robust", zero_radius=zero,
+                           count_iterations=True)
+            wrong = wrong_hits(frame, relief, camera)
+            rows.append({"tolerance": tol, "zero_radius": zero,
+                         "mean_radius": float(relief.safety.mean()),
+                         "zero_fraction": float((relief.safety == 0).mean()),
+                         "iterations_mean": frame.stats["iterations_mean"],
+                         "wrong_fraction": wrong["wrong_fraction"]})
+        log(f"fig 12: tolerance {tol}: mean radius {rows[-1]['mean_radius']:.2f}, "
+            f"iterations {rows[-2]['iterations_mean']:.1f} (clamp)")
+    return rows
+
+
+def correctness(cfg: BenchConfig, log) -> list[dict]:
+    """Wrong-hit fraction of each method against the exact reference, grazing views too."""
+    from ..bake import bake_relief
+    from ..reference.relief import wrong_hits
+    from ..render import render
+    from ..scene.assets import make_asset
+    from ..scene.views import orbit_bounds
+
+    rows = []
+    for name in ("terrain", "blob", "vehicle"):
+        mesh = make_asset(name)
+        relief = bake_relief(mesh, depth_res=cfg.correctness_res)
+        for az, el in cfg.correctness_views:
+            camera = orbit_bounds(relief.bounds, az, el, 2.2, cfg.correctness_size)
+            row = {"model": name, "azimuth": az, "elevation": el}
+            for method in METHODS:
+                frame = render(relief, camera, method=method)
+                row[method] = wrong_hits(frame, relief, camera)["wrong_fraction"]
+            rows.append(row)
+            log(f"correctness: {name} el {el}: " + ", ".join(
+                f"{m} {row[m]:.4%}" for m in METHODS))
+    return rows
+
+
+def safety_timing(cfg: BenchConfig, log) -> list[dict]:
+    from ..bake.safety import safety_radii
+    from ..scene.assets import terrain_heights
+
+    safety_radii(terrain_heights(32))  # compile outside the measurement
+    rows = []
+    for res in cfg.safety_resolutions:
+        heights = terrain_heights(res)
+        start = time.perf_counter()
+        radii = safety_radii(heights)
+        rows.append({"res": res, "seconds": time.perf_counter() - start,
+                     "mean_radius": float(radii.mean()),
+                     "zero_fraction": float((radii == 0).mean())})
+        log(f"safety radii {res}^2: {rows[-1]['seconds']:.1f} s")
+    return rows
+
+
+def run(cfg: BenchConfig, log=print) -> dict:
+    from ..gl.context import gl_info
+
+    info = gl_info()
+    results = {"machine": {"renderer": info["renderer"], "gl": info["version"],
+                           "cpu": platform.processor() or platform.machine(),
+                           "python": platform.python_version()},
+               "config": {"size": cfg.size, "repeats": cfg.repeats}}
+    results["safety"] = safety_timing(cfg, log)
+    results["table1"] = table1(cfg, log)
+    results["tolerance"] = tolerance_study(cfg, log)
+    results["correctness"] = correctness(cfg, log)
+    results["targets"] = check_targets(results)
+    return results
+
+
+def check_targets(results: dict) -> list[dict]:
+    """The issue's targets, met or not, with the figures."""
+    out = []
+    corr = results["correctness"]
+    worst = {m: max(r[m] for r in corr) for m in METHODS}
+    out.append({"target": "exact <= 0.1% wrong pixels at every view",
+                "value": worst["exact"], "met": worst["exact"] <= 0.001})
+    out.append({"target": "robust <= 0.5% wrong pixels at every view",
+                "value": worst["robust"], "met": worst["robust"] <= 0.005})
+    rows = results["table1"]
+    for model in sorted({r["model"] for r in rows}):
+        by_res = {r["res"]: r for r in rows if r["model"] == model}
+        if 64 in by_res and 1024 in by_res:
+            robust = by_res[1024]["robust_it_mean"] / by_res[64]["robust_it_mean"]
+            exact = by_res[1024]["exact_it_mean"] / by_res[64]["exact_it_mean"]
+            out.append({"target": f"{model}: robust iterations 64^2 -> 1024^2 grow <= 1.5x",
+                        "value": robust, "met": robust <= 1.5})
+            out.append({"target": f"{model}: exact iterations 64^2 -> 1024^2 grow >= 8x",
+                        "value": exact, "met": exact >= 8})
+        if 256 in by_res:
+            ratio = by_res[256]["robust_ms"] / by_res[256]["binary_ms"]
+            out.append({"target": f"{model}: robust within 1.3x of binary's frame time at 256^2",
+                        "value": ratio, "met": ratio <= 1.3})
+    for row in results["safety"]:
+        if row["res"] == 512:
+            out.append({"target": "safety radii for 512^2 in under 30 s",
+                        "value": row["seconds"], "met": row["seconds"] < 30})
+    return out
+
+
+def markdown(results: dict) -> str:
+    m = results["machine"]
+    lines = [f"Machine: {m['renderer']}, {m['gl']}, CPU {m['cpu']}, Python {m['python']}; "
+             f"images {results['config']['size'][0]}x{results['config']['size'][1]}, "
+             f"median of {results['config']['repeats']} draws.", "",
+             "#### Table 1: frame time (ms) and loop iterations per fragment (mean / max)", "",
+             "| model | depth res | mesh ms | exact ms | robust ms | binary ms | exact it | "
+             "robust it | binary it | robust/binary time |", "|---" * 10 + "|"]
+    for r in results["table1"]:
+        its = [f"{r[f'{k}_it_mean']:.1f} / {r[f'{k}_it_max']}" for k in METHODS]
+        lines.append(f"| {r['model']} | {r['res']}² | {r['mesh_ms']:.1f} | {r['exact_ms']:.1f} | "
+                     f"{r['robust_ms']:.1f} | {r['binary_ms']:.1f} | " + " | ".join(its)
+                     + f" | {r['robust_ms'] / r['binary_ms']:.2f} |")
+    lines += ["", "#### Fig. 12: safety tolerance (terrain, robust method)", "",
+              "| tolerance | zero radius | mean radius | zero-radius texels | iterations | "
+              "wrong pixels |", "|---" * 6 + "|"]
+    for r in results["tolerance"]:
+        lines.append(f"| {r['tolerance']} | {r['zero_radius']} | {r['mean_radius']:.2f} | "
+                     f"{r['zero_fraction']:.1%} | {r['iterations_mean']:.1f} | "
+                     f"{r['wrong_fraction']:.3%} |")
+    lines += ["", "#### Correctness: wrong-hit fraction against the exact reference", "",
+              "| model | view (az, el) | exact | robust | binary |", "|---" * 5 + "|"]
+    for r in results["correctness"]:
+        lines.append(f"| {r['model']} | {r['azimuth']}, {r['elevation']} | {r['exact']:.3%} | "
+                     f"{r['robust']:.3%} | {r['binary']:.3%} |")
+    lines += ["", "#### Safety radii computation time", "",
+              "| resolution | seconds | mean radius | zero-radius texels |", "|---" * 4 + "|"]
+    for r in results["safety"]:
+        lines.append(f"| {r['res']}² | {r['seconds']:.2f} | {r['mean_radius']:.2f} | "
+                     f"{r['zero_fraction']:.1%} |")
+    lines += ["", "#### Targets", "", "| target | value | met |", "|---|---|---|"]
+    for t in results["targets"]:
+        lines.append(f"| {t['target']} | {t['value']:.4g} | {'yes' if t['met'] else 'no'} |")
+    return "\n".join(lines) + "\n"
+
+
+def write(results: dict, out: Path) -> list[Path]:
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / "relief-bench.json", out / "relief-bench.md"]
+    with atomic_path(paths[0]) as tmp:
+        tmp.write_text(json.dumps(results, indent=2))
+    with atomic_path(paths[1]) as tmp:
+        tmp.write_text(markdown(results))
+    return paths

@@ -1,0 +1,37 @@
+"""Side-by-side frame timing of drawables in one framebuffer (no read-back in the loop)."""
+
+from __future__ import annotations
+
+from ..gl.context import bind_home_framebuffer, get_context
+from ..gl.textures import render_target
+from ..gl.timing import gpu_time_ms
+from ..render.registry import make_drawables
+from ..render.targets import FRAME_ATTACHMENTS
+from ..scene.light import DirectionalLight
+
+
+def time_render(obj, camera, *, repeats: int = 3, light=None, **options) -> dict:
+    """Median wall and GPU milliseconds of drawing ``obj`` (clear + draw + finish)."""
+    import moderngl
+
+    ctx = get_context()
+    (drawable,) = make_drawables(ctx, [obj], options)
+    light = light or DirectionalLight()
+    fbo = render_target(ctx, *camera.size, FRAME_ATTACHMENTS)
+
+    def draw():
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        drawable.draw(camera, light)
+
+    try:
+        return gpu_time_ms(ctx, draw, repeats=repeats)
+    finally:
+        bind_home_framebuffer(ctx)
+        for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+            attachment.release()
+        fbo.release()
+        release = getattr(drawable, "release", None)
+        if release:
+            release()
