@@ -87,7 +87,7 @@ def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
     color_size = size if color_res is None else tuple(
         max(2, round(s * color_res / depth_res)) for s in size)
     lo, hi = mesh.bounds
-    pad = 0.01 * (hi - lo).max()
+    pad = 2.0 * (hi - lo).max() / depth_res  # bilinear ramps reach half a texel outside
     params = {"projection": "reverse-frustum", "axis": axis, "spread_deg": spread_deg,
               "depth_res": depth_res, "color_res": color_res or depth_res, "source": mesh.name}
     if clip:

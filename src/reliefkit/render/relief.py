@@ -80,12 +80,14 @@ class ReliefDrawable:
         }
         check_gl_error(ctx, "uploading a relief texture")
 
-    def eye_inside(self, camera) -> bool:
-        """Is the camera's near-plane centre inside the proxy (then draw its back faces)?"""
-        eye = np.asarray(camera.eye)
-        forward = np.asarray(camera.target) - eye
-        near_point = eye + camera.near * forward / np.linalg.norm(forward)
-        return self.proxy.contains(near_point, tolerance=1e-6 * camera.near)
+    def reaches_near_plane(self, camera) -> bool:
+        """Does the proxy extend in front of the near plane (camera inside or close)?
+
+        Then its front faces would be clipped and the back faces are drawn instead; the
+        shader builds the ray from the window position, not from the face it was drawn for.
+        """
+        eye_z = np.c_[self.proxy.positions, np.ones(len(self.proxy.positions))] @ camera.view[2]
+        return bool(eye_z.max() > -camera.near * 1.001)
 
     def draw(self, camera, light) -> None:
         import moderngl
@@ -97,7 +99,7 @@ class ReliefDrawable:
             tex.use(unit)
             set_uniforms(self.prog, {name: unit})
         self.ctx.enable(moderngl.CULL_FACE)
-        self.ctx.cull_face = "front" if self.eye_inside(camera) else "back"
+        self.ctx.cull_face = "front" if self.reaches_near_plane(camera) else "back"
         self.vao.render()
         self.ctx.disable(moderngl.CULL_FACE)
 
@@ -126,9 +128,14 @@ class ReliefDrawable:
 
 
 class ReliefObjectDrawable:
-    """Every part of a ReliefObject (six frusta of a cube) with the same options."""
+    """Every part of a ReliefObject (six frusta of a cube) with the same options.
+
+    The parts always write their hit depth: a part whose proxy reaches the near plane is
+    drawn by its back faces, and box depths of front and back faces would not order parts.
+    """
 
     def __init__(self, ctx, obj: ReliefObject, **options):
+        options = options | {"depth_mode": "exact"}
         self.parts = [ReliefDrawable(ctx, part, **options) for part in obj.parts]
         self.extra_attachments = self.parts[0].extra_attachments
 

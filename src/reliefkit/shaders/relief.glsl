@@ -54,6 +54,33 @@ vec2 unit_cube_interval(vec3 o, vec3 d) {
     return vec2(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
 }
 
+// Clip t in [0, 1] of the homogeneous segment a + t (b - a) to one halfspace f(X) >= 0.
+void clip_linear(float fa, float fb, inout vec2 span) {
+    if (fa < 0.0 && fb < 0.0) { span = vec2(1.0, 0.0); return; }
+    if (fa >= 0.0 && fb >= 0.0) return;
+    float t = fa / (fa - fb);
+    if (fa < 0.0) span.x = max(span.x, t); else span.y = min(span.y, t);
+}
+
+// The pixel's ray from the near to the far plane, clipped to the unit cube in homogeneous
+// box coordinates (0 <= x, y, z <= w, w > 0), so a projective box_to_world needs no care
+// about its singular plane and no proxy depth is involved. Returns the clipped end points.
+bool box_segment(vec2 ndc, out vec3 p0, out vec3 p1) {
+    vec4 a = u_world_to_box * vec4(unproject(ndc, -1.0), 1.0);
+    vec4 b = u_world_to_box * vec4(unproject(ndc, 1.0), 1.0);
+    vec2 span = vec2(0.0, 1.0);
+    clip_linear(a.w, b.w, span);
+    for (int k = 0; k < 3; ++k) {
+        clip_linear(a[k], b[k], span);
+        clip_linear(a.w - a[k], b.w - b[k], span);
+    }
+    if (span.y <= span.x) return false;
+    vec4 h0 = mix(a, b, span.x), h1 = mix(a, b, span.y);
+    p0 = clamp(h0.xyz / h0.w, 0.0, 1.0);
+    p1 = clamp(h1.xyz / h1.w, 0.0, 1.0);
+    return true;
+}
+
 // World normal of the box face that box point p lies on (the side walls of the solid).
 vec3 box_face_normal(vec3 p) {
     vec3 dist = min(p, 1.0 - p);
@@ -66,14 +93,14 @@ vec3 box_face_normal(vec3 p) {
 
 void main() {
     vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
-    // two points of the pixel's ray in box coordinates: the near plane and the proxy surface
-    // (a projective box_to_world maps lines to lines, so the ray stays a line there)
-    vec3 a = to_box(unproject(ndc, -1.0));
-    vec3 b = to_box(unproject(ndc, gl_FragCoord.z * 2.0 - 1.0));
+    // the ray inside the box: s = 0 where it enters (or at the near plane), s = 1 where it
+    // leaves; a projective box_to_world maps lines to lines, so it stays a line there
+    vec3 a, b;
+    if (!box_segment(ndc, a, b)) discard;
     vec3 d = b - a;
-    vec2 span = unit_cube_interval(a, d);
-    float s0 = max(span.x, 0.0), s1 = span.y;
-    if (s1 <= s0) discard;
+    if (dot(d, d) == 0.0) discard;
+    float s0 = 0.0, s1 = 1.0;
+    bool entered_side = a.z < 1.0 && a.z > 0.0 && (min(a.x, a.y) <= 0.0 || max(a.x, a.y) >= 1.0);
     vec3 scale = vec3(vec2(u_hf_size), 1.0);  // box -> texel coordinates
     vec3 o_t = a * scale, d_t = d * scale;
     int iters = 0;
@@ -92,7 +119,7 @@ void main() {
     vec3 hit = to_world(hit_box);
     vec4 base = texture(u_color, hit_box.xy);
     vec3 n = normalize(texture(u_normal, hit_box.xy).xyz);
-    if (s_hit <= s0 && span.x >= 0.0) n = box_face_normal(hit_box);  // a side wall of the box
+    if (s_hit <= s0 && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
     vec3 to_eye = u_orthographic ? u_view_dir : normalize(u_eye - hit);
     if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
 

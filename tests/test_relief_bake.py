@@ -1,0 +1,115 @@
+"""Baking relief textures: conventions against analytic meshes, frusta and cubes vs the mesh."""
+
+import numpy as np
+import pytest
+
+from reliefkit import metrics
+from reliefkit.bake.frustum import bake_relief_cube, bake_relief_frustum
+from reliefkit.bake.heightfield import bake_relief, relief_from_heights
+from reliefkit.render import render
+from reliefkit.scene.assets import make_asset
+from reliefkit.scene.mesh import RenderMesh, vertex_normals
+from reliefkit.scene.views import orbit_bounds
+
+
+def tilted_plane(n=24):
+    """A grid over x, z in [-1, 1] with y = 0.2 + 0.3 x + 0.1 z, coloured by x."""
+    x, z = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-1, 1, n))
+    y = 0.2 + 0.3 * x + 0.1 * z
+    pos = np.stack([x, y, z], -1).reshape(-1, 3).astype(np.float32)
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = idx[:-1, :-1], idx[:-1, 1:], idx[1:, :-1], idx[1:, 1:]
+    faces = np.concatenate([np.stack([a, c, b], -1).reshape(-1, 3),
+                            np.stack([b, c, d], -1).reshape(-1, 3)])
+    colors = np.c_[(pos[:, 0] + 1) / 2, np.full(len(pos), 0.5), np.full(len(pos), 0.2),
+                   np.ones(len(pos))]
+    return RenderMesh(pos, faces, vertex_normals(pos, faces), colors, name="plane")
+
+
+def test_bake_heights_follow_texel_centre_convention(gl):
+    mesh = tilted_plane()
+    relief = bake_relief(mesh, depth_res=32, safety=False)
+    h, w = relief.height.shape
+    u, v = np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
+    covered = relief.height > 0
+    assert covered[2:-2, 2:-2].all() and not covered[0].any() and not covered[:, -1].any()
+    # the surface point above each texel centre, in world space, lies on the plane
+    world = relief.to_world(np.stack([u, v, relief.height], -1))[covered]
+    expected_y = 0.2 + 0.3 * world[:, 0] + 0.1 * world[:, 2]
+    assert np.abs(world[:, 1] - expected_y).max() < 1e-4
+    n = np.array([-0.3, 1.0, -0.1]) / np.linalg.norm([-0.3, 1.0, -0.1])
+    np.testing.assert_allclose(relief.normal[3:-3, 3:-3] @ n, 1.0, atol=1e-4)
+    # colour varies with x as the mesh's does (sRGB of (x + 1) / 2)
+    red = relief.color[h // 2, 2:-2, 0].astype(float)
+    assert np.all(np.diff(red) >= 0) and red[-1] - red[0] > 150
+
+
+def test_independent_resolutions(gl):
+    relief = bake_relief(tilted_plane(), depth_res=16, color_res=64, safety=False)
+    assert relief.height.shape == (16, 16) and relief.color.shape == (64, 64, 4)
+    assert relief.normal.shape == (64, 64, 3)
+
+
+def test_from_heights_keeps_the_array():
+    heights = np.random.default_rng(0).random((12, 20))
+    relief = relief_from_heights(heights, size=(4.0, 1.0, 2.0), safety=False)
+    scaled = (heights - heights.min()) / np.ptp(heights)
+    np.testing.assert_allclose((relief.height - 0.01) / 0.99, scaled, atol=1e-6)
+    lo, hi = relief.bounds
+    np.testing.assert_allclose(hi - lo, [4.0, 1.0, 2.0])
+
+
+def _scores(rep, mesh, view, size=(128, 128), **options):
+    camera = orbit_bounds(mesh.bounds, *view, size=size)
+    truth = render(mesh, camera)
+    frame = render(rep, camera, method="exact", **options)
+    return metrics.compare(frame, truth, scene_size=mesh.radius), frame
+
+
+@pytest.fixture(scope="module")
+def vehicle():
+    return make_asset("vehicle")
+
+
+def test_reverse_frustum_captures_the_sides(gl, vehicle):
+    ortho = bake_relief(vehicle, depth_res=96, safety=False)
+    frustum = bake_relief_frustum(vehicle, depth_res=96, safety=False)
+    side = (80.0, 12.0, 2.2)  # looking at the van's flank, nearly horizontal
+    s_ortho, _ = _scores(ortho, vehicle, side)
+    s_frustum, _ = _scores(frustum, vehicle, side)
+    assert s_frustum["psnr"] > s_ortho["psnr"] + 1.0
+    assert s_frustum["position_mean_rel"] < s_ortho["position_mean_rel"]
+    assert s_frustum["iou"] > 0.85
+
+
+def test_clipped_frustum_draws_fewer_fragments_for_the_same_image(gl, vehicle):
+    clipped = bake_relief_frustum(vehicle, depth_res=64, safety=False)
+    full = bake_relief_frustum(vehicle, depth_res=64, safety=False, clip=False)
+    camera = orbit_bounds(full.bounds, 30, 30, 2.0, size=(96, 96))  # near/far hold both
+    a = render(clipped, camera, method="exact", count_iterations=True)
+    b = render(full, camera, method="exact", count_iterations=True)
+    assert a.stats["fragments"] < b.stats["fragments"]
+    assert np.mean(a.mask != b.mask) < 0.002
+
+
+def star_shaped(n=4):
+    """A closed bumpy sphere: every ray from its centre meets it once, so six
+    heightfields from the centre represent it exactly up to sampling."""
+    import trimesh
+
+    s = trimesh.creation.icosphere(subdivisions=n)
+    v = np.asarray(s.vertices)
+    r = 1.0 + 0.15 * np.sin(3 * v[:, 0]) * np.cos(2 * v[:, 1]) + 0.1 * v[:, 2] ** 2
+    pos = (v * r[:, None] + [0.3, -0.2, 0.1]).astype(np.float32)
+    colors = np.c_[0.5 + 0.4 * v, np.ones(len(v))]
+    return RenderMesh(pos, s.faces, vertex_normals(pos, s.faces), colors, name="star")
+
+
+def test_six_frusta_represent_a_closed_object(gl):
+    mesh = star_shaped()
+    cube = bake_relief_cube(mesh, depth_res=96, safety=False)
+    assert len(cube.parts) == 6
+    for view in [(35.0, 25.0, 2.5), (200.0, -30.0, 2.5), (100.0, 80.0, 2.5)]:
+        scores, _ = _scores(cube, mesh, view)
+        assert scores["iou"] > 0.97
+        assert scores["position_p95_rel"] < 0.02
