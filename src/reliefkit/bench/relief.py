@@ -239,9 +239,44 @@ def markdown(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def plot(results: dict, path: Path) -> None:
+    """Iterations vs depth resolution per method (Table 1) and the tolerance study (Fig. 12)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    rows = results["table1"]
+    for model in sorted({r["model"] for r in rows}):
+        sub = [r for r in rows if r["model"] == model]
+        res = [r["res"] for r in sub]
+        for method, style in zip(METHODS, ("-o", "-s", "-^"), strict=True):
+            axes[0].plot(res, [r[f"{method}_it_mean"] for r in sub], style,
+                         label=f"{model} {method}", alpha=0.8)
+    axes[0].set(xscale="log", yscale="log", xlabel="depth resolution",
+                ylabel="iterations per fragment (mean)", title="Table 1: iterations")
+    axes[0].legend(fontsize=6, ncol=2)
+    tol = [r for r in results["tolerance"] if r["zero_radius"] == "clamp"]
+    x = [max(r["tolerance"], 1e-4) for r in tol]
+    axes[1].plot(x, [r["mean_radius"] for r in tol], "-o", label="mean safety radius")
+    axes[1].plot(x, [r["iterations_mean"] for r in tol], "-s", label="robust iterations")
+    axes[1].set(xscale="log", xlabel="tolerance (height units; 0 shown at 1e-4)",
+                title="Fig. 12: tolerance vs radius and iterations")
+    axes[1].legend(fontsize=8)
+    axes[2].plot(x, [100 * r["wrong_fraction"] for r in tol], "-o", color="C3")
+    axes[2].set(xscale="log", xlabel="tolerance", ylabel="wrong pixels (%)",
+                title="Fig. 12: silhouette error")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+
+
 def write(results: dict, out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "relief-bench.json", out / "relief-bench.md"]
+    paths = [out / "relief-bench.json", out / "relief-bench.md", out / "relief-bench.png"]
+    plot(results, paths[2])
     with atomic_path(paths[0]) as tmp:
         tmp.write_text(json.dumps(results, indent=2))
     with atomic_path(paths[1]) as tmp:

@@ -39,6 +39,9 @@ def _entry(obj) -> _Entry:
 
 def make_drawables(ctx, objects, options: dict) -> list:
     """Drawables for ``objects``, each given the options it accepts; unknown options fail."""
+    from . import load_renderers
+
+    load_renderers()
     entries = [_entry(obj) for obj in objects]
     unknown = set(options) - set().union(*(e.options for e in entries))
     if unknown:
@@ -51,10 +54,8 @@ def render(obj, camera, *, light=None, ctx=None, **options):
     """Render a representation, a RenderMesh (ground truth), or a list of them, into a Frame."""
     from ..gl.context import get_context
     from ..scene.light import DirectionalLight
-    from . import load_renderers
     from .targets import draw_into_frame
 
-    load_renderers()
     ctx = ctx or get_context()
     objects = list(obj) if isinstance(obj, list | tuple) else [obj]
     if not objects:
