@@ -62,3 +62,10 @@ def test_timer_reports_positive_times(gl):
     fbo.use()
     timing = gpu_time_ms(gl, lambda: fbo.clear(1.0, 0.0, 0.0, 1.0), repeats=3)
     assert timing["repeats"] == 3 and timing["wall_ms"] > 0 and timing["gpu_ms"] >= 0
+
+
+def test_oversized_render_target_is_refused_before_allocation(gl):
+    from reliefkit.gl.textures import render_target
+
+    with pytest.raises(GPUError, match="GiB of render targets"):
+        render_target(gl, 16000, 16000, 3)

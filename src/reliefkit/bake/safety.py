@@ -486,7 +486,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
             r2, c2 = _to_original(i, j2, wp, hp, transpose, flipx, flipy)
             bound = max(bound, _current_bound(bufs, r2, c2))
         if bound > 0:
-            xstop = max(xstop, min(xend, xp + bound + margin))
+            xstop = max(xstop, min(xend, xp + 2 * bound + margin))
     if not xstop > xlo:
         return
     bx = work[0]
@@ -498,6 +498,10 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
     npieces = _line_pieces(height, m, yc, xlo, xstop, bx, c0s, c1s, c2s)
     nh = 0
     k = 0
+    # Along one line the first violation b*(P) never moves backwards as P advances (a later P
+    # has more surface behind it, so fewer unblocked rays): ``known`` is a lower bound of
+    # b* for every later P, and a P whose scan limit is below it cannot lower its radius.
+    known = -np.inf
     for i in range(i_first, i_last + 1):
         xp = i + 0.5
         if xp > xstop:
@@ -519,9 +523,14 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
         bound = max(_current_bound(bufs, r, c), _current_bound(bufs, r2, c2))
         if bound == 0:
             continue
-        b = _scan(bx, c0s, c1s, c2s, npieces, k - 1, min(xp + bound + margin, xstop), hx, hz,
-                  nh, eps, floor)
-        if b != np.inf:
+        limit = min(xp + bound + margin, xstop)
+        if known >= limit:
+            continue
+        # scan a little further than needed so that the next walk positions can be skipped
+        reach = min(limit + bound, xstop)
+        b = _scan(bx, c0s, c1s, c2s, npieces, k - 1, reach, hx, hz, nh, eps, floor)
+        known = b if b != np.inf else reach
+        if b <= limit:
             n = max(int(math.ceil(b - xp - margin)) - 1, 0)
             if n < bufs[tid, r, c]:
                 bufs[tid, r, c] = n

@@ -8,6 +8,7 @@ from ..errors import GPUError
 from .context import check_framebuffer_size, check_gl_error
 
 GL_SRGB8_ALPHA8 = 0x8C43
+MAX_TARGET_BYTES = 2 << 30  # refuse render targets above 2 GiB (RGBA32F attachments + depth)
 
 _DTYPES = {np.dtype(np.uint8): "f1", np.dtype(np.float32): "f4", np.dtype(np.uint16): "u2",
            np.dtype(np.float16): "f2"}
@@ -63,6 +64,11 @@ def render_target(ctx, width: int, height: int, color_attachments: int):
     """A framebuffer of ``color_attachments`` RGBA32F textures plus a float depth texture."""
     check_framebuffer_size(ctx, width, height)
     limit = int(ctx.info["GL_MAX_COLOR_ATTACHMENTS"])
+    needed = width * height * (16 * color_attachments + 4)
+    if needed > MAX_TARGET_BYTES:
+        raise GPUError(f"a {width}x{height} image with its AOVs needs {needed / 2**30:.1f} GiB "
+                       f"of render targets (limit {MAX_TARGET_BYTES / 2**30:.0f} GiB); "
+                       "render a smaller size")
     if color_attachments > limit:
         raise GPUError(f"{color_attachments} colour attachments exceed this GPU's limit of {limit}")
     colors = [ctx.texture((width, height), 4, dtype="f4") for _ in range(color_attachments)]
