@@ -121,3 +121,33 @@ def test_frame_save_and_aovs(gl, tmp_path):
         np.testing.assert_array_equal(data["mask"], frame.mask)
         np.testing.assert_array_equal(data["view"], frame.view)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["q.npz", "q.png"]  # no temp files
+
+
+def test_textured_glb_renders_its_texture_the_right_way_up(gl, tmp_path):
+    from PIL import Image
+
+    from reliefkit.scene.loader import load_mesh
+
+    # a 2x2 texture: red top-left, green top-right, blue bottom-left, white bottom-right
+    image = Image.fromarray(np.array([[[255, 0, 0], [0, 255, 0]], [[0, 0, 255],
+                                      [255, 255, 255]]], np.uint8))
+    quad = trimesh.Trimesh(vertices=[[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]],
+                           faces=[[0, 1, 2], [0, 2, 3]], process=False)
+    quad.visual = trimesh.visual.TextureVisuals(
+        uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]),
+        material=trimesh.visual.material.SimpleMaterial(image=image, diffuse=(255, 255, 255)))
+    quad.export(tmp_path / "quad.glb")
+    mesh = load_mesh(tmp_path / "quad.glb")
+    from reliefkit.render.mesh import render_mesh
+    from reliefkit.scene.light import DirectionalLight
+
+    flat = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)
+    frame = render_mesh(mesh, Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(32, 32),
+                                     ortho_height=1.0), light=flat)
+    rgb = frame.color[..., :3]  # linear
+    # the image's top-left texel shows at the quad's top-left (uv (0.25, 0.75)), and so on;
+    # pixels (8, 8) etc. sit on the texel centres, where bilinear filtering is exact
+    np.testing.assert_allclose(rgb[7:9, 7:9].mean(axis=(0, 1)), [1, 0, 0], atol=0.1)
+    np.testing.assert_allclose(rgb[7:9, 23:25].mean(axis=(0, 1)), [0, 1, 0], atol=0.1)
+    np.testing.assert_allclose(rgb[23:25, 7:9].mean(axis=(0, 1)), [0, 0, 1], atol=0.1)
+    np.testing.assert_allclose(rgb[23:25, 23:25].mean(axis=(0, 1)), [1, 1, 1], atol=0.1)
