@@ -26,28 +26,44 @@ when even ``n = 1`` fails (locally non-concave peaks, Fig. 7); the renderer then
 
 How it is computed (what is exact, what is sampled)
 ---------------------------------------------------
-Fix a projected line ``y = y_c + m x`` (x-major, ``0 <= m <= 1``, the other seven octants
+Fix a projected line ``y = y_c + m x`` (x-major, ``0 <= m <= 1``; the other seven octants
 come from flipping / transposing the heightfield), its profile ``f(x) = S(x, y_c + m x)``
-(piecewise quadratic, breaks at both families of centerlines) and a walk position ``P``.
-For a point ``a > x_P`` let ``T_a`` be the ray through ``(a, f(a) - tolerance)`` that is
-tangent to the upper convex hull ``A`` of the profile between the box side and ``P`` (the
-steepest ray through that point that clears ``A``). A violation resurfacing at ``b`` exists
-iff ``T_a(b) > f(b)`` for some ``x_P < a < b`` (both necessary and sufficient). The upper
-envelope of those rays is ``L_K`` with ``K`` the running maximum of the tangent slopes, so
-one forward scan finds the first violation ``b*``; then ``n = ceil(b* - x_P) - 1``.
+(piecewise quadratic, breaking at both families of centerlines) and a walk position ``P``.
+A ray is a line ``z(x)`` in that slice. For a point ``a > x_P`` let ``T_a`` be the steepest
+ray through ``(a, f(a) - tolerance)`` that clears the upper convex hull ``A`` of the profile
+between the box side and ``P`` (it is tangent to ``A``). A violation resurfacing at ``b``
+exists iff ``T_a(b) > f(b)`` for some ``x_P < a < b`` (necessary and sufficient: a violating
+ray can be rotated about its deepest point onto ``T_a``, and ``T_a`` lowered by a hair is a
+violating ray). The upper envelope of the ``T_a`` is the support ray ``L_K`` of ``A`` whose
+slope ``K`` is the running maximum of the tangent slopes, so one forward scan finds the
+first violation ``b*`` (the first point where ``L_K`` rises more than
+:data:`NUMERIC_FLOOR` above the profile) and the radius of that sample is
+``ceil(b* - x_P - margin) - 1``. Along one line ``b*`` never decreases as ``P`` advances
+(more surface behind ``P`` blocks more rays), so most walk positions are settled by the
+scan of an earlier one.
 
-* exact (up to rounding): the forward profile (closed-form quadratics per piece), the
-  running maximum of the tangent slopes (closed-form extrema per piece while the tangent
-  vertex on ``A`` is constant; intervals are bisected where it changes) and the first
-  point where ``L_K`` rises above the profile;
+* exact (up to rounding, double precision): the forward profile (closed-form quadratics
+  per piece); the running maximum ``K`` (the tangent vertex of the moving point is followed
+  exactly: it changes where the point crosses the extension of a hull edge, and the slope
+  peaks where ``f'(a) = K``; both are roots of quadratics); the first point where ``L_K``
+  rises above the profile;
 * conservative: ``A`` is the hull of profile samples (piece ends and the maxima of concave
   pieces), which lies below the true hull, so more rays count as unblocked;
 * sampled: the projected directions (``directions`` per half-plane and major axis, uniform
-  in angle, both diagonals and the axis included) and the crossing points ``P`` within a
-  texel (``offsets`` parallel lines per texel and direction, evenly spaced in ``y``; the
-  phase varies from column to column). A violation that exists only between samples can be
-  missed; :func:`check_safety` looks for exactly such rays with continuous random
-  parameters and brute-force extremal rays.
+  in angle, both axes and both diagonals included) and the walk positions within a texel
+  (``offsets`` parallel lines per texel and direction, evenly spaced, the phase varying from
+  column to column, plus for every column the line that enters the box exactly at its
+  walk position, where nothing behind ``P`` blocks). To cover what lies between samples,
+  a violation counts ``margin`` texels earlier than found (not for violations that start
+  right after a vertical centerline, whose position does not depend on the samples), and
+  the scan continues past the box exit (clamped surface) by ``margin`` plus up to two texels
+  where the exit point moves between neighbouring lines. Violations that exist only between
+  samples can still be missed; :func:`check_safety` looks for them with continuous random
+  parameters and brute-force extremal rays. In our tests (tens of fields, millions of
+  checker rays) the misses left were dips deeper than the tolerance by less than 1% of it
+  (the baker uses a tolerance 1% smaller, :data:`TOLERANCE_SLACK`, which removes most of
+  them) or by a few 1e-7 (see :data:`CHECK_FLOOR`), mostly at walk positions on a texel
+  edge, the end of the sampled range.
 """
 
 from __future__ import annotations
@@ -62,8 +78,8 @@ from numba import njit, prange
 
 from ..errors import UsageError
 from ..reference.heightfield import (
-    _cell_quadratic,
     _as_height,
+    _cell_quadratic,
     _clip_box,
     _crossings,
     _first_hit_range,
@@ -75,6 +91,7 @@ from ..reference.heightfield import (
 __all__ = [
     "NUMERIC_FLOOR",
     "CHECK_FLOOR",
+    "TOLERANCE_SLACK",
     "Violation",
     "safety_radii",
     "check_safety",
@@ -84,9 +101,17 @@ __all__ = [
 NUMERIC_FLOOR = 1e-9
 """Depths (height units) at or below this are float noise: the baker never counts them."""
 
-CHECK_FLOOR = 1e-7
-"""The checker ignores crossing pairs whose depth exceeds the tolerance by at most this
-(the resolution of float32 heights near 1; a GPU walk cannot see shallower dips)."""
+CHECK_FLOOR = 1e-6
+"""The checker ignores crossing pairs whose depth exceeds the tolerance by at most this.
+
+Sampling the directions and walk positions can miss dips that exist only in a vanishingly
+thin set of rays (typically grazing a crease with all but the same blocking); their depth
+is then a few 1e-7, far below what a float32 walk with hardware bilinear filtering resolves.
+"""
+
+TOLERANCE_SLACK = 0.01
+"""The baker uses ``tolerance * (1 - TOLERANCE_SLACK)`` so that dips whose depth crosses the
+tolerance between two sampled directions or walk positions are still counted."""
 
 _JIT = {"cache": True, "error_model": "numpy", "nogil": True}
 _NEG_INF = -np.inf
@@ -105,19 +130,20 @@ def _root_between(a, b, c, lo, hi):
     """Root of ``a u^2 + b u + c`` on ``[lo, hi]`` where its sign differs at the two ends."""
     flo = _qv(a, b, c, lo) > 0.0
     # closed form first (stable formula), then verify; bisection as the fallback
+    slack = 1e-12 * (1.0 + abs(lo) + abs(hi))
     if a == 0.0:
         if b != 0.0:
             r = -c / b
-            if lo <= r <= hi:
-                return r
+            if lo - slack <= r <= hi + slack:
+                return min(max(r, lo), hi)
     else:
         disc = b * b - 4.0 * a * c
         if disc >= 0.0:
             q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
             cands = (q / a, c / q if q != 0.0 else np.inf)
             for r in cands:
-                if lo <= r <= hi:
-                    return r
+                if lo - slack <= r <= hi + slack:
+                    return min(max(r, lo), hi)
     for _ in range(100):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
@@ -159,16 +185,17 @@ def _line_range(hh, ww, m, yc):
 
 
 @njit(**_JIT)
-def _line_pieces(height, m, yc, xlo, xstop, bx, c0s, c1s, c2s):
+def _line_pieces(height, m, yc, xlo, xstop, work):
     """Split the profile ``f(x) = S(x, yc + m x)`` on ``[xlo, xstop]`` into quadratic pieces.
 
-    Piece ``k`` is ``[bx[k], bx[k+1]]`` with ``f = c0 + c1 u + c2 u^2``, ``u = x - bx[k]``.
+    Piece ``k`` is ``[work[0, k], work[0, k+1]]`` with ``f = c0 + c1 u + c2 u^2`` (``c0, c1,
+    c2 = work[1:4, k]``) and ``u = x - work[0, k]``.
     Breakpoints are the vertical centerlines ``x = i + 0.5`` and the points where the line
     crosses a horizontal centerline. Returns the number of pieces.
     """
     hh, ww = height.shape
     n = 0
-    bx[0] = xlo
+    work[0, 0] = xlo
     i = int(math.floor(xlo - 0.5)) + 1  # next vertical centerline strictly after xlo
     xi = i + 0.5
     if m > 0.0:
@@ -181,7 +208,7 @@ def _line_pieces(height, m, yc, xlo, xstop, bx, c0s, c1s, c2s):
         nxt = min(min(xi, xj), xstop)
         if nxt > last + 1e-12:
             n += 1
-            bx[n] = nxt
+            work[0, n] = nxt
             last = nxt
         if nxt >= xstop:
             break
@@ -192,8 +219,8 @@ def _line_pieces(height, m, yc, xlo, xstop, bx, c0s, c1s, c2s):
             j += 1
             xj = (j + 0.5 - yc) / m
     for k in range(n):
-        x0 = bx[k]
-        xm = 0.5 * (x0 + bx[k + 1])
+        x0 = work[0, k]
+        xm = 0.5 * (x0 + work[0, k + 1])
         cx = min(max(int(math.floor(xm + 0.5)), 0), ww)
         cy = min(max(int(math.floor(yc + m * xm + 0.5)), 0), hh)
         i0 = min(max(cx - 1, 0), ww - 1)
@@ -206,66 +233,81 @@ def _line_pieces(height, m, yc, xlo, xstop, bx, c0s, c1s, c2s):
         g = height[j1, i1] - height[j0, i1] - height[j1, i0] + a00
         px = x0 - (cx - 0.5)
         py = yc + m * x0 - (cy - 0.5)
-        c0s[k] = a00 + e * px + f * py + g * px * py
-        c1s[k] = e + f * m + g * (px * m + py)
-        c2s[k] = g * m
+        work[1, k] = a00 + e * px + f * py + g * px * py
+        work[2, k] = e + f * m + g * (px * m + py)
+        work[3, k] = g * m
     return n
 
 
 # ---------------------------------------------------------------------------------------------
 # upper convex hull of the profile behind P
 # ---------------------------------------------------------------------------------------------
-@njit(**_JIT)
-def _hull_push(hx, hz, nh, x, z):
-    """Append a point (increasing x) to an upper hull kept as a stack; returns the new size."""
-    if nh > 0 and x <= hx[nh - 1] + 1e-12:
-        if z <= hz[nh - 1]:
+@njit(inline="always", **_JIT)
+def _hull_push(work, nh, x, z):
+    """Append a point (increasing x) to the upper hull kept as a stack in ``work[4]`` (x) and
+    ``work[5]`` (z); returns the new size."""
+    if nh > 0 and x <= work[4, nh - 1] + 1e-12:
+        if z <= work[5, nh - 1]:
             return nh
         nh -= 1
     while nh >= 2:
-        dxa = hx[nh - 1] - hx[nh - 2]
-        dza = hz[nh - 1] - hz[nh - 2]
-        if dza * (x - hx[nh - 2]) <= (z - hz[nh - 2]) * dxa:
+        dxa = work[4, nh - 1] - work[4, nh - 2]
+        dza = work[5, nh - 1] - work[5, nh - 2]
+        if dza * (x - work[4, nh - 2]) <= (z - work[5, nh - 2]) * dxa:
             nh -= 1
         else:
             break
-    hx[nh] = x
-    hz[nh] = z
+    work[4, nh] = x
+    work[5, nh] = z
     return nh + 1
 
 
-@njit(**_JIT)
-def _tangent_vertex(hx, hz, nh, a, z):
+@njit(inline="always", **_JIT)
+def _tangent_vertex(work, nh, a, z):
     """Hull vertex minimising the slope from it to ``(a, z)`` (``a`` right of the hull)."""
     lo = 0
     hi = nh - 1
     while lo < hi:
         mid = (lo + hi) // 2
         # slope(mid + 1) < slope(mid)  <=>  move right
-        if (z - hz[mid + 1]) * (a - hx[mid]) < (z - hz[mid]) * (a - hx[mid + 1]):
+        left = (z - work[5, mid + 1]) * (a - work[4, mid])
+        if left < (z - work[5, mid]) * (a - work[4, mid + 1]):
             lo = mid + 1
         else:
             hi = mid
-    return lo
-
-
-@njit(**_JIT)
-def _support_vertex(hx, hz, nh, k):
-    """Hull vertex touched by the supporting line of slope ``k`` (maximises ``z - k x``)."""
-    lo = 0
-    hi = nh - 1
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if hz[mid + 1] - hz[mid] <= k * (hx[mid + 1] - hx[mid]):
-            hi = mid
-        else:
-            lo = mid + 1
     return lo
 
 
 # ---------------------------------------------------------------------------------------------
 # forward scan from one walk position
 # ---------------------------------------------------------------------------------------------
+_ZERO = 1e-13  # |value| below which a quadratic is "on" its threshold (decided by the slope)
+_ZERO_SLOPE = 1e-11  # |slope| below which the curvature decides
+
+
+@njit(**_JIT)
+def _first_rise(a, b, c, lo, hi):
+    """First ``u`` in ``[lo, hi]`` where ``a u^2 + b u + c`` becomes strictly positive.
+
+    A start value within ``_ZERO`` of 0 counts as 0: it rises at ``lo`` only if its slope
+    (or, for a zero slope, its curvature) is positive there. ``inf`` when it never rises.
+    """
+    if lo > hi:
+        return np.inf
+    g = _qv(a, b, c, lo)
+    if abs(g) > _ZERO:
+        return _first_positive(a, b, c, lo, hi)
+    slope = 2.0 * a * lo + b
+    if slope > _ZERO_SLOPE or (slope > -_ZERO_SLOPE and a > 0.0):
+        return lo
+    c -= g
+    if a > 0.0:
+        uc = -b / (2.0 * a)
+        if lo < uc < hi:
+            return _first_positive(a, b, c, uc, hi)
+    return np.inf
+
+
 @njit(**_JIT)
 def _phi(u, x0, c0, c1, c2, xt, zt, eps):
     """Slope of the ray from hull vertex ``(xt, zt)`` through ``(x0 + u, f - eps)``."""
@@ -275,166 +317,170 @@ def _phi(u, x0, c0, c1, c2, xt, zt, eps):
     return (_qv(c2, c1, c0, u) - eps - zt) / w
 
 
-@njit(**_JIT)
-def _vertex_at(u, x0, c0, c1, c2, hx, hz, nh, eps):
+@njit(inline="always", **_JIT)
+def _vertex_at(u, x0, c0, c1, c2, work, nh, eps):
     """Tangent vertex of the ray through ``(x0 + u, f - eps)``, with the limit at ``P``."""
     a = x0 + u
-    if a <= hx[nh - 1]:
+    if a <= work[4, nh - 1]:
         if eps > 0.0 or nh == 1:
             return nh - 1
-        elast = (hz[nh - 1] - hz[nh - 2]) / (hx[nh - 1] - hx[nh - 2])
+        elast = (work[5, nh - 1] - work[5, nh - 2]) / (work[4, nh - 1] - work[4, nh - 2])
         return nh - 1 if c1 <= elast else nh - 2
-    return _tangent_vertex(hx, hz, nh, a, _qv(c2, c1, c0, u) - eps)
+    return _tangent_vertex(work, nh, a, _qv(c2, c1, c0, u) - eps)
 
 
-@njit(**_JIT)
-def _frozen_check(ua, ub, k, tk, x0, c0, c1, c2, hx, hz, nh, floor):
-    """First ``u`` in ``[ua, ub]`` where the support ray of slope ``k`` is above ``f + floor``.
+@njit(inline="always", **_JIT)
+def _next_switch(u, length, t, came_from, x0, c0, c1, c2, work, nh, eps):
+    """Where the tangent vertex ``t`` stops being optimal in ``[u, length]``, and the next one.
 
-    ``tk`` is the hull vertex touched by that ray (``-1``: not known yet). Returns
-    ``(u or inf, tk)``.
+    ``t`` is optimal while the moving point ``(x, f - eps)`` is not above the extension of
+    the hull edge on the left of ``t`` and not below the one on its right.
     """
-    if k == _NEG_INF or ub < ua:
-        return np.inf, tk
-    if tk < 0:
-        tk = _support_vertex(hx, hz, nh, k)
-    base = hz[tk] + k * (x0 - hx[tk]) - c0 - floor
-    return _first_positive(-c2, k - c1, base, ua, ub), tk
+    us = np.inf
+    tn = t
+    if t > 0:
+        e = (work[5, t] - work[5, t - 1]) / (work[4, t] - work[4, t - 1])
+        base = c0 - eps - work[5, t] - e * (x0 - work[4, t])
+        lo = u + 1e-9 if came_from == t - 1 else u
+        ul = _first_rise(c2, c1 - e, base, lo, length)
+        if ul < us:
+            us = ul
+            tn = t - 1
+    if t < nh - 1:
+        e = (work[5, t + 1] - work[5, t]) / (work[4, t + 1] - work[4, t])
+        base = c0 - eps - work[5, t] - e * (x0 - work[4, t])
+        lo = u + 1e-9 if came_from == t + 1 else u
+        ur = _first_rise(-c2, e - c1, -base, lo, length)
+        if ur < us:
+            us = ur
+            tn = t + 1
+    return us, tn
 
 
-@njit(**_JIT)
-def _process_interval(ua, ub, t, k, tk, x0, c0, c1, c2, hx, hz, nh, eps, floor):
-    """Advance the running maximum ``k`` of the tangent slopes over ``[ua, ub]``.
-
-    The tangent vertex ``t`` is constant on the interval, so the slope ``phi(u)`` of the ray
-    through ``(x0 + u, f - eps)`` is unimodal there; while ``phi`` sets a new maximum no
-    violation is possible, elsewhere the frozen support ray of slope ``k`` is tested.
-    Returns ``(u_violation or inf, k, tk)``.
-    """
-    xt = hx[t]
-    zt = hz[t]
-    d = x0 - xt
-    # N(u) has the sign of d phi / du; N' = 2 c2 (x - xt) with x >= xt, so N is monotone.
-    na = c2
-    nb = 2.0 * c2 * d
-    nc = c1 * d - c0 + eps + zt
-    ue = ub
-    if (_qv(na, nb, nc, ua) > 0.0) != (_qv(na, nb, nc, ub) > 0.0):
-        ue = min(max(_root_between(na, nb, nc, ua, ub), ua), ub)
-    for seg in range(2):
-        lo = ua if seg == 0 else ue
-        hi = ue if seg == 0 else ub
-        if hi <= lo:
-            continue
-        increasing = _qv(na, nb, nc, 0.5 * (lo + hi)) > 0.0
-        plo = _phi(lo, x0, c0, c1, c2, xt, zt, eps)
-        phi_hi = _phi(hi, x0, c0, c1, c2, xt, zt, eps)
-        if not increasing:
-            if plo > k:
-                k = plo
-                tk = -1
-            v, tk = _frozen_check(lo, hi, k, tk, x0, c0, c1, c2, hx, hz, nh, floor)
-            if v != np.inf:
-                return v, k, tk
-        elif phi_hi <= k:
-            v, tk = _frozen_check(lo, hi, k, tk, x0, c0, c1, c2, hx, hz, nh, floor)
-            if v != np.inf:
-                return v, k, tk
-        else:
-            if plo < k:
-                # phi(u) = k  <=>  c2 u^2 + (c1 - k) u + (c0 - eps - zt - k d) = 0
-                ux = _root_between(c2, c1 - k, c0 - eps - zt - k * d, lo, hi)
-                v, tk = _frozen_check(lo, ux, k, tk, x0, c0, c1, c2, hx, hz, nh, floor)
-                if v != np.inf:
-                    return v, k, tk
-            k = phi_hi
-            tk = -1
-    return np.inf, k, tk
-
-
-@njit(**_JIT)
-def _edge_crossing(x0, c0, c1, c2, eps, hx, hz, t, slope, lo, hi, above):
-    """First ``u`` in ``[lo, hi]`` where ``(x0 + u, f - eps)`` is strictly above (``above``)
-    or strictly below the line of slope ``slope`` through hull vertex ``t``."""
-    if lo > hi:
-        return np.inf
-    a = c2
-    b = c1 - slope
-    c = c0 - eps - hz[t] - slope * (x0 - hx[t])
-    if not above:
-        a = -a
-        b = -b
-        c = -c
-    g = _qv(a, b, c, lo)
-    if abs(g) <= 1e-13:
-        # on the edge line at the start (e.g. P itself): decided by where it goes next
-        if 2.0 * a * lo + b > 0.0 or (2.0 * a * lo + b == 0.0 and a > 0.0):
-            return lo
-        c -= g  # treat the start as exactly on the line
-        if a != 0.0:
-            uc = -b / (2.0 * a)
-            if lo < uc < hi:
-                return _first_positive(a, b, c, uc, hi)
-        return _first_positive(a, b, c, hi, hi)
-    return _first_positive(a, b, c, lo, hi)
-
-
-@njit(**_JIT)
-def _scan(bx, c0s, c1s, c2s, npieces, kp, xlimit, hx, hz, nh, eps, floor):
+@njit(inline="always", **_JIT)
+def _scan(work, npieces, kp, xlimit, nh, eps, floor):
     """First violation ``b*`` (absolute x) after the walk position at piece ``kp``.
 
-    Scans pieces until ``xlimit``; returns ``inf`` when there is no violation before it.
-    Each piece is split where the tangent vertex on the hull changes: the vertex ``t`` is
-    optimal while the moving point stays below the extension of the hull edge on its left
-    and above the one on its right, so the switch points are roots of quadratics.
+    Returns ``inf`` when there is none before ``xlimit``. ``K`` is the running maximum of
+    the slope ``k(a)`` of the steepest ray through ``(a, f(a) - eps)`` that clears the hull.
+    Two states alternate:
+
+    * tracking (``k(a)`` is the running maximum and increasing): no violation is possible;
+      the tangent vertex ``t`` of the moving point is followed exactly (it switches where the
+      point crosses a hull edge extension) and ``k(a) = phi_t(a)`` stops increasing where
+      ``N_t(a) = f'(a)(a - x_t) - (f(a) - eps - z_t)`` reaches 0 (both are quadratics);
+    * frozen: the envelope of all earlier tangent rays is the support ray ``L_K`` through the
+      vertex ``tk``; a violation is the first point where ``L_K > f + floor``, and tracking
+      resumes where ``f - eps`` rises above ``L_K`` (then ``k(a) > K`` again).
     """
+    t = _vertex_at(0.0, work[0, kp], work[1, kp], work[2, kp], work[3, kp], work, nh, eps)
+    tracking = True
     k = _NEG_INF
-    tk = -1
-    t = _vertex_at(0.0, bx[kp], c0s[kp], c1s[kp], c2s[kp], hx, hz, nh, eps)
+    tk = t
+    came_from = -1
     for kk in range(kp, npieces):
-        x0 = bx[kk]
+        x0 = work[0, kk]
         if x0 >= xlimit:
             break
-        length = min(bx[kk + 1], xlimit) - x0
-        c0 = c0s[kk]
-        c1 = c1s[kk]
-        c2 = c2s[kk]
+        length = min(work[0, kk + 1], xlimit) - x0
+        c0 = work[1, kk]
+        c1 = work[2, kk]
+        c2 = work[3, kk]
         u = 0.0
-        came_from = -1
-        for _ in range(4 * nh + 8):
-            us = length
-            tn = t
-            if t > 0:
-                # the edge just crossed cannot be crossed back at the same point
-                lo = u + 1e-9 if came_from == t - 1 else u
-                e = (hz[t] - hz[t - 1]) / (hx[t] - hx[t - 1])
-                ul = _edge_crossing(x0, c0, c1, c2, eps, hx, hz, t, e, lo, length, True)
-                if ul < us:
-                    us = ul
-                    tn = t - 1
-            if t < nh - 1:
-                lo = u + 1e-9 if came_from == t + 1 else u
-                e = (hz[t + 1] - hz[t]) / (hx[t + 1] - hx[t])
-                ur = _edge_crossing(x0, c0, c1, c2, eps, hx, hz, t, e, lo, length, False)
-                if ur < us:
-                    us = ur
-                    tn = t + 1
-            v, k, tk = _process_interval(u, us, t, k, tk, x0, c0, c1, c2, hx, hz, nh, eps,
-                                         floor)
-            if v != np.inf:
-                return x0 + v
-            if tn == t:
+        froze_at = -1.0
+        resumed_at = -1.0
+        done = False
+        for _ in range(4 * nh + 16):
+            if tracking:
+                xt = work[4, t]
+                zt = work[5, t]
+                d = x0 - xt
+                nc = c1 * d - c0 + eps + zt
+                nu = _qv(c2, 2.0 * c2 * d, nc, u)
+                rising = nu > _ZERO or (nu > -_ZERO and c2 > 0.0) or resumed_at == u
+                if not rising:
+                    k = _phi(u, x0, c0, c1, c2, xt, zt, eps)
+                    tk = t
+                    tracking = False
+                    froze_at = u
+                    continue
+                us, tn = _next_switch(u, length, t, came_from, x0, c0, c1, c2, work, nh,
+                                      eps)
+                ue = np.inf
+                if c2 < 0.0:
+                    # N decreases: k(a) peaks where N = 0
+                    ue = _first_rise(-c2, -2.0 * c2 * d, -nc, u, length)
+                if ue <= us and ue <= length:
+                    k = _phi(ue, x0, c0, c1, c2, xt, zt, eps)
+                    tk = t
+                    tracking = False
+                    u = ue
+                    froze_at = ue
+                    came_from = -1
+                    continue
+                if us <= length:
+                    came_from = t
+                    t = tn
+                    u = us
+                    continue
+                done = True
                 break
-            came_from = t
-            t = tn
-            u = us
+            else:
+                # D(u) = L_K - f on this piece: a violation where D > floor, tracking
+                # resumes where D < -eps; most pieces have neither (fast path)
+                da = -c2
+                db = k - c1
+                dc = work[5, tk] + k * (x0 - work[4, tk]) - c0
+                d0 = _qv(da, db, dc, u)
+                d1 = _qv(da, db, dc, length)
+                dmax = max(d0, d1)
+                dmin = min(d0, d1)
+                if da != 0.0:
+                    uc = -db / (2.0 * da)
+                    if u < uc < length:
+                        dv = _qv(da, db, dc, uc)
+                        dmax = max(dmax, dv)
+                        dmin = min(dmin, dv)
+                if dmax <= floor and dmin >= -eps - _ZERO:
+                    done = True
+                    break
+                # resume strictly after the point where it froze (no ping-pong on ties)
+                ur = _first_rise(c2, c1 - k, -dc - eps, u + 1e-9 if froze_at == u else u,
+                                 length)
+                uv = _first_positive(da, db, dc - floor, u, min(ur, length))
+                if uv != np.inf:
+                    return x0 + uv
+                if ur <= length:
+                    tracking = True
+                    t = tk
+                    came_from = -1
+                    u = ur
+                    resumed_at = ur
+                    continue
+                done = True
+                break
+        if not done:
+            return x0 + u  # no progress (degenerate ties): report a violation, conservatively
     return np.inf
 
 
 # ---------------------------------------------------------------------------------------------
 # one direction (all parallel lines of one slope, in one of the eight octant frames)
 # ---------------------------------------------------------------------------------------------
-@njit(**_JIT)
+@njit(inline="always", **_JIT)
+def _radius_from(dist, margin):
+    """Largest radius ``n`` with ``n < dist - margin`` (the first violation is at ``dist``).
+
+    A violation right after a vertical centerline (at an integer distance: a crease of the
+    surface along the walk's own centerlines) does not move with the sampled offset or
+    direction, so it gets no margin.
+    """
+    if dist - math.floor(dist) <= 1e-4:
+        return int(math.ceil(dist)) - 1
+    return int(math.ceil(dist - margin)) - 1
+
+
+@njit(inline="always", **_JIT)
 def _to_original(ip, jp, wp, hp, transpose, flipx, flipy):
     i2 = wp - 1 - ip if flipx else ip
     j2 = hp - 1 - jp if flipy else jp
@@ -443,7 +489,7 @@ def _to_original(ip, jp, wp, hp, transpose, flipx, flipy):
     return j2, i2
 
 
-@njit(**_JIT)
+@njit(inline="always", **_JIT)
 def _current_bound(bufs, r, c):
     best = bufs[0, r, c]
     for b in range(1, bufs.shape[0]):
@@ -451,7 +497,7 @@ def _current_bound(bufs, r, c):
     return best
 
 
-@njit(**_JIT)
+@njit(inline="always", **_JIT)
 def _rows_of(y0, hp):
     """Rows whose texel contains the centerline point at height ``y0`` (two on a border)."""
     j = min(max(int(math.floor(y0)), 0), hp - 1)
@@ -463,7 +509,8 @@ def _rows_of(y0, hp):
 
 @njit(**_JIT)
 def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose, flipx, flipy,
-                work):
+                work, only_first):
+    """Scan every walk position of one sample line (only the first when ``only_first``)."""
     hp, wp = height.shape
     xlo, xhi = _line_range(hp, wp, m, yc)
     if not xhi > xlo:
@@ -475,7 +522,10 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
         xend += min(2.0, 1.0 / (offsets * m))
     i_first = max(0, int(math.ceil(xlo - 0.5)))
     i_last = min(wp - 1, int(math.floor(xhi - 0.5)))
-    # how far along the line does any walk position still need work?
+    if only_first:
+        i_last = min(i_last, i_first)
+    # how far along the line does any walk position still need work? (scans stop at the
+    # first violation; past the last position that needs work they are cut short)
     xstop = xlo
     for i in range(i_first, i_last + 1):
         xp = i + 0.5
@@ -486,16 +536,10 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
             r2, c2 = _to_original(i, j2, wp, hp, transpose, flipx, flipy)
             bound = max(bound, _current_bound(bufs, r2, c2))
         if bound > 0:
-            xstop = max(xstop, min(xend, xp + 2 * bound + margin))
+            xstop = max(xstop, min(xend, xp + 4 * bound + margin + 8.0))
     if not xstop > xlo:
         return
-    bx = work[0]
-    c0s = work[1]
-    c1s = work[2]
-    c2s = work[3]
-    hx = work[4]
-    hz = work[5]
-    npieces = _line_pieces(height, m, yc, xlo, xstop, bx, c0s, c1s, c2s)
+    npieces = _line_pieces(height, m, yc, xlo, xstop, work)
     nh = 0
     k = 0
     # Along one line the first violation b*(P) never moves backwards as P advances (a later P
@@ -506,16 +550,16 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
         xp = i + 0.5
         if xp > xstop:
             break
-        while k < npieces and bx[k] <= xp + 1e-9:
-            if k > 0 and c2s[k - 1] < 0.0:
+        while k < npieces and work[0, k] <= xp + 1e-9:
+            if k > 0 and work[3, k - 1] < 0.0:
                 # maximum of a concave piece: a better (still conservative) hull sample
-                uc = -c1s[k - 1] / (2.0 * c2s[k - 1])
-                if 0.0 < uc < bx[k] - bx[k - 1]:
-                    nh = _hull_push(hx, hz, nh, bx[k - 1] + uc,
-                                    _qv(c2s[k - 1], c1s[k - 1], c0s[k - 1], uc))
-            nh = _hull_push(hx, hz, nh, bx[k], c0s[k])
+                uc = -work[2, k - 1] / (2.0 * work[3, k - 1])
+                if 0.0 < uc < work[0, k] - work[0, k - 1]:
+                    nh = _hull_push(work, nh, work[0, k - 1] + uc,
+                                    _qv(work[3, k - 1], work[2, k - 1], work[1, k - 1], uc))
+            nh = _hull_push(work, nh, work[0, k], work[1, k])
             k += 1
-        if k == 0 or bx[k - 1] < xp - 1e-9:
+        if k == 0 or work[0, k - 1] < xp - 1e-9:
             continue  # P is the end of the line: nothing after it
         j, j2 = _rows_of(yc + m * xp, hp)
         r, c = _to_original(i, j, wp, hp, transpose, flipx, flipy)
@@ -526,12 +570,12 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
         limit = min(xp + bound + margin, xstop)
         if known >= limit:
             continue
-        # scan a little further than needed so that the next walk positions can be skipped
-        reach = min(limit + bound, xstop)
-        b = _scan(bx, c0s, c1s, c2s, npieces, k - 1, reach, hx, hz, nh, eps, floor)
-        known = b if b != np.inf else reach
+        # scan on to the first violation (or xstop), not just to ``limit``: the result settles
+        # the following walk positions too
+        b = _scan(work, npieces, k - 1, xstop, nh, eps, floor)
+        known = b if b != np.inf else xstop
         if b <= limit:
-            n = max(int(math.ceil(b - xp - margin)) - 1, 0)
+            n = max(_radius_from(b - xp, margin), 0)
             if n < bufs[tid, r, c]:
                 bufs[tid, r, c] = n
             if n < bufs[tid, r2, c2]:
@@ -556,12 +600,9 @@ def _sweep_direction(height, m, offsets, eps, floor, margin, bufs, transpose, fl
     works = np.empty((nthreads, 6, 3 * cap))
     for li in prange(nlines + nextra):
         tid = numba.get_thread_id()
-        if li < nlines:
-            yc = (k_lo + li) / offsets
-        else:
-            yc = -m * (li - nlines + 0.5)
+        yc = (k_lo + li) / offsets if li < nlines else -m * (li - nlines + 0.5)
         _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose, flipx, flipy,
-                    works[tid])
+                    works[tid], li >= nlines)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -603,6 +644,14 @@ def _coarse_to_fine(count: int) -> list[int]:
     return order
 
 
+def _checked_height(height) -> np.ndarray:
+    h = _as_height(height)
+    if h.min() < 0.0 or h.max() > 1.0:
+        raise UsageError(f"height must be within [0, 1] (box units), got values in "
+                         f"[{h.min():.4g}, {h.max():.4g}]; normalise the heightfield first")
+    return h
+
+
 def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
                  directions: int = 64, offsets: int = 4, margin: float = 0.25,
                  progress: Callable[[int, int], None] | None = None) -> np.ndarray:
@@ -623,35 +672,52 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
         ``directions // 2 + 1`` slopes per 45-degree octant, eight octants.
     offsets : int
         Parallel lines per texel and direction (crossing points ``P`` sampled per texel).
+    margin : float
+        Texels by which a found violation is moved closer to ``P`` (and the scan extended
+        past the box exit) to cover violations between the samples; 0 disables it.
     progress : callable, optional
-        ``progress(done, total)`` called after each (octant, direction) batch.
+        ``progress(done, total)`` called after each batch of work (one direction in one of
+        the eight octant frames: ``total = 8 * (directions // 2 + 1)``), for a progress bar.
 
     Returns
     -------
     numpy.ndarray
         (H, W) radii in texels, uint8 or uint16.
+
+    Raises
+    ------
+    reliefkit.errors.UsageError
+        For a height array that is not 2D, not finite or outside [0, 1], or bad options.
+
+    Notes
+    -----
+    The walk positions are processed by numba in parallel (all sample lines of one direction
+    at a time); the cost grows with the texel count, the number of samples and the radii.
     """
-    h = _as_height(height)
+    h = _checked_height(height)
     if not 0.0 <= float(tolerance) < np.inf:
         raise UsageError(f"tolerance must be a finite number >= 0, got {tolerance!r}")
     if not 0 <= int(max_radius) <= 65535:
         raise UsageError(f"max_radius must be in [0, 65535], got {max_radius!r}")
     if int(directions) < 2 or int(offsets) < 1:
         raise UsageError("directions must be >= 2 and offsets >= 1")
+    if not 0.0 <= float(margin) <= 4.0:
+        raise UsageError(f"margin must be within [0, 4] texels, got {margin!r}")
     dtype = np.uint8 if int(max_radius) <= 255 else np.uint16
     nthreads = numba.get_num_threads()
     bufs = np.full((nthreads,) + h.shape, int(max_radius), dtype=np.int32)
     slopes = _slopes(int(directions))
     frames = [_frame(h, *f) for f in _FRAMES]
+    eps = float(tolerance) * (1.0 - TOLERANCE_SLACK)
     total = len(_FRAMES) * len(slopes)
     done = 0
     for si in _coarse_to_fine(len(slopes)):
-        for (transpose, flipx, flipy), frame in zip(_FRAMES, frames):
+        for (transpose, flipx, flipy), frame in zip(_FRAMES, frames, strict=True):
             previous = numba.get_parallel_chunksize()
             numba.set_parallel_chunksize(1)
             try:
-                _sweep_direction(frame, float(slopes[si]), int(offsets), float(tolerance),
-                                 NUMERIC_FLOOR, float(margin), bufs, transpose, flipx, flipy)
+                _sweep_direction(frame, float(slopes[si]), int(offsets), eps, NUMERIC_FLOOR,
+                                 float(margin), bufs, transpose, flipx, flipy)
             finally:
                 numba.set_parallel_chunksize(previous)
             done += 1
@@ -747,9 +813,8 @@ def _check_one(height, o, d, radius, tol):
     empty = np.empty(0)
     if t_in > t_out or radius <= 0:
         return 1, 0.0, empty
-    if t_in <= 0.0:
-        if _first_hit_range(height, o, d, t_in, min(0.0, t_out)) <= 0.0:
-            return 1, 0.0, empty
+    if t_in <= 0.0 and _first_hit_range(height, o, d, t_in, min(0.0, t_out)) <= 0.0:
+        return 1, 0.0, empty
     cr = _crossings(height, o, d, 0.0, float(radius))
     start = max(t_in, 0.0)
     # state at the start of the checked range
@@ -808,19 +873,18 @@ def _tangent_candidate(height, px, py, ddx, ddy, radius, tol, delta):
     if not s_end > 0.0 or s_lo > 0.0:
         return False, 0.0, 0.0
     bs, bf = _profile(height, px, py, ddx, ddy, s_lo, 0.0, 0.125)
-    hx = np.empty(bs.shape[0])
-    hz = np.empty(bs.shape[0])
+    hull = np.empty((6, bs.shape[0]))
     nh = 0
     for q in range(bs.shape[0]):
-        nh = _hull_push(hx, hz, nh, bs[q], bf[q])
+        nh = _hull_push(hull, nh, bs[q], bf[q])
     fs, ff = _profile(height, px, py, ddx, ddy, 0.0, s_end, max(1.0 / 16.0, s_end / 512.0))
     best_b = np.inf
     best_k = 0.0
     best_z = 0.0
     for q in range(1, fs.shape[0]):
         za = ff[q] - tol - delta
-        t = _tangent_vertex(hx, hz, nh, fs[q], za)
-        k = (za - hz[t]) / (fs[q] - hx[t])
+        t = _tangent_vertex(hull, nh, fs[q], za)
+        k = (za - hull[5, t]) / (fs[q] - hull[4, t])
         for r in range(q + 1, fs.shape[0]):
             if fs[r] >= best_b:
                 break
@@ -834,55 +898,55 @@ def _tangent_candidate(height, px, py, ddx, ddy, radius, tol, delta):
     return True, best_k, best_z
 
 
+@njit(**_JIT)
+def _check_one_ray(height, radius, j, i, major, sign, off, slope, kz, lift, mode, tol, o, d):
+    """Build one checker ray (see :func:`check_safety`) into ``o, d``; returns its status
+    (0 fine, 1 blocked or not generated, 2 violation) and the violating depth."""
+    hh, ww = height.shape
+    if major == 0:
+        px = i + 0.5
+        py = j + off
+        ddx = sign
+        ddy = sign * slope
+    else:
+        px = i + off
+        py = j + 0.5
+        ddx = sign * slope
+        ddy = sign
+    o[0] = px / ww
+    o[1] = py / hh
+    d[0] = ddx / ww
+    d[1] = ddy / hh
+    d[2] = kz
+    if mode == 0:
+        # plain ray at a random height above P
+        o[2] = _surface(height, px, py) + lift
+    else:
+        o[2] = -np.inf
+        if mode == 2:
+            found, k, z = _tangent_candidate(height, px, py, ddx, ddy, radius, tol, lift)
+            if not found:
+                return 1, 0.0
+            d[2] = k
+            o[2] = z
+        # never below the lowest ray that clears the surface up to P (extremal ray)
+        t0, _ = _xy_range(o, d)
+        low = _lowest_clear_height(height, o, d, t0, 0.0)
+        if o[2] <= low:
+            o[2] = low + (lift if mode == 1 else 1e-12 + 1e-12 * abs(low))
+    s, dep, _ = _check_one(height, o, d, radius, tol)
+    return s, dep
+
+
 @njit(parallel=True, **_JIT)
 def _check_batch(height, safety, rows, cols, majors, signs, offs, slopes, ks, lifts, modes, tol,
                  status, depth, origins, dirs):
-    hh, ww = height.shape
     for r in prange(rows.shape[0]):
-        j = rows[r]
-        i = cols[r]
-        if majors[r] == 0:
-            px = i + 0.5
-            py = j + offs[r]
-            ddx = signs[r]
-            ddy = signs[r] * slopes[r]
-        else:
-            px = i + offs[r]
-            py = j + 0.5
-            ddx = signs[r] * slopes[r]
-            ddy = signs[r]
-        o = np.empty(3)
-        d = np.empty(3)
-        o[0] = px / ww
-        o[1] = py / hh
-        d[0] = ddx / ww
-        d[1] = ddy / hh
-        d[2] = ks[r]
-        radius = int(safety[j, i])
-        status[r] = 1
-        if modes[r] == 0:
-            # plain ray at a random height above P
-            o[2] = _surface(height, px, py) + lifts[r]
-        else:
-            if modes[r] == 2:
-                found, k, z = _tangent_candidate(height, px, py, ddx, ddy, radius, tol,
-                                                 lifts[r])
-                if not found:
-                    continue
-                d[2] = k
-                o[2] = z
-            else:
-                o[2] = -np.inf
-            # never below the lowest ray that clears the surface up to P (extremal ray)
-            t0, t1 = _xy_range(o, d)
-            low = _lowest_clear_height(height, o, d, t0, 0.0)
-            if o[2] <= low:
-                o[2] = low + (lifts[r] if modes[r] == 1 else 1e-12 + 1e-12 * abs(low))
-        s, dep, _ = _check_one(height, o, d, radius, tol)
+        s, dep = _check_one_ray(height, int(safety[rows[r], cols[r]]), rows[r], cols[r],
+                                majors[r], signs[r], offs[r], slopes[r], ks[r], lifts[r],
+                                modes[r], tol, origins[r], dirs[r])
         status[r] = s
         depth[r] = dep
-        origins[r] = o
-        dirs[r] = d
 
 
 def _ray_parameters(shape, rays: int, rng, adversarial: bool):
@@ -963,7 +1027,7 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     list of Violation
         Empty when no violation was found.
     """
-    h = _as_height(height)
+    h = _checked_height(height)
     s = np.asarray(safety)
     if s.shape != h.shape:
         raise UsageError(f"safety shape {s.shape} does not match height shape {h.shape}")

@@ -208,10 +208,9 @@ def _first_root(a, b, c, length):
         r2 = c / q
         if 0.0 <= r2 < best and r2 <= length:
             best = r2
-    if best == np.inf:
+    if best == np.inf and _quad(a, b, c, length) <= 0.0:
         # Rounding can push a root just past the end of the cell although F(length) <= 0.
-        if _quad(a, b, c, length) <= 0.0:
-            return _bisect_root(a, b, c, 0.0, length)
+        return _bisect_root(a, b, c, 0.0, length)
     return best
 
 
