@@ -57,7 +57,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("render", help="render a mesh or an .rk representation to PNG / GIF",
                        description="Render a mesh (ground truth) or an .rk representation.",
-                       epilog="examples:\n  reliefkit render model.glb -o model.png --aovs model.npz"
+                       epilog="examples:\n  reliefkit render model.glb -o model.png"
+                              " --aovs model.npz"
                               "\n  reliefkit render demo:vehicle --turntable 24 -o spin.gif",
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("input", help="mesh file, .rk file or demo:NAME")
@@ -155,8 +156,9 @@ def _add_bake_args(p: argparse.ArgumentParser) -> None:
                    help="representation to bake (default: %(default)s)")
     p.add_argument("--depth-res", type=int, help="heightfield resolution (longest side)")
     p.add_argument("--color-res", type=int, help="colour/normal resolution (default: depth)")
-    p.add_argument("--safety-tolerance", type=float, default=0.0, metavar="E",
-                   help="allowed silhouette error (height units) for larger safety radii")
+    p.add_argument("--safety-tolerance", type=float, default=0.01, metavar="E",
+                   help="ignored dip depth (height units, Fig. 12): larger radii and fewer "
+                        "iterations for a bounded silhouette error (default: %(default)s)")
     p.add_argument("--no-safety", action="store_true", help="skip the safety radii")
     p.add_argument("--axis", default="y", help="projection axis: x, y, z, -x, -y, -z")
     p.add_argument("--spread", type=float, default=30.0,
@@ -312,7 +314,8 @@ def cmd_info(args) -> int:
     else:
         for section in report.values():
             for key, value in section.items():
-                print(f"{key:>24}: {json.dumps(value) if isinstance(value, dict | list) else value}")
+                shown = json.dumps(value) if isinstance(value, dict | list) else value
+                print(f"{key:>24}: {shown}")
     return 0
 
 

@@ -1,13 +1,14 @@
 """Baking: meshes and heightmaps into representations."""
 
 from .frustum import bake_relief_cube, bake_relief_frustum, fit_reverse_frustum
-from .heightfield import bake_relief, relief_from_heights
+from .heightfield import DEFAULT_TOLERANCE, bake_relief, relief_from_heights
 
 BAKE_KINDS = ("relief", "relief-frustum", "relief-cube")
 
 
 def bake(source, kind: str, *, depth_res: int | None = None, color_res: int | None = None,
-         tolerance: float = 0.0, safety: bool = True, axis: str = "y", progress=None, **extra):
+         tolerance: float = DEFAULT_TOLERANCE, safety: bool = True, axis: str = "y",
+         progress=None, **extra):
     """Bake a RenderMesh (or a height array, for ``relief``) into the representation ``kind``."""
     import numpy as np
 

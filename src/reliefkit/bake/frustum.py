@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import UsageError
 from ..represent.relief import ReliefObject, ReliefTexture
 from ..scene.mesh import RenderMesh
-from .heightfield import BORDER_TEXELS, axis_frame, bake_through
+from .heightfield import BORDER_TEXELS, DEFAULT_TOLERANCE, axis_frame, bake_through
 
 UNIT_FROM_NDC = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1]])
 CUBE_FACES = ("x", "-x", "y", "-y", "z", "-z")
@@ -71,7 +71,8 @@ def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 3
 def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
                         depth_res: int = 256, color_res: int | None = None, axis: str = "y",
                         spread_deg: float = 30.0, clip: bool = True, safety: bool = True,
-                        tolerance: float = 0.0, progress=None, ctx=None) -> ReliefTexture:
+                        tolerance: float = DEFAULT_TOLERANCE, progress=None,
+                        ctx=None) -> ReliefTexture:
     """Relief texture through a reverse frustum (a user's box_to_world, or a fitted one).
 
     With ``clip`` the proxy drawn at render time is the frustum intersected with the
@@ -107,7 +108,7 @@ def cube_frusta(mesh: RenderMesh, margin: float = 0.02,
 
 
 def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int | None = None,
-                     safety: bool = True, tolerance: float = 0.0, progress=None,
+                     safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
                      ctx=None) -> ReliefObject:
     """Six reverse-perspective heightfields splitting the bounding cube (§4.2, Fig. 10)."""
     size = (depth_res, depth_res)

@@ -19,6 +19,10 @@ from ..scene.mesh import RenderMesh
 AXES = {"x": 0, "y": 1, "z": 2}
 BORDER_TEXELS = 1.5      # empty margin around the footprint (the border ring must be 0)
 HEIGHT_MARGIN = 0.01     # the box bottom lies this fraction of the height below the mesh
+# Safety-radius tolerance of bakes (height units, Fig. 12): with 0 most texels of a bilinear
+# terrain get radius 0 (every non-planar patch bends down along some direction); 1% of the
+# box height keeps radii growing with resolution at a bounded silhouette error.
+DEFAULT_TOLERANCE = 0.01
 FLAT_LIGHT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
 
 # box (u, v, h) -> clip: x = 2u - 1, y = 2v - 1, z = 1 - 2h (the top is nearest)
@@ -115,7 +119,7 @@ def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int,
 
 
 def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
-                 safety: bool = True, tolerance: float = 0.0, progress=None,
+                 safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
                  params: dict | None = None, zero_border: bool = True,
                  ctx=None) -> ReliefTexture:
     """Bake ``mesh`` through any box/frustum matrix at the given resolutions.
@@ -143,7 +147,7 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
 
 
 def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = None,
-                axis: str = "y", *, safety: bool = True, tolerance: float = 0.0,
+                axis: str = "y", *, safety: bool = True, tolerance: float = DEFAULT_TOLERANCE,
                 progress=None, ctx=None) -> ReliefTexture:
     """Orthographic relief texture of ``mesh`` seen from above along ``axis`` (§3)."""
     box_to_world, depth_size = ortho_box(mesh, axis, depth_res)
@@ -155,7 +159,7 @@ def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = 
 
 
 def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bool = True,
-                        tolerance: float = 0.0, progress=None) -> ReliefTexture:
+                        tolerance: float = DEFAULT_TOLERANCE, progress=None) -> ReliefTexture:
     """A relief texture straight from a height array (values scaled to [0, 1]).
 
     ``size`` is the world extent (x, y, z) of the box: u along +x, v along -z, h along +y,

@@ -15,7 +15,7 @@ compile error raises GPUError("shaders/relief.glsl:42: ...").
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 
 from ..errors import GPUError
@@ -32,7 +32,7 @@ _VERSION = re.compile(r"^//!\s*version:\s*(\d+)\s*$", re.M)
 _ERROR_LOC = re.compile(r"^\s*(?:ERROR:\s*)?(\d+)[:(](\d+)\)?(?:\(\d+\))?\s*:\s*(.*)$", re.M)
 
 
-@lru_cache(maxsize=None)
+@cache
 def read_shader_file(name: str) -> str:
     """The text of ``reliefkit/shaders/<name>``."""
     path = resources.files("reliefkit").joinpath("shaders", name)

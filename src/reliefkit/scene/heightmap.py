@@ -21,10 +21,7 @@ def load_heightmap(path) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise FormatError(f"{path}: no such file")
-    if path.suffix.lower() == ".npy":
-        heights = _load_npy(path)
-    else:
-        heights = _load_png(path)
+    heights = _load_npy(path) if path.suffix.lower() == ".npy" else _load_png(path)
     if heights.ndim != 2 or min(heights.shape) < 4 or max(heights.shape) > MAX_SIDE:
         raise FormatError(f"{path}: a heightmap must be 2D, between 4 and {MAX_SIDE} texels "
                           f"per side; got shape {heights.shape}")

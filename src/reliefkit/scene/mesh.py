@@ -98,9 +98,9 @@ def _indices(a, vertex_count: int, name: str) -> np.ndarray:
         raise MeshError(f"{name}: the mesh is empty (no triangles)")
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise MeshError(f"{name}: indices must have shape (F, 3), got {arr.shape}")
-    if not np.issubdtype(arr.dtype, np.integer):
-        if not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr)):
-            raise MeshError(f"{name}: indices must be integers")
+    if not np.issubdtype(arr.dtype, np.integer) and (
+            not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr))):
+        raise MeshError(f"{name}: indices must be integers")
     lo, hi = int(arr.min()), int(arr.max())
     if lo < 0:
         raise MeshError(f"{name}: a triangle index is negative ({lo})")
