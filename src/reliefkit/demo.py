@@ -46,7 +46,10 @@ def _baked(name: str, kind: str, **bake_options) -> Callable[[], object]:
 def demo_tiles() -> list[DemoTile]:
     """Every tile of the demo sheet, in order (representations add theirs here)."""
     terrain_view, vehicle_view, blob_view = (30.0, 35.0, 2.2), (40.0, 20.0, 2.2), (35, 25, 2.5)
-    robust_shadows = {"method": "robust", "shadows": True}
+    from .scene.light import DirectionalLight
+
+    low_sun = DirectionalLight(direction=(-0.85, 0.35, 0.25))
+    robust_shadows = {"method": "robust", "shadows": True, "light": low_sun}
     return [
         DemoTile("terrain (mesh)", "terrain-mesh", _asset("terrain"), terrain_view),
         DemoTile("blob (mesh)", "blob-mesh", _asset("blob"), blob_view),

@@ -10,6 +10,12 @@ from pathlib import Path
 from .errors import UsageError
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_path(path, *, suffix: str | None = None):
     """Yield a temporary path beside ``path``; on success fsync it and move it into place.
@@ -23,6 +29,7 @@ def atomic_path(path, *, suffix: str | None = None):
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{dest.name}.",
                                suffix=suffix if suffix is not None else dest.suffix + ".tmp")
     os.close(fd)
+    os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give outputs the usual mode
     try:
         yield Path(tmp)
         with open(tmp, "rb+") as handle:
