@@ -770,20 +770,7 @@ class Violation:
 @njit(**_JIT)
 def _xy_range(o, d):
     """Parameter range of the ray's projection inside the unit square (z ignored)."""
-    t0 = -np.inf
-    t1 = np.inf
-    for a in range(2):
-        if d[a] == 0.0:
-            if o[a] < 0.0 or o[a] > 1.0:
-                return 1.0, 0.0
-        else:
-            ta = (0.0 - o[a]) / d[a]
-            tb = (1.0 - o[a]) / d[a]
-            if ta > tb:
-                ta, tb = tb, ta
-            t0 = max(t0, ta)
-            t1 = min(t1, tb)
-    return t0, t1
+    return _clip_box(o, d, -np.inf, np.inf, 2)
 
 
 @njit(**_JIT)

@@ -66,14 +66,15 @@ def _surface(height, x, y):
 
 
 @njit(**_JIT)
-def _clip_box(o, d, t_min, t_max):
-    """Clip the parameter range [t_min, t_max] of ``o + t d`` to the unit box.
+def _clip_box(o, d, t_min, t_max, axes=3):
+    """Clip the parameter range [t_min, t_max] of ``o + t d`` to the unit box (to the unit
+    square of the first two coordinates when ``axes`` is 2).
 
     Returns ``(t0, t1)``; the ray misses when ``t0 > t1``.
     """
     t0 = t_min
     t1 = t_max
-    for a in range(3):
+    for a in range(axes):
         if d[a] == 0.0:
             if o[a] < 0.0 or o[a] > 1.0:
                 return 1.0, 0.0
