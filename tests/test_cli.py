@@ -109,3 +109,34 @@ def test_bad_mesh_and_bad_rk_are_one_line_errors(tmp_path):
     forged.write_bytes(b"PK\x03\x04 not really a zip")
     assert_one_line_error(run_cli("render", forged, "-o", tmp_path / "x.png"), "forged.rk")
     assert not (tmp_path / "x.png").exists()
+
+
+def test_bake_heightmap_png16_and_npy(gl, tmp_path):
+    from PIL import Image
+
+    y, x = np.mgrid[0:24, 0:32]
+    heights = (np.sin(x / 5.0) * np.cos(y / 4.0) + 1) / 2
+    Image.fromarray(np.round(heights * 65535).astype(np.uint16)).save(tmp_path / "h.png")
+    np.save(tmp_path / "h.npy", heights)
+    for name in ("h.png", "h.npy"):
+        out = run_cli("bake", tmp_path / name, "--as", "relief", "--box", "3,0.5,2", "-o",
+                      tmp_path / "h.rk")
+        assert out.returncode == 0, out.stderr
+        from reliefkit.formats import load
+
+        relief = load(tmp_path / "h.rk")
+        assert relief.height.shape == (24, 32)
+        np.testing.assert_allclose(relief.bounds[1] - relief.bounds[0], [3, 0.5, 2])
+    assert_one_line_error(run_cli("bake", tmp_path / "h.npy", "--as", "relief-cube", "-o",
+                                  tmp_path / "c.rk"), "heightmap")
+
+
+def test_compare_writes_picture_and_metrics(gl, tmp_path):
+    out = run_cli("compare", "demo:terrain", "--as", "relief", "--depth-res", "32",
+                  "--size", "64x64", "--out", tmp_path / "cmp")
+    assert out.returncode == 0, out.stderr
+    report = json.loads((tmp_path / "cmp" / "metrics.json").read_text())
+    assert set(report["methods"]) == {"binary", "exact", "robust"}
+    assert report["methods"]["exact"]["wrong_hit_fraction"] <= 0.001
+    assert (tmp_path / "cmp" / "compare.png").stat().st_size > 1000
+    assert "| robust |" in (tmp_path / "cmp" / "metrics.md").read_text()
