@@ -49,18 +49,23 @@ def _add_view_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fov", type=float, default=40.0, help="vertical field of view in degrees")
 
 
+def _command(sub, name: str, summary: str, description: str, *examples: str):
+    """A subcommand parser whose --help ends with its examples."""
+    epilog = "examples:\n" + "\n".join(f"  {line}" for line in examples)
+    return sub.add_parser(name, help=summary, description=description, epilog=epilog,
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
                      epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    p = sub.add_parser("render", help="render a mesh or an .rk representation to PNG / GIF",
-                       description="Render a mesh (ground truth) or an .rk representation.",
-                       epilog="examples:\n  reliefkit render model.glb -o model.png"
-                              " --aovs model.npz"
-                              "\n  reliefkit render demo:vehicle --turntable 24 -o spin.gif",
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _command(sub, "render", "render a mesh or an .rk representation to PNG / GIF",
+                 "Render a mesh (ground truth) or an .rk representation.",
+                 "reliefkit render model.glb -o model.png --aovs model.npz",
+                 "reliefkit render demo:vehicle --turntable 24 -o spin.gif")
     p.add_argument("input", help="mesh file, .rk file or demo:NAME")
     _add_view_args(p)
     p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable)")
@@ -72,50 +77,44 @@ def build_parser() -> argparse.ArgumentParser:
     _add_relief_args(p)
     p.set_defaults(run=cmd_render)
 
-    p = sub.add_parser("bake", help="bake a mesh or heightmap into an .rk representation",
-                       description="Bake a mesh (or a heightmap) into a representation.",
-                       epilog="examples:\n  reliefkit bake model.glb --as relief --depth-res 256 "
-                              "--color-res 512 -o model.rk\n  reliefkit bake demo:vehicle --as "
-                              "relief-frustum -o van.rk\n  reliefkit bake height.png --as relief "
-                              "--box 2,0.4,2 -o terrain.rk",
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",
+                 "Bake a mesh (or a heightmap) into a representation.",
+                 "reliefkit bake model.glb --as relief --depth-res 256 --color-res 512 -o model.rk",
+                 "reliefkit bake demo:vehicle --as relief-frustum -o van.rk",
+                 "reliefkit bake height.png --as relief --box 2,0.4,2 -o terrain.rk")
     _add_bake_args(p)
     p.add_argument("-o", "--output", required=True, help="output .rk file")
     p.set_defaults(run=cmd_bake)
 
-    p = sub.add_parser("compare", help="bake, then render mesh and every method side by side",
-                       description="Bake INPUT, render the mesh and each intersection method "
-                                   "from one view; write compare.png, metrics.md, metrics.json.",
-                       epilog="examples:\n  reliefkit compare demo:terrain --as relief --out cmp"
-                              "\n  reliefkit compare car.glb --as relief-frustum --view 60,15,2"
-                              " --out cmp",
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _command(sub, "compare", "bake, then render mesh and every method side by side",
+                 "Bake INPUT, render the mesh and each intersection method from one view; "
+                 "write compare.png, metrics.md, metrics.json.",
+                 "reliefkit compare demo:terrain --as relief --out cmp",
+                 "reliefkit compare car.glb --as relief-frustum --view 60,15,2 --out cmp")
     _add_bake_args(p)
     _add_view_args(p)
     p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
     p.set_defaults(run=cmd_compare)
 
-    p = sub.add_parser("bench", help="reproduce a paper's tables (speed, iterations, errors)",
-                       description="Benchmarks measured side by side in one run.",
-                       epilog="examples:\n  reliefkit bench relief --quick\n"
-                              "  reliefkit bench relief --out docs/bench",
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",
+                 "Benchmarks measured side by side in one run.",
+                 "reliefkit bench relief --quick", "reliefkit bench relief --out docs/bench")
     p.add_argument("name", choices=("relief",), help="which benchmark")
     p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
     p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
     p.set_defaults(run=cmd_bench)
 
-    p = sub.add_parser("info", help="GL capabilities, or the contents of a mesh / .rk file",
-                       description="Print the OpenGL renderer and limits (--gl) and/or "
-                                   "summarise a mesh or .rk file.")
+    p = _command(sub, "info", "GL capabilities, or the contents of a mesh / .rk file",
+                 "Print the OpenGL renderer and limits (--gl) and/or summarise a mesh or .rk "
+                 "file.", "reliefkit info --gl", "reliefkit info --json model.rk")
     p.add_argument("file", nargs="?", help="mesh file, .rk file or demo:NAME")
     p.add_argument("--gl", action="store_true", help="print renderer, GL version and limits")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.set_defaults(run=cmd_info)
 
-    p = sub.add_parser("demo", help="render the demo assets into a titled contact sheet",
-                       description="Render every demo asset (and representation) into "
-                                   "OUT/demo.png plus one PNG per tile.")
+    p = _command(sub, "demo", "render the demo assets into a titled contact sheet",
+                 "Render every demo asset (and representation) into OUT/demo.png plus one "
+                 "PNG per tile.", "reliefkit demo --out out")
     p.add_argument("--out", default="out", help="output folder (default: %(default)s)")
     p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
     p.set_defaults(run=cmd_demo)
