@@ -6,19 +6,26 @@
 """
 
 from . import metrics
-from .bake import bake_relief, bake_relief_cube, bake_relief_frustum, relief_from_heights
+from .bake import bake
 from .errors import FormatError, GPUError, MeshError, ReliefkitError, UsageError
-from .formats import load, save
+from .io.rk import load, save
 from .render import Frame, render
-from .represent.relief import ReliefObject, ReliefTexture
 from .scene.camera import Camera
 from .scene.light import DirectionalLight
 from .scene.loader import load_mesh
 from .scene.mesh import RenderMesh
+from .techniques.relief import (
+    ReliefObject,
+    ReliefTexture,
+    bake_relief,
+    bake_relief_cube,
+    bake_relief_frustum,
+    relief_from_heights,
+)
 
 __all__ = [
     "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
-    "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
+    "bake", "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
     "relief_from_heights", "ReliefTexture", "ReliefObject",
     "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
 ]

@@ -14,22 +14,44 @@ from pathlib import Path
 from .errors import ReliefkitError, UsageError
 from .scene.views import DEFAULT_SIZE, DEFAULT_VIEW
 
-EXAMPLES = """\
-examples:
-  reliefkit demo --out out                          contact sheet of every demo asset
-  reliefkit render bunny.ply -o bunny.png           one view (default --view 30,25,2.6)
-  reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs side.npz
-  reliefkit render demo:tree --turntable 36 -o spin.gif
-  reliefkit bake demo:terrain --as relief --depth-res 256 -o terrain.rk
-  reliefkit render terrain.rk --method robust --shadows -o terrain.png
-  reliefkit compare demo:vehicle --as relief-frustum --out cmp
-  reliefkit info --gl                               the OpenGL renderer and its limits
-  reliefkit info model.obj                          counts and bounds of a mesh (or an .rk)
+CORE_EXAMPLES = {
+    "demo": ["reliefkit demo --out out                          contact sheet of every demo"],
+    "render": ["reliefkit render bunny.ply -o bunny.png           one view (default --view "
+               "30,25,2.6)",
+               "reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs "
+               "side.npz",
+               "reliefkit render demo:tree --turntable 36 -o spin.gif"],
+    "info": ["reliefkit info --gl                               the OpenGL renderer and its "
+             "limits",
+             "reliefkit info model.obj                          counts and bounds of a mesh "
+             "(or an .rk)"],
+}
+ORDER = ("demo", "render", "bake", "compare", "bench", "info")
 
-inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME
-(demo assets: terrain, blob, tree, vehicle), or for `bake --as relief` a heightmap
-(8/16-bit greyscale .png or a 2D .npy array).
-"""
+
+def _examples(command: str | None = None) -> list[str]:
+    """Example lines: the core's and every technique's, for one command or all in order."""
+    from .core.technique import techniques
+
+    table = {name: list(lines) for name, lines in CORE_EXAMPLES.items()}
+    for tech in techniques():
+        for name, lines in tech.examples.items():
+            table.setdefault(name, []).extend(lines)
+    names = [command] if command else [n for n in ORDER if n in table]
+    return [line for name in names for line in table.get(name, [])]
+
+
+def _epilog() -> str:
+    from .core.technique import bakers
+
+    heightmap_kinds = [name for name, (_, b) in bakers().items() if "heightmap" in b.sources]
+    lines = ["examples:", *(f"  {line}" for line in _examples()), "",
+             "inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME",
+             "(demo assets: terrain, blob, tree, vehicle)"]
+    if heightmap_kinds:
+        lines[-1] += (f", or for `bake --as {'/'.join(heightmap_kinds)}` a heightmap")
+        lines.append("(8/16-bit greyscale .png or a 2D .npy array)")
+    return "\n".join(lines) + ".\n"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -49,64 +71,67 @@ def _add_view_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fov", type=float, default=40.0, help="vertical field of view in degrees")
 
 
-def _command(sub, name: str, summary: str, description: str, *examples: str):
+def _command(sub, name: str, summary: str, description: str):
     """A subcommand parser whose --help ends with its examples."""
-    epilog = "examples:\n" + "\n".join(f"  {line}" for line in examples)
+    epilog = "examples:\n" + "\n".join(f"  {line}" for line in _examples(name))
     return sub.add_parser(name, help=summary, description=description, epilog=epilog,
                           formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .bench import suite_names
+    from .core.technique import bakers, bench_suites, techniques
+
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
-                     epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+                     epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    table = bakers()
 
     p = _command(sub, "render", "render a mesh or an .rk representation to PNG / GIF",
-                 "Render a mesh (ground truth) or an .rk representation.",
-                 "reliefkit render model.glb -o model.png --aovs model.npz",
-                 "reliefkit render demo:vehicle --turntable 24 -o spin.gif")
+                 "Render a mesh (ground truth) or an .rk representation.")
     p.add_argument("input", help="mesh file, .rk file or demo:NAME")
     _add_view_args(p)
     p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable)")
     p.add_argument("--aovs", metavar="OUT.npz",
                    help="also write color, mask, depth, position, normal, view, proj, viewport")
+    p.add_argument("--stats", metavar="OUT.json",
+                   help="also write the frame's counters: covered pixels, fragments and loop "
+                        "iterations per pixel (mean, max) where the renderer counts them")
     p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
     p.add_argument("--background", default="transparent",
                    help="'transparent' or a grey level 0..1 to composite over")
-    _add_relief_args(p)
+    _add_options(p, [(t.name, spec.option_list) for t in techniques() for spec in t.drawables],
+                 "render options")
     p.set_defaults(run=cmd_render)
 
     p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",
-                 "Bake a mesh (or a heightmap) into a representation.",
-                 "reliefkit bake model.glb --as relief --depth-res 256 --color-res 512 -o model.rk",
-                 "reliefkit bake demo:vehicle --as relief-frustum -o van.rk",
-                 "reliefkit bake height.png --as relief --box 2,0.4,2 -o terrain.rk")
-    _add_bake_args(p)
+                 "Bake a mesh (or a heightmap) into a representation. Representations: "
+                 + "; ".join(f"{name}: {b.summary}" for name, (_, b) in table.items()) + ".")
+    _add_bake_args(p, table)
     p.add_argument("-o", "--output", required=True, help="output .rk file")
     p.set_defaults(run=cmd_bake)
 
-    p = _command(sub, "compare", "bake, then render mesh and every method side by side",
-                 "Bake INPUT, render the mesh and each intersection method from one view; "
-                 "write compare.png, metrics.md, metrics.json.",
-                 "reliefkit compare demo:terrain --as relief --out cmp",
-                 "reliefkit compare car.glb --as relief-frustum --view 60,15,2 --out cmp")
-    _add_bake_args(p)
+    p = _command(sub, "compare", "bake, then render the mesh and every variant side by side",
+                 "Bake INPUT, render the mesh and each variant of the representation (its "
+                 "methods or modes) from one view; write compare.png, metrics.md, metrics.json.")
+    _add_bake_args(p, table)
     _add_view_args(p)
     p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
     p.set_defaults(run=cmd_compare)
 
+    names = suite_names()
     p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",
-                 "Benchmarks measured side by side in one run.",
-                 "reliefkit bench relief --quick", "reliefkit bench relief --out docs/bench")
-    p.add_argument("name", choices=("relief",), help="which benchmark")
+                 "Benchmarks measured side by side in one run: "
+                 + "; ".join(f"{n}: {s.summary}" for n, (_, s) in bench_suites().items()) + ".")
+    p.add_argument("name", choices=names, help="which benchmark")
     p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
     p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
     p.set_defaults(run=cmd_bench)
 
     p = _command(sub, "info", "GL capabilities, or the contents of a mesh / .rk file",
                  "Print the OpenGL renderer and limits (--gl) and/or summarise a mesh or .rk "
-                 "file.", "reliefkit info --gl", "reliefkit info --json model.rk")
+                 "file.")
     p.add_argument("file", nargs="?", help="mesh file, .rk file or demo:NAME")
     p.add_argument("--gl", action="store_true", help="print renderer, GL version and limits")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
@@ -114,87 +139,106 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = _command(sub, "demo", "render the demo assets into a titled contact sheet",
                  "Render every demo asset (and representation) into OUT/demo.png plus one "
-                 "PNG per tile.", "reliefkit demo --out out")
+                 "PNG per tile.")
     p.add_argument("--out", default="out", help="output folder (default: %(default)s)")
     p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
     p.set_defaults(run=cmd_demo)
     return parser
 
 
-def _add_relief_args(p: argparse.ArgumentParser) -> None:
-    g = p.add_argument_group("relief textures")
-    g.add_argument("--method", default="robust", choices=("binary", "exact", "robust"),
-                   help="ray/heightfield intersection (default: %(default)s)")
-    g.add_argument("--depth-mode", default="conservative", choices=("conservative", "exact"),
-                   help="keep the box depth, or write the hit's depth (default: %(default)s)")
-    g.add_argument("--shadows", action="store_true", help="self-shadowing (a ray to the light)")
-    g.add_argument("--zero-radius", default="exact", choices=("exact", "clamp"),
-                   help="robust method at zero safety radius (default: %(default)s)")
-    g.add_argument("--cell-test", default="quadratic", choices=("quadratic", "linear"),
-                   help="exact/robust: test each cell's exact quadratic, or assume heights "
-                        "linear between centrelines as the paper does (default: %(default)s)")
-    g.add_argument("--linear-steps", type=int, default=16, help="binary: fixed pre-steps")
-    g.add_argument("--binary-steps", type=int, default=8, help="binary search steps")
+OPTION_PREFIX = "opt_"  # argparse dest of a declared option (kept apart from the command's own)
 
 
-def _relief_options(args, obj) -> dict:
-    from .represent.relief import ReliefObject, ReliefTexture
+def _add_options(p: argparse.ArgumentParser, owners: list[tuple[str, tuple]], title: str):
+    """One flag per declared option name, whoever declares it; defaults stay the owners'.
 
-    if not isinstance(obj, ReliefTexture | ReliefObject):
-        return {}
-    return {"method": args.method, "depth_mode": args.depth_mode, "shadows": args.shadows,
-            "zero_radius": args.zero_radius, "cell_test": args.cell_test,
-            "linear_steps": args.linear_steps,
-            "binary_steps": args.binary_steps}
+    The flag's value is checked later by the declaration of whatever the input turns out to
+    be, so two techniques may both declare ``method`` with different choices.
+    """
+    by_name: dict[str, list] = {}
+    for owner, options in owners:
+        for opt in options:
+            by_name.setdefault(opt.name, []).append((owner, opt))
+    group = p.add_argument_group(title)
+    for name, decls in by_name.items():
+        first = decls[0][1]
+        flag = "--" + first.flag
+        if all(opt.kind == "bool" for _, opt in decls):
+            group.add_argument(flag, dest=OPTION_PREFIX + name, default=None,
+                               action=argparse.BooleanOptionalAction, help=_option_help(decls))
+            continue
+        metavar = "|".join(map(str, first.choices)) if first.choices else (
+            ",".join(["X"] * (first.count or 2)) if first.kind == "floats" else first.kind.upper())
+        group.add_argument(flag, dest=OPTION_PREFIX + name, default=None, metavar=metavar,
+                           help=_option_help(decls))
 
 
-def _add_bake_args(p: argparse.ArgumentParser) -> None:
+def _option_help(decls: list) -> str:
+    """One help text for an option that several owners declare: owners sharing a text or a
+    default are listed together."""
+    from .core.params import describe_default
+
+    texts: dict[str, list[str]] = {}
+    defaults: dict[str, list[str]] = {}
+    for owner, opt in decls:
+        texts.setdefault(opt.help, []).append(owner)
+        defaults.setdefault(describe_default(opt), []).append(owner)
+    single = len(texts) == 1
+    parts = [text if single else f"{', '.join(owners)}: {text}" for text, owners in texts.items()]
+    owners_all = ", ".join(dict.fromkeys(o for o, _ in decls))
+    if len(defaults) == 1:
+        tail = f"default {next(iter(defaults))}"
+    else:
+        tail = "default " + ", ".join(f"{d} ({', '.join(o)})" for d, o in defaults.items())
+    return (f"[{owners_all}] " if single else "") + "; ".join(parts).replace("%", "%%") + \
+        f"; {tail}"
+
+
+def _given_options(args) -> dict:
+    """The declared options the user gave (the rest keep their declared defaults)."""
+    return {key[len(OPTION_PREFIX):]: value for key, value in vars(args).items()
+            if key.startswith(OPTION_PREFIX) and value is not None}
+
+
+def _applicable(given: dict, options, what: str) -> dict:
+    """``given`` restricted to ``options``; a flag that does not apply is an error."""
+    names = {opt.name for opt in options}
+    wrong = [k for k in given if k not in names]
+    if wrong:
+        flags = ", ".join("--" + k.replace("_", "-") for k in wrong)
+        has = ", ".join("--" + opt.flag for opt in options) or "none"
+        raise UsageError(f"{flags} does not apply to {what} (its options: {has})")
+    return given
+
+
+def _add_bake_args(p: argparse.ArgumentParser, table: dict) -> None:
     p.add_argument("input", help="mesh file, demo:NAME, or a heightmap (.png/.npy)")
-    p.add_argument("--as", dest="kind", default="relief",
-                   choices=("relief", "relief-frustum", "relief-cube"),
+    kinds = tuple(table)
+    p.add_argument("--as", dest="kind", default=kinds[0] if kinds else None, choices=kinds,
                    help="representation to bake (default: %(default)s)")
-    p.add_argument("--depth-res", type=int, help="heightfield resolution (longest side)")
-    p.add_argument("--color-res", type=int, help="colour/normal resolution (default: depth)")
-    p.add_argument("--safety-tolerance", type=float, default=0.01, metavar="E",
-                   help="ignored dip depth (height units, Fig. 12): larger radii and fewer "
-                        "iterations for a bounded silhouette error (default: %(default)s)")
-    p.add_argument("--no-safety", action="store_true", help="skip the safety radii")
-    p.add_argument("--axis", default="y", help="projection axis: x, y, z, -x, -y, -z")
-    p.add_argument("--spread", type=float, default=30.0,
-                   help="relief-frustum: side tilt in degrees (default: %(default)s)")
-    p.add_argument("--box", default="2,0.5,2", metavar="SX,SY,SZ",
-                   help="heightmaps: world size of the box (default: %(default)s)")
+    _add_options(p, [(name, b.options) for name, (_, b) in table.items()], "bake options")
 
 
 def _bake_input(args):
     from .bake import bake
+    from .core.technique import baker
     from .progress import progress_bar
     from .scene.heightmap import is_heightmap, load_heightmap
 
-    if args.safety_tolerance < 0 or args.safety_tolerance > 1:
-        raise UsageError("--safety-tolerance must be within [0, 1]")
-    extra = {}
+    _, chosen = baker(args.kind)
+    params = _applicable(_given_options(args), chosen.options, f"--as {args.kind}")
     if is_heightmap(args.input):
         source = load_heightmap(args.input)
-        try:
-            extra["size"] = tuple(float(x) for x in args.box.split(","))
-            assert len(extra["size"]) == 3 and min(extra["size"]) > 0
-        except (ValueError, AssertionError):
-            raise UsageError(f"--box must be three positive sizes, got {args.box!r}") from None
     else:
-        from .inputs import load_input
+        from .io.inputs import load_input
 
         source = load_input(args.input)
-        if args.kind == "relief-frustum":
-            extra["spread_deg"] = args.spread
-    with progress_bar("safety radii", 1, enabled=not args.no_safety) as advance:
-        return bake(source, args.kind, depth_res=args.depth_res, color_res=args.color_res,
-                    tolerance=args.safety_tolerance, safety=not args.no_safety,
-                    axis=args.axis, progress=advance, **extra)
+    with progress_bar(f"baking {args.kind}", 1) as advance:
+        return bake(source, args.kind, progress=advance, **params)
 
 
 def cmd_bake(args) -> int:
-    from .formats import file_sha256, save
+    from .io.rk import file_sha256, save
 
     if Path(args.output).suffix.lower() != ".rk":
         raise UsageError(f"output must be an .rk file, got {args.output}")
@@ -222,9 +266,9 @@ def _background(text: str):
 
 
 def cmd_render(args) -> int:
-    from .inputs import load_input
+    from .io.inputs import load_input
     from .pictures import save_gif
-    from .render import render
+    from .render import render, render_options
     from .scene.views import orbit_bounds, parse_size, parse_view, turntable
 
     az, el, dist = parse_view(args.view)
@@ -235,8 +279,11 @@ def cmd_render(args) -> int:
         raise UsageError("--turntable writes an animated .gif: name the output *.gif")
     if args.turntable is None and suffix != ".png":
         raise UsageError(f"output must be a .png file, got {args.output}")
+    if args.stats and Path(args.stats).suffix.lower() != ".json":
+        raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
     obj = load_input(args.input)
-    options = _relief_options(args, obj)
+    options = _applicable(_given_options(args), render_options(obj),
+                          f"a {type(obj).__name__} ({args.input})")
     if args.turntable is not None:
         from .progress import progress_bar
 
@@ -250,18 +297,32 @@ def cmd_render(args) -> int:
         save_gif(frames, args.output)
         print(f"wrote {args.output} ({len(frames)} views)")
         return 0
-    frame = render(obj, orbit_bounds(obj.bounds, az, el, dist, size, args.fov), **options)
+    camera = orbit_bounds(obj.bounds, az, el, dist, size, args.fov)
+    frame = render(obj, camera, **options)
     frame.save(args.output, background)
-    print(f"wrote {args.output} ({size[0]}x{size[1]}, {int(frame.mask.sum())} pixels covered)")
+    print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
     if args.aovs:
         frame.save_aovs(args.aovs)
         print(f"wrote {args.aovs}")
+    if args.stats:
+        _write_stats(args, frame, render(obj, camera, count_iterations=True, **options))
     return 0
 
 
+def _write_stats(args, frame, counted) -> None:
+    """The plain frame's counters plus the instrumented pass's (fragments, iterations)."""
+    from .io.atomic import atomic_path
+
+    stats = {"input": args.input, "size": list(frame.size), "view": args.view,
+             **counted.stats, **frame.stats}
+    with atomic_path(args.stats) as tmp:
+        tmp.write_text(json.dumps(stats, indent=2) + "\n")
+    print(f"wrote {args.stats}")
+
+
 def cmd_compare(args) -> int:
-    from .compare import compare_relief, metrics_markdown, write_comparison
-    from .inputs import load_input
+    from .compare import compare, metrics_markdown, write_comparison
+    from .io.inputs import load_input
     from .scene.views import orbit_bounds, parse_size, parse_view
 
     az, el, dist = parse_view(args.view)
@@ -269,24 +330,20 @@ def cmd_compare(args) -> int:
     mesh = load_input(args.input)
     if not hasattr(mesh, "triangle_count"):
         raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not an .rk file")
-    relief = _bake_input(args)
-    result = compare_relief(mesh, relief, orbit_bounds(mesh.bounds, az, el, dist, size,
-                                                       args.fov))
+    rep = _bake_input(args)
+    result = compare(mesh, rep, orbit_bounds(mesh.bounds, az, el, dist, size, args.fov))
     title = f"{mesh.name} as {args.kind}, view {args.view}"
     paths = write_comparison(result, Path(args.out), title)
-    print(metrics_markdown(result["metrics"], title))
+    print(metrics_markdown(result, title))
     print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0
 
 
 def cmd_bench(args) -> int:
-    from .bench import relief
+    from .bench import run_suite
 
-    out = Path(args.out)
-    cfg = relief.BenchConfig.quick(out) if args.quick else relief.BenchConfig(out=out)
-    results = relief.run(cfg, log=lambda msg: print(msg, file=sys.stderr, flush=True))
-    paths = relief.write(results, out)
-    print(relief.markdown(results))
+    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out))
+    print(report)
     print("wrote " + ", ".join(map(str, paths)))
     return 0
 
@@ -301,11 +358,11 @@ def cmd_info(args) -> int:
         report["gl"] = gl_info()
     if args.file:
         if Path(args.file).suffix.lower() == ".rk":
-            from .formats import read_manifest
+            from .io.rk import read_manifest
 
             report["file"] = read_manifest(args.file)
         else:
-            from .inputs import describe, load_input
+            from .io.inputs import describe, load_input
 
             report["file"] = describe(load_input(args.file))
     if args.json:
@@ -328,7 +385,11 @@ def cmd_demo(args) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except ReliefkitError as exc:  # a technique failed to register
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
     args = parser.parse_args(argv)
     if not getattr(args, "run", None):
         parser.print_help()

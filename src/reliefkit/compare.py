@@ -1,4 +1,9 @@
-"""`reliefkit compare`: one representation against its mesh, every method side by side."""
+"""`reliefkit compare`: a representation against its mesh, every variant its technique declares.
+
+Each variant (a method, a mode) is rendered from the same camera with the instrumented
+shaders; the core scores it against the mesh (PSNR, SSIM, IoU, position error, iterations)
+and the technique adds its own metrics (such as wrong hits against an exact reference).
+"""
 
 from __future__ import annotations
 
@@ -7,57 +12,71 @@ from pathlib import Path
 
 import numpy as np
 
-from .fileio import atomic_path
+from .io.atomic import atomic_path
 
-METHODS = ("binary", "exact", "robust")
-BACKGROUND = (0.05, 0.055, 0.065)
+SHEET_BACKGROUND = (0.05, 0.055, 0.065)  # linear grey behind every tile of a picture
+CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
+                "iterations_max")
 
 
-def compare_relief(mesh, relief, camera, *, light=None) -> dict:
-    """Render ``mesh`` and ``relief`` with each method; metrics, frames and error images."""
+def compare(mesh, representation, camera, *, light=None) -> dict:
+    """Render ``mesh`` and every variant of ``representation``; metrics, frames, error masks.
+
+    Returns ``{"metrics": {variant: row}, "frames": {"mesh": Frame, variant: Frame},
+    "errors": {variant: mask or None}, "columns": table columns}``.
+    """
     from . import metrics
-    from .reference.relief import wrong_hits
+    from .core.technique import technique_of
+    from .errors import UsageError
     from .render import render
 
+    tech = technique_of(representation)
+    if tech is None or not tech.compare_variants:
+        raise UsageError(f"nothing to compare: {type(representation).__name__} declares no "
+                         "compare variants")
     truth = render(mesh, camera, light=light)
-    methods = [m for m in METHODS if m != "robust" or _has_safety(relief)]
-    results, frames, wrong_maps = {}, {"mesh": truth}, {}
-    for method in methods:
-        frame = render(relief, camera, light=light, method=method, count_iterations=True)
-        wrong = wrong_hits(frame, relief, camera)
-        scores = metrics.compare(frame, truth, scene_size=mesh.radius)
-        results[method] = {
-            "wrong_hit_fraction": wrong["wrong_fraction"], "wrong_pixels": wrong["wrong_pixels"],
-            "psnr": scores["psnr"], "ssim": scores["ssim"], "iou": scores["iou"],
-            "position_mean_rel": scores["position_mean_rel"],
-            "iterations_mean": frame.stats["iterations_mean"],
-            "iterations_max": frame.stats["iterations_max"],
-            "fragments": frame.stats["fragments"], "covered": frame.stats["covered"],
-        }
-        frames[method] = frame
-        wrong_maps[method] = wrong["wrong"]
-    return {"metrics": results, "frames": frames, "wrong": wrong_maps}
-
-
-def _has_safety(relief) -> bool:
-    parts = getattr(relief, "parts", [relief])
-    return all(p.safety is not None for p in parts)
+    rows, frames, errors = {}, {"mesh": truth}, {}
+    for variant in tech.compare_variants:
+        if not variant.available(representation):
+            continue
+        plain = render(representation, camera, light=light, **variant.options)
+        counted = render(representation, camera, light=light, count_iterations=True,
+                         **variant.options)
+        scores = metrics.compare(plain, truth, scene_size=mesh.radius)
+        row = {key: scores[key] for key in ("psnr", "ssim", "iou", "position_mean_rel")}
+        row |= {key: counted.stats.get(key, 0) for key in
+                ("iterations_mean", "iterations_max", "fragments")}
+        row["covered"] = plain.stats["covered"]
+        error_mask = None
+        for metric in tech.compare_metrics:
+            extra, mask = metric.measure(plain, representation, camera)
+            row |= extra
+            error_mask = mask if error_mask is None or mask is None else error_mask | mask
+        rows[variant.name] = row
+        frames[variant.name] = plain
+        errors[variant.name] = error_mask
+    columns = tuple(c for m in tech.compare_metrics for c in m.columns) + CORE_COLUMNS
+    return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns}
 
 
 def comparison_sheet(result: dict, title: str):
-    """mesh | binary | exact | robust on top; below, coverage (green both, red relief only,
-    blue mesh only) and per method the colour error with wrong hits in red."""
+    """mesh and every variant on top; below, coverage against the mesh (green both, red
+    representation only, blue mesh only) and per variant the colour error, its technique's
+    error mask (wrong hits, ...) in red."""
     from . import metrics
     from .pictures import contact_sheet
 
     frames, truth = result["frames"], result["frames"]["mesh"]
-    tiles = [(name, frame.rgba8(BACKGROUND)) for name, frame in frames.items()]
-    tiles.append(("coverage vs mesh",
-                  _rgba(metrics.error_image(frames[list(result["wrong"])[-1]], truth, "mask"))))
-    for method, wrong in result["wrong"].items():
-        err = metrics.error_image(frames[method], truth, "color", scale=0.25)
-        err[wrong] = (1.0, 0.1, 0.1)
-        tiles.append((f"{method}: error, wrong hits red", _rgba(err)))
+    tiles = [(name, frame.rgba8(SHEET_BACKGROUND)) for name, frame in frames.items()]
+    last = frames[list(result["errors"])[-1]]
+    tiles.append(("coverage vs mesh", _rgba(metrics.error_image(last, truth, "mask"))))
+    for name, mask in result["errors"].items():
+        err = metrics.error_image(frames[name], truth, "color", scale=0.25)
+        caption = f"{name}: error"
+        if mask is not None:
+            err[mask] = (1.0, 0.1, 0.1)
+            caption += ", wrong in red"
+        tiles.append((caption, _rgba(err)))
     return contact_sheet(tiles, columns=len(frames), title=title)
 
 
@@ -67,14 +86,14 @@ def _rgba(rgb: np.ndarray) -> np.ndarray:
     return out
 
 
-def metrics_markdown(metrics_by_method: dict, heading: str) -> str:
-    cols = ("wrong_hit_fraction", "psnr", "ssim", "iou", "position_mean_rel",
-            "iterations_mean", "iterations_max")
-    lines = [f"### {heading}", "", "| method | " + " | ".join(cols) + " |",
+def metrics_markdown(result: dict, heading: str) -> str:
+    cols = result["columns"]
+    lines = [f"### {heading}", "", "| variant | " + " | ".join(cols) + " |",
              "|---" * (len(cols) + 1) + "|"]
-    for method, row in metrics_by_method.items():
-        cells = [f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c]) for c in cols]
-        lines.append(f"| {method} | " + " | ".join(cells) + " |")
+    for name, row in result["metrics"].items():
+        cells = [f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, ""))
+                 for c in cols]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
@@ -87,7 +106,7 @@ def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]
              "json": out_dir / "metrics.json"}
     save_image(comparison_sheet(result, title), paths["picture"])
     with atomic_path(paths["markdown"]) as tmp:
-        tmp.write_text(metrics_markdown(result["metrics"], title))
+        tmp.write_text(metrics_markdown(result, title))
     with atomic_path(paths["json"]) as tmp:
-        tmp.write_text(json.dumps({"title": title, "methods": result["metrics"]}, indent=2))
+        tmp.write_text(json.dumps({"title": title, "variants": result["metrics"]}, indent=2))
     return paths

@@ -1,33 +1,35 @@
-"""Baking: meshes and heightmaps into representations."""
+"""Baking: `bake(source, kind, **params)` through the registered bakers, and what bakers share
+(`project`: a mesh through any box; `voxelize`: a mesh into a 3D grid)."""
 
-from .frustum import bake_relief_cube, bake_relief_frustum, fit_reverse_frustum
-from .heightfield import DEFAULT_TOLERANCE, bake_relief, relief_from_heights
-
-BAKE_KINDS = ("relief", "relief-frustum", "relief-cube")
+from __future__ import annotations
 
 
-def bake(source, kind: str, *, depth_res: int | None = None, color_res: int | None = None,
-         tolerance: float = DEFAULT_TOLERANCE, safety: bool = True, axis: str = "y",
-         progress=None, **extra):
-    """Bake a RenderMesh (or a height array, for ``relief``) into the representation ``kind``."""
+def bake(source, kind: str, *, progress=None, **params):
+    """Bake a RenderMesh (or a 2D height array) into the representation ``kind``.
+
+    ``params`` are the baker's typed parameters (``reliefkit bake --help`` lists them per
+    kind); an unknown or invalid one is a UsageError.
+    """
     import numpy as np
 
+    from ..core import params as options
+    from ..core.technique import baker
     from ..errors import UsageError
 
-    if kind not in BAKE_KINDS:
-        raise UsageError(f"unknown representation {kind!r} (choose from {', '.join(BAKE_KINDS)})")
-    common = dict(safety=safety, tolerance=tolerance, progress=progress)
-    if isinstance(source, np.ndarray):
-        if kind != "relief":
-            raise UsageError("a heightmap can only be baked --as relief")
-        return relief_from_heights(source, **common, **extra)
-    if kind == "relief":
-        return bake_relief(source, depth_res or 256, color_res, axis, **common)
-    if kind == "relief-frustum":
-        return bake_relief_frustum(source, depth_res=depth_res or 256, color_res=color_res,
-                                   axis=axis, **common, **extra)
-    return bake_relief_cube(source, depth_res=depth_res or 128, color_res=color_res, **common)
+    tech, chosen = baker(kind)
+    source_kind = "heightmap" if isinstance(source, np.ndarray) else "mesh"
+    if source_kind not in chosen.sources:
+        raise UsageError(f"--as {kind} bakes a {' or '.join(chosen.sources)}, not a "
+                         f"{source_kind}")
+    values = options.make(chosen.params, params, f"bake --as {kind}")
+    return chosen.bake(source, values, progress)
 
 
-__all__ = ["bake", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
-           "relief_from_heights", "fit_reverse_frustum", "BAKE_KINDS"]
+def bake_kinds() -> tuple[str, ...]:
+    """The ``--as`` names of every registered baker."""
+    from ..core.technique import bakers
+
+    return tuple(bakers())
+
+
+__all__ = ["bake", "bake_kinds"]

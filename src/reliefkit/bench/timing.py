@@ -5,8 +5,8 @@ from __future__ import annotations
 from ..gl.context import bind_home_framebuffer, get_context
 from ..gl.textures import render_target
 from ..gl.timing import gpu_time_ms
-from ..render.registry import make_drawables
-from ..render.targets import FRAME_ATTACHMENTS
+from ..gl.targets import FRAME_ATTACHMENTS
+from ..render.registry import make_drawables, release_all
 from ..scene.light import DirectionalLight
 
 
@@ -32,6 +32,4 @@ def time_render(obj, camera, *, repeats: int = 3, light=None, **options) -> dict
         for attachment in (*fbo.color_attachments, fbo.depth_attachment):
             attachment.release()
         fbo.release()
-        release = getattr(drawable, "release", None)
-        if release:
-            release()
+        release_all([drawable])

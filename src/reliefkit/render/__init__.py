@@ -1,12 +1,6 @@
-"""Renderers, one per representation, found by `render(representation, camera)`."""
+"""Rendering: `render(obj, camera)` into a `Frame`; the ground-truth mesh drawable; proxies."""
 
 from .frame import Frame
-from .registry import register_renderer, render
+from .registry import make_drawables, render, render_options
 
-
-def load_renderers() -> None:
-    """Import every renderer module so each registers itself."""
-    from . import mesh, relief  # noqa: F401
-
-
-__all__ = ["Frame", "render", "register_renderer", "load_renderers"]
+__all__ = ["Frame", "render", "make_drawables", "render_options"]

@@ -7,8 +7,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..colorspace import to_rgba8
+from ..core.transforms import transform_points
 from ..errors import UsageError
-from ..fileio import atomic_path
+from ..io.atomic import atomic_path
 
 AOV_NAMES = ("color", "mask", "depth", "position", "normal", "view", "proj", "viewport")
 
@@ -23,7 +24,10 @@ class Frame:
     position : (H, W, 3) float32 world-space hit point, NaN where ``mask`` is False.
     normal : (H, W, 3) float32 world-space unit normal, 0 where ``mask`` is False.
     view, proj : 4x4 float64 camera matrices; viewport : (x, y, w, h) int32.
-    stats : renderer-specific counters (iterations per pixel, fragments, ...).
+    stats : counters: ``covered`` pixels always; ``fragments`` and ``iterations_*`` where
+        the render was instrumented (``count_iterations=True``); technique-specific ones.
+    extra : arrays that are no AOV (``iterations``: per-pixel loop counts, NaN where no
+        fragment ran).
     """
 
     color: np.ndarray
@@ -72,26 +76,44 @@ class Frame:
             np.savez(handle, **self.aovs())
 
 
-def frame_from_targets(camera, color, position, normal, depth, stats=None) -> Frame:
-    """Assemble a Frame from read-back targets (RGBA float arrays, row 0 on top).
+def frame_from_passes(camera, images) -> Frame:
+    """Assemble a Frame from read-back pass images (`reliefkit.gl.targets.PassImages`).
 
-    ``position``'s alpha channel is the coverage written by the shader (1 where drawn).
+    Opaque pixels keep their colour and AOVs; where the transparent pass drew, its
+    premultiplied colour lies over the opaque one, and the AOVs belong to the point where the
+    accumulated opacity first reached 0.5 (the transparent gate, else the opaque surface
+    behind, else NaN). Colour is returned straight (not premultiplied).
     """
-    mask = position[..., 3] > 0.5
-    pos = np.where(mask[..., None], position[..., :3], np.nan).astype(np.float32)
-    nrm = np.where(mask[..., None], normal[..., :3], 0.0).astype(np.float32)
-    col = np.where(mask[..., None], color, 0.0).astype(np.float32)
-    return Frame(color=col, mask=mask, depth=depth.astype(np.float32), position=pos, normal=nrm,
-                 view=camera.view, proj=camera.proj, viewport=camera.viewport,
-                 stats=dict(stats or {}))
+    covered = images.position[..., 3] > 0.5
+    color = np.where(covered[..., None], images.color, 0.0)
+    pos = np.where(covered[..., None], images.position[..., :3], np.nan)
+    nrm = np.where(covered[..., None], images.normal[..., :3], 0.0)
+    depth = images.depth
+    mask = covered
+    if images.transparent is not None:
+        t_color, t_pos, t_nrm = images.transparent
+        t_alpha = t_color[..., 3:4]
+        o_alpha = color[..., 3:4]
+        alpha = t_alpha + (1.0 - t_alpha) * o_alpha
+        rgb = t_color[..., :3] + (1.0 - t_alpha) * color[..., :3] * o_alpha
+        with np.errstate(divide="ignore", invalid="ignore"):
+            straight = np.where(alpha > 0, rgb / np.where(alpha > 0, alpha, 1.0), 0.0)
+        color = np.concatenate([straight, alpha], axis=-1)
+        gate = t_pos[..., 3] > 0.5
+        pos = np.where(gate[..., None], t_pos[..., :3], pos)
+        nrm = np.where(gate[..., None], t_nrm[..., :3], nrm)
+        depth = np.where(gate, window_depth(pos, camera.view, camera.proj, depth), depth)
+        mask = covered | (t_alpha[..., 0] > 0)
+        pos = np.where((covered | gate)[..., None], pos, np.nan)
+    return Frame(color=color.astype(np.float32), mask=mask, depth=depth.astype(np.float32),
+                 position=pos.astype(np.float32), normal=nrm.astype(np.float32),
+                 view=camera.view, proj=camera.proj, viewport=camera.viewport)
 
 
 def window_depth(position: np.ndarray, view: np.ndarray, proj: np.ndarray,
                  fallback: np.ndarray) -> np.ndarray:
     """Window depth of world positions (H, W, 3); ``fallback`` where position is NaN."""
     valid = np.isfinite(position).all(axis=-1)
-    p = np.where(valid[..., None], position, 0.0).astype(np.float64)
-    clip = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1) @ (proj @ view).T
-    with np.errstate(divide="ignore", invalid="ignore"):
-        depth = 0.5 * clip[..., 2] / clip[..., 3] + 0.5
+    p = np.where(valid[..., None], position, 0.0)
+    depth = 0.5 * transform_points(np.asarray(proj) @ np.asarray(view), p)[..., 2] + 0.5
     return np.where(valid, depth, fallback).astype(np.float32)

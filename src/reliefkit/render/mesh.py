@@ -9,17 +9,19 @@ from ..gl.shaders import program
 from ..gl.textures import texture2d
 from ..scene.light import DirectionalLight
 from ..scene.mesh import RenderMesh
-from .registry import register_renderer
-from .targets import camera_uniforms, set_uniforms
+from ..gl.uniforms import camera_uniforms, set_uniforms
+from .registry import register_core_drawable
 
 
 class MeshDrawable:
     """GPU buffers of a RenderMesh, drawable many times (turntables, benchmarks)."""
 
-    def __init__(self, ctx, mesh: RenderMesh):
+    def __init__(self, ctx, mesh: RenderMesh, options=None, instrument: bool = False):
         self.ctx, self.mesh = ctx, mesh
         textured = mesh.texture is not None
-        self.prog = program(ctx, "mesh.glsl", {"HAS_TEXTURE": textured})
+        self.extra_attachments = 1 if instrument else 0
+        self.prog = program(ctx, "core:mesh.glsl", {"HAS_TEXTURE": textured,
+                                                    "COUNT_ITERATIONS": instrument})
         uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2), np.float32)
         interleaved = np.hstack([mesh.positions, mesh.normals, mesh.colors, uvs]).astype(np.float32)
         self.vbo = ctx.buffer(interleaved.tobytes())
@@ -40,7 +42,6 @@ class MeshDrawable:
             set_uniforms(self.prog, {"u_texture": 0})
         self.vao.render()
 
-
     def finish(self, frame) -> None:
         frame.stats["triangles"] = frame.stats.get("triangles", 0) + self.mesh.triangle_count
 
@@ -57,4 +58,10 @@ def render_mesh(mesh: RenderMesh, camera, *, light: DirectionalLight | None = No
     return render(mesh, camera, light=light, ctx=ctx)
 
 
-register_renderer(RenderMesh, MeshDrawable)
+def _register() -> None:
+    from ..core.technique import DrawableSpec
+
+    register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable))
+
+
+_register()

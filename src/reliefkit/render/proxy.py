@@ -1,9 +1,10 @@
-"""Proxy geometry for relief textures: the box or frustum, optionally clipped (§4.1).
+"""Convex proxy geometry: the halfspaces of a (projective) box, an AABB, their intersection.
 
-A proxy is a convex polyhedron in world space with outward counter-clockwise triangles.
-The relief shader rebuilds each pixel's ray from the window position, so any convex proxy
-that contains the visible surface works: the whole box (frustum), or the frustum intersected
-with the object's bounding box, which rasterizes far fewer fragments.
+A proxy is a convex polyhedron in world space with outward counter-clockwise triangles,
+rasterized so that a fragment shader can resolve the detail inside it. Shaders that rebuild
+each pixel's ray from the window position accept any convex proxy that contains the visible
+surface: a whole box (frustum), or a box cut to the object's bounds, which rasterizes fewer
+fragments.
 """
 
 from __future__ import annotations
@@ -13,15 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
+from ..errors import UsageError
+
 
 @dataclass(frozen=True)
 class Proxy:
     positions: np.ndarray   # (V, 3) float32 world
     triangles: np.ndarray   # (F, 3) uint32, outward CCW
     planes: np.ndarray      # (P, 4) inside where planes @ (x, y, z, 1) <= 0
-
-    def contains(self, point, tolerance: float = 1e-9) -> bool:
-        return bool(np.all(self.planes @ np.append(point, 1.0) <= tolerance))
 
 
 def box_planes(world_to_box: np.ndarray) -> np.ndarray:
@@ -75,13 +75,5 @@ def _interior_point(planes: np.ndarray) -> np.ndarray:
     result = linprog(np.array([0, 0, 0, -1.0]), A_ub=np.hstack([planes[:, :3], norms[:, None]]),
                      b_ub=-planes[:, 3], bounds=[(None, None)] * 3 + [(0, None)])
     if not result.success or result.x[3] <= 0:
-        raise ValueError("the proxy's halfspaces have an empty interior")
+        raise UsageError("the proxy's halfspaces have an empty interior (a degenerate box)")
     return result.x[:3]
-
-
-def relief_proxy(world_to_box: np.ndarray, clip_bounds=None) -> Proxy:
-    """The box (frustum) of a relief texture, intersected with ``clip_bounds`` when given."""
-    planes = box_planes(world_to_box)
-    if clip_bounds is not None:
-        planes = np.vstack([planes, aabb_planes(clip_bounds)])
-    return convex_proxy(planes)

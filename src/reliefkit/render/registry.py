@@ -1,80 +1,146 @@
 """`render(obj, camera, **options)`: draws any representation (or several) into a Frame.
 
-Each renderer registers a *drawable factory* for its representation type: a callable
-``factory(ctx, obj, **options)`` returning an object with ``draw(camera, light)`` and, when
-it must adjust the read-back Frame, ``finish(frame)``. Several objects passed as a list are
-drawn into one framebuffer, so depth testing between them is real (used for the depth modes).
+Each technique declares a `DrawableSpec` per representation class (its factory and the
+dataclass of its render options); the core declares the mesh's. Several objects passed as a
+list are drawn into one framebuffer: the opaque ones first (depth test and write), then the
+transparent ones front to back (depth test against the opaque pass, no depth write, see
+`reliefkit.gl.targets`). Render options are routed by name to every drawable that declares
+one of that name and checked by that drawable's own declaration, so two techniques may both
+have a ``method`` option with different choices; an option nobody declares is an error.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+import numpy as np
 
+from ..core import params as _params
 from ..errors import UsageError
 
-
-@dataclass(frozen=True)
-class _Entry:
-    factory: Callable
-    options: frozenset
+_core_specs: list = []
 
 
-_drawables: dict[type, _Entry] = {}
+def register_core_drawable(spec) -> None:
+    """The core's own drawables (the ground-truth mesh); techniques register through theirs."""
+    if any(s.cls is spec.cls for s in _core_specs):
+        raise UsageError(f"a core drawable for {spec.cls.__name__} is already registered")
+    _core_specs.append(spec)
 
 
-def register_renderer(cls: type, factory: Callable, options=()) -> None:
-    """Draw instances of ``cls`` with ``factory(ctx, obj, **opts)``; ``options`` are the
-    keyword arguments it accepts."""
-    _drawables[cls] = _Entry(factory, frozenset(options))
+def core_drawables() -> tuple:
+    from . import mesh  # noqa: F401  (registers the ground-truth drawable)
+
+    return tuple(_core_specs)
 
 
-def _entry(obj) -> _Entry:
-    for cls in type(obj).__mro__:
-        if cls in _drawables:
-            return _drawables[cls]
-    known = ", ".join(sorted(c.__name__ for c in _drawables))
-    raise UsageError(f"no renderer for {type(obj).__name__} (known: {known})")
+def _spec_for(obj):
+    from ..core.technique import drawable_spec
+
+    tech, spec = drawable_spec(obj)
+    if spec is None:
+        from ..core.technique import techniques
+
+        known = [s.cls.__name__ for s in core_drawables()] + [
+            d.cls.__name__ for t in techniques() for d in t.drawables]
+        raise UsageError(f"no renderer for {type(obj).__name__} (known: {', '.join(known)})")
+    return (tech.name if tech else "mesh"), spec
 
 
-def make_drawables(ctx, objects, options: dict) -> list:
-    """Drawables for ``objects``, each given the options it accepts; unknown options fail."""
-    from . import load_renderers
+def render_options(obj) -> tuple:
+    """The render options ``obj``'s drawable declares (`reliefkit.core.params.Option`)."""
+    return _spec_for(obj)[1].option_list
 
-    load_renderers()
-    entries = [_entry(obj) for obj in objects]
-    unknown = set(options) - set().union(*(e.options for e in entries))
+
+def make_drawables(ctx, objects, options: dict, *, instrument: bool = False) -> list:
+    """Drawables for ``objects``, each given the options it declares; unknown options fail."""
+    found = [_spec_for(obj) for obj in objects]
+    declared = {opt.name for _, spec in found for opt in spec.option_list}
+    unknown = sorted(set(options) - declared)
     if unknown:
-        raise UsageError(f"unknown render option(s): {', '.join(sorted(unknown))}")
-    return [e.factory(ctx, obj, **{k: v for k, v in options.items() if k in e.options})
-            for e, obj in zip(entries, objects, strict=True)]
+        offered = ", ".join(sorted(declared)) or "none"
+        raise UsageError(f"unknown render option(s) {', '.join(unknown)} for "
+                         f"{', '.join(sorted({type(o).__name__ for o in objects}))} "
+                         f"(options: {offered})")
+    drawables = []
+    try:
+        for (owner, spec), obj in zip(found, objects, strict=True):
+            mine = {k: v for k, v in options.items()
+                    if k in {opt.name for opt in spec.option_list}}
+            opts = _params.make(spec.options, mine, f"{owner} render option") \
+                if spec.options is not None else None
+            drawables.append(spec.factory(ctx, obj, opts, instrument))
+    except BaseException:
+        release_all(drawables)
+        raise
+    return drawables
 
 
-def render(obj, camera, *, light=None, ctx=None, **options):
-    """Render a representation, a RenderMesh (ground truth), or a list of them, into a Frame."""
-    from ..gl.context import get_context
-    from ..scene.light import DirectionalLight
-    from .targets import draw_into_frame
-
-    ctx = ctx or get_context()
-    objects = list(obj) if isinstance(obj, list | tuple) else [obj]
-    if not objects:
-        raise UsageError("nothing to render")
-    drawables = make_drawables(ctx, objects, options)
-    light = light or DirectionalLight()
-    extra = max(getattr(d, "extra_attachments", 0) for d in drawables)
-
-    def draw_all():
-        for drawable in drawables:
-            drawable.draw(camera, light)
-
-    frame = draw_into_frame(ctx, camera, draw_all, extra_attachments=extra)
-    for drawable in drawables:
-        finish = getattr(drawable, "finish", None)
-        if finish:
-            finish(frame)
+def release_all(drawables) -> None:
     for drawable in drawables:
         release = getattr(drawable, "release", None)
         if release:
             release()
-    return frame
+
+
+def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False, **options):
+    """Render a representation, a RenderMesh (ground truth), or a list of them, into a Frame.
+
+    ``count_iterations`` draws the instrumented variants and fills ``frame.stats`` with
+    fragments and loop iterations per pixel (``frame.extra["iterations"]``).
+    """
+    from ..gl.context import get_context
+    from ..gl.targets import draw_passes
+    from ..scene.light import DirectionalLight
+    from .frame import frame_from_passes
+
+    objects = list(obj) if isinstance(obj, list | tuple) else [obj]
+    if not objects:
+        raise UsageError("nothing to render")
+    ctx = ctx or get_context()
+    light = light or DirectionalLight()
+    drawables = make_drawables(ctx, objects, options, instrument=count_iterations)
+    try:
+        opaque = [d for d in drawables if not getattr(d, "transparent", False)]
+        transparent = sorted((d for d in drawables if getattr(d, "transparent", False)),
+                             key=lambda d: _front_distance(d, camera))
+        extra = max((getattr(d, "extra_attachments", 0) for d in opaque), default=0)
+
+        def draw_opaque():
+            for drawable in opaque:
+                drawable.draw(camera, light)
+
+        images = draw_passes(ctx, camera.size, draw_opaque,
+                             [lambda d=d: d.draw(camera, light) for d in transparent],
+                             extra_attachments=extra)
+        frame = frame_from_passes(camera, images)
+        frame.stats["covered"] = int(frame.mask.sum())
+        if count_iterations and extra:
+            _iteration_stats(frame, images.extra[0])
+        for drawable in drawables:
+            finish = getattr(drawable, "finish", None)
+            if finish:
+                finish(frame)
+        return frame
+    finally:
+        release_all(drawables)
+
+
+def _front_distance(drawable, camera) -> float:
+    """Sort key of transparent drawables: distance of their nearest bound from the eye."""
+    key = getattr(drawable, "sort_distance", None)
+    return float(key(camera)) if key else 0.0
+
+
+def _iteration_stats(frame, counts: np.ndarray) -> None:
+    """Counters of shaders/include/iterations.glsl: (primary, secondary, ran, hit)."""
+    ran = counts[..., 2] > 0.5
+    covered = frame.mask
+    primary, secondary = counts[..., 0], counts[..., 1]
+    frame.stats.update({
+        "fragments": int(ran.sum()),
+        "iterations_mean": float(primary[ran].mean()) if ran.any() else 0.0,
+        "iterations_max": int(primary[ran].max()) if ran.any() else 0,
+        "iterations_mean_covered": float(primary[covered].mean()) if covered.any() else 0.0,
+        "secondary_iterations_mean": float(secondary[covered].mean()) if covered.any()
+        else 0.0,
+    })
+    frame.extra["iterations"] = np.where(ran, primary, np.nan).astype(np.float32)

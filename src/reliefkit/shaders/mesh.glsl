@@ -2,8 +2,7 @@
 //! defines: HAS_TEXTURE
 
 #if defined VERTEX_SHADER
-uniform mat4 u_view;
-uniform mat4 u_proj;
+#include "include/camera.glsl"
 in vec3 in_position;
 in vec3 in_normal;
 in vec4 in_color;
@@ -23,11 +22,10 @@ void main() {
 #endif
 
 #if defined FRAGMENT_SHADER
+#include "include/camera.glsl"
 #include "include/shading.glsl"
 #include "include/frame_outputs.glsl"
-uniform vec3 u_eye;
-uniform bool u_orthographic;
-uniform vec3 u_view_dir;      // for orthographic cameras: from the scene towards the eye
+#include "include/iterations.glsl"
 #if defined HAS_TEXTURE
 uniform sampler2D u_texture;  // sRGB texture: sampling returns linear colour
 #endif
@@ -41,9 +39,9 @@ void main() {
 #if defined HAS_TEXTURE
     base *= texture(u_texture, v_uv);
 #endif
-    vec3 to_eye = u_orthographic ? u_view_dir : normalize(u_eye - v_world);
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;  // two-sided: leaves and open meshes shade from both sides
-    write_frame(vec4(shade_phong(base.rgb, n, to_eye, 1.0), base.a), v_world, n);
+    write_frame(vec4(shade_phong(base.rgb, n, towards_eye(v_world), 1.0), base.a), v_world, n);
+    write_iterations(0, 0, true);
 }
 #endif

@@ -1,5 +1,6 @@
-// The render targets every representation writes (render/frame.py reads them back):
+// The render targets every opaque drawable writes (gl/targets.py reads them back):
 // 0: linear colour with straight alpha, 1: world position + coverage, 2: world normal.
+// Further attachments start at RK_FRAME_ATTACHMENTS (see iterations.glsl).
 layout(location = 0) out vec4 f_color;
 layout(location = 1) out vec4 f_position;
 layout(location = 2) out vec4 f_normal;

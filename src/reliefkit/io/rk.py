@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy
 
-from .errors import FormatError, ReliefkitError
-from .scene.mesh import RenderMesh
+from ..errors import FormatError, ReliefkitError
+from .atomic import atomic_path
 
 __all__ = [
     "ArraySpec", "Codec", "RkFile", "register", "unregister", "registered_kinds",
@@ -150,8 +150,10 @@ def unregister(kind: str) -> None:
         _BY_CLASS.pop(codec.cls, None)
 
 
-def registered_kinds() -> tuple[str, ...]:
-    """The kinds this process can read and write, sorted."""
+def registered_kinds(*, load: bool = True) -> tuple[str, ...]:
+    """The kinds this process can read and write, sorted (built-in ones loaded first)."""
+    if load:
+        _load_builtin_codecs()
     return tuple(sorted(_CODECS))
 
 
@@ -178,8 +180,11 @@ def _ndims(spec: ArraySpec) -> tuple[int, ...]:
 
 
 def _load_builtin_codecs() -> None:
-    """Register the representations' kinds (their module imports this one, not vice versa)."""
-    from . import codecs  # noqa: F401
+    """Register the built-in kinds: the mesh's and every registered technique's."""
+    from ..core.technique import load_all
+    from . import mesh_codec  # noqa: F401
+
+    load_all()
 
 
 def _codec_for_kind(kind) -> Codec:
@@ -316,12 +321,13 @@ def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
         _check_source_hash(source_hash)
     except FormatError as exc:
         raise FormatError(f"cannot write {path}: {exc}") from None
-    from . import __version__
+    from .. import __version__
 
     head = {"format": FORMAT_NAME, "format_version": FORMAT_VERSION, "kind": codec.kind,
             "kind_version": codec.version, "params": params, "source_hash": source_hash,
             "created_by": f"reliefkit {__version__}"}
-    _atomic_write(path, lambda fh: _write_zip(fh, head, arrays))
+    with atomic_path(path, error=FormatError) as tmp, open(tmp, "wb") as fh:
+        _write_zip(fh, head, arrays)
     return path
 
 
@@ -373,50 +379,6 @@ def _write_zip(fh, head: dict, arrays: dict[str, np.ndarray]) -> None:
                              "sha256": out.sha.hexdigest()}
         manifest = {**head, "arrays": entries}
         zf.writestr(_zipinfo(MANIFEST_NAME), json.dumps(manifest, indent=2) + "\n")
-
-
-def _atomic_write(path: Path, write: Callable) -> None:
-    """Run ``write(file)`` on a temp file next to `path`, fsync it, then rename it over."""
-    folder = path.parent
-    try:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise FormatError(f"cannot write {path}: {exc.strerror or exc}; check that the folder "
-                          "exists and is writable") from exc
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise FormatError(f"cannot write {path}: {exc.strerror or exc}; nothing was "
-                              "written") from exc
-        raise
-    _fsync_folder(folder)
-
-
-@functools.cache
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def _fsync_folder(folder: Path) -> None:
-    """Make the rename durable where the OS allows syncing a directory."""
-    if os.name != "posix":
-        return
-    with contextlib.suppress(OSError):
-        fd = os.open(folder, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
 
 
 # --------------------------------------------------------------------------- reading
@@ -710,40 +672,3 @@ def file_sha256(path) -> str:
         raise FormatError(f"{path}: cannot read ({exc.strerror or exc}); check the path") \
             from exc
     return sha.hexdigest()
-
-
-# ------------------------------------------------------------------ built-in: mesh
-
-
-def _mesh_to_arrays(mesh: RenderMesh) -> tuple[dict[str, np.ndarray], dict]:
-    arrays = {"positions": mesh.positions, "indices": mesh.indices, "normals": mesh.normals,
-              "colors": mesh.colors, "uvs": mesh.uvs, "texture": mesh.texture}
-    return arrays, {"name": mesh.name}
-
-
-def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh:
-    name = params.get("name", "mesh")
-    if not isinstance(name, str):
-        raise FormatError(f"mesh param 'name' must be a string, got {type(name).__name__}")
-    return RenderMesh(name=name, **arrays)
-
-
-def _rows(dtype: str, cols: int, **options) -> ArraySpec:
-    """Spec of an (N, cols) per-vertex or per-triangle table."""
-    return ArraySpec((dtype,), ndim=2, trailing=(cols,), **options)
-
-
-register(Codec(
-    kind="mesh",
-    cls=RenderMesh,
-    arrays={
-        "positions": _rows("float32", 3, finite=True),
-        "indices": _rows("uint32", 3),
-        "normals": _rows("float32", 3, finite=True),
-        "colors": _rows("float32", 4, finite=True),
-        "uvs": _rows("float32", 2, finite=True, required=False),
-        "texture": ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False),
-    },
-    to_arrays=_mesh_to_arrays,
-    from_arrays=_mesh_from_arrays,
-))

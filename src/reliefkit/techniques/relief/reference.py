@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..represent.relief import ReliefObject, ReliefTexture
-from .heightfield import intersect_rays, surface_height
+from .reference_heightfield import intersect_rays, surface_height
+from .representation import ReliefObject, ReliefTexture
 
 FLOOR_EPS = 1e-7
 

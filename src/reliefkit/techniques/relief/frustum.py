@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import UsageError
-from ..represent.relief import ReliefObject, ReliefTexture
-from ..scene.mesh import RenderMesh
-from .heightfield import BORDER_TEXELS, DEFAULT_TOLERANCE, axis_frame, bake_through
+from ...bake.project import axis_frame, cube_face_frames
+from ...errors import UsageError
+from ...scene.mesh import RenderMesh
+from .bake import BORDER_TEXELS, DEFAULT_TOLERANCE, bake_through
+from .representation import ReliefObject, ReliefTexture
 
 UNIT_FROM_NDC = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1]])
-CUBE_FACES = ("x", "-x", "y", "-y", "z", "-z")
 
 
 def frustum_matrix(apex, frame, tan_u: float, tan_v: float, near: float,
@@ -91,10 +91,9 @@ def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
     pad = 2.0 * (hi - lo).max() / depth_res  # bilinear ramps reach half a texel outside
     params = {"projection": "reverse-frustum", "axis": axis, "spread_deg": spread_deg,
               "depth_res": depth_res, "color_res": color_res or depth_res, "source": mesh.name}
-    if clip:
-        params["clip_bounds"] = [(lo - pad).tolist(), (hi + pad).tolist()]
+    clip_bounds = np.stack([lo - pad, hi + pad]) if clip else None
     return bake_through(mesh, frustum, size, color_size, safety=safety, tolerance=tolerance,
-                        progress=progress, params=params, ctx=ctx)
+                        progress=progress, params=params, clip_bounds=clip_bounds, ctx=ctx)
 
 
 def cube_frusta(mesh: RenderMesh, margin: float = 0.02,
@@ -103,8 +102,8 @@ def cube_frusta(mesh: RenderMesh, margin: float = 0.02,
     lo, hi = mesh.bounds
     centre = (lo + hi) / 2
     half = float((hi - lo).max()) / 2 * (1 + margin)
-    return [frustum_matrix(centre, axis_frame(face), 1.0, 1.0, near_fraction * half, half)
-            for face in CUBE_FACES]
+    return {face: frustum_matrix(centre, frame, 1.0, 1.0, near_fraction * half, half)
+            for face, frame in cube_face_frames().items()}
 
 
 def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int | None = None,
@@ -114,7 +113,7 @@ def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int |
     size = (depth_res, depth_res)
     color_size = size if color_res is None else (color_res, color_res)
     parts = []
-    for k, (face, box_to_world) in enumerate(zip(CUBE_FACES, cube_frusta(mesh), strict=True)):
+    for k, (face, box_to_world) in enumerate(cube_frusta(mesh).items()):
         params = {"projection": "cube-frustum", "face": face, "depth_res": depth_res,
                   "color_res": color_res or depth_res, "source": mesh.name}
         part_progress = None if progress is None else (

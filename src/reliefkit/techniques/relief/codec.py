@@ -1,4 +1,4 @@
-"""The .rk kinds of the representations (the ``mesh`` kind lives in formats.py).
+"""The .rk kinds of relief textures (registered through the technique record).
 
 ``relief``: one ReliefTexture, arrays named as DESIGN.md says. ``relief-object``: several
 parts (the six frusta of a cube), each part's arrays prefixed ``pK_``.
@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import FormatError
-from .formats import ArraySpec, Codec, register
-from .represent.relief import ReliefObject, ReliefTexture
+from ...errors import FormatError, UsageError
+from ...io.rk import ArraySpec, Codec
+from .representation import ReliefObject, ReliefTexture
 
 MAX_PARTS = 6
 
@@ -20,6 +20,7 @@ RELIEF_ARRAYS = {
     "normal": ArraySpec(("float32",), ndim=3, trailing=(None, 3), finite=True),
     "safety": ArraySpec(("uint8", "uint16"), ndim=2, required=False),
     "box_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
+    "clip_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False, finite=True),
 }
 
 
@@ -28,6 +29,8 @@ def _relief_arrays(relief: ReliefTexture, prefix: str = "") -> dict[str, np.ndar
               "box_to_world": relief.box_to_world}
     if relief.safety is not None:
         arrays["safety"] = relief.safety
+    if relief.clip_bounds is not None:
+        arrays["clip_bounds"] = relief.clip_bounds
     return {prefix + name: a for name, a in arrays.items()}
 
 
@@ -35,7 +38,7 @@ def _relief_from(arrays: dict, params: dict, prefix: str = "") -> ReliefTexture:
     get = {name: arrays.get(prefix + name) for name in RELIEF_ARRAYS}
     try:
         return ReliefTexture(params=dict(params), **get)
-    except Exception as exc:  # UsageError from the representation's own validation
+    except (UsageError, TypeError, ValueError) as exc:  # the representation refuses it
         raise FormatError(f"invalid relief texture: {exc}") from None
 
 
@@ -62,12 +65,13 @@ def _object_from(arrays: dict, params: dict) -> ReliefObject:
     return ReliefObject(parts=parts, params=rest)
 
 
-register(Codec(kind="relief", cls=ReliefTexture, arrays=RELIEF_ARRAYS,
+RELIEF = Codec(kind="relief", cls=ReliefTexture, arrays=RELIEF_ARRAYS,
                to_arrays=lambda r: (_relief_arrays(r), dict(r.params)),
-               from_arrays=_relief_from))
-register(Codec(
+               from_arrays=_relief_from)
+RELIEF_OBJECT = Codec(
     kind="relief-object", cls=ReliefObject,
     arrays={f"p{k}_{name}": ArraySpec(spec.dtypes, spec.ndim, required=False,
                                       finite=spec.finite, trailing=spec.trailing)
             for k in range(MAX_PARTS) for name, spec in RELIEF_ARRAYS.items()},
-    to_arrays=_object_arrays, from_arrays=_object_from))
+    to_arrays=_object_arrays, from_arrays=_object_from)
+CODECS = (RELIEF, RELIEF_OBJECT)

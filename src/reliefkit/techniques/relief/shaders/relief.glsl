@@ -1,11 +1,10 @@
 // Relief texture (Baboud & Decoret 2006): rasterize the box (or reverse frustum) and
 // intersect each pixel's ray with the heightfield in normalized box coordinates.
-//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST WRITE_DEPTH SHADOWS COUNT_ITERATIONS
+//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST WRITE_DEPTH SHADOWS
 
 #if defined VERTEX_SHADER
-uniform mat4 u_view;
-uniform mat4 u_proj;
-in vec3 in_position;   // proxy vertex in world space (render/proxy.py)
+#include "core:include/camera.glsl"
+in vec3 in_position;   // proxy vertex in world space (render.py relief_proxy)
 
 void main() {
     gl_Position = u_proj * u_view * vec4(in_position, 1.0);
@@ -13,21 +12,14 @@ void main() {
 #endif
 
 #if defined FRAGMENT_SHADER
-#include "include/relief_intersect.glsl"
-#include "include/shading.glsl"
-#include "include/frame_outputs.glsl"
-#if defined COUNT_ITERATIONS
-layout(location = 3) out vec4 f_iterations;  // (primary, shadow, 1 = fragment ran, hit)
-#endif
-uniform mat4 u_view;
-uniform mat4 u_proj;
-uniform mat4 u_inv_view_proj;
+#include "include/intersect.glsl"
+#include "core:include/camera.glsl"
+#include "core:include/raybox.glsl"
+#include "core:include/shading.glsl"
+#include "core:include/frame_outputs.glsl"
+#include "core:include/iterations.glsl"
 uniform mat4 u_world_to_box;
 uniform mat4 u_box_to_world;
-uniform vec2 u_viewport;
-uniform vec3 u_eye;
-uniform bool u_orthographic;
-uniform vec3 u_view_dir;
 uniform sampler2D u_color;    // sRGB base colour (decoded to linear by the sampler)
 uniform sampler2D u_normal;   // world-space normals
 
@@ -41,46 +33,6 @@ vec3 to_world(vec3 box) {
     return w.xyz / w.w;
 }
 
-vec3 unproject(vec2 ndc_xy, float ndc_z) {
-    vec4 w = u_inv_view_proj * vec4(ndc_xy, ndc_z, 1.0);
-    return w.xyz / w.w;
-}
-
-// Parameter interval where o + s * d lies in the unit cube (empty when s_exit < s_enter).
-vec2 unit_cube_interval(vec3 o, vec3 d) {
-    vec3 inv = 1.0 / d;
-    vec3 ta = (vec3(0.0) - o) * inv, tb = (vec3(1.0) - o) * inv;
-    vec3 lo = min(ta, tb), hi = max(ta, tb);
-    return vec2(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
-}
-
-// Clip t in [0, 1] of the homogeneous segment a + t (b - a) to one halfspace f(X) >= 0.
-void clip_linear(float fa, float fb, inout vec2 span) {
-    if (fa < 0.0 && fb < 0.0) { span = vec2(1.0, 0.0); return; }
-    if (fa >= 0.0 && fb >= 0.0) return;
-    float t = fa / (fa - fb);
-    if (fa < 0.0) span.x = max(span.x, t); else span.y = min(span.y, t);
-}
-
-// The pixel's ray from the near to the far plane, clipped to the unit cube in homogeneous
-// box coordinates (0 <= x, y, z <= w, w > 0), so a projective box_to_world needs no care
-// about its singular plane and no proxy depth is involved. Returns the clipped end points.
-bool box_segment(vec2 ndc, out vec3 p0, out vec3 p1) {
-    vec4 a = u_world_to_box * vec4(unproject(ndc, -1.0), 1.0);
-    vec4 b = u_world_to_box * vec4(unproject(ndc, 1.0), 1.0);
-    vec2 span = vec2(0.0, 1.0);
-    clip_linear(a.w, b.w, span);
-    for (int k = 0; k < 3; ++k) {
-        clip_linear(a[k], b[k], span);
-        clip_linear(a.w - a[k], b.w - b[k], span);
-    }
-    if (span.y <= span.x) return false;
-    vec4 h0 = mix(a, b, span.x), h1 = mix(a, b, span.y);
-    p0 = clamp(h0.xyz / h0.w, 0.0, 1.0);
-    p1 = clamp(h1.xyz / h1.w, 0.0, 1.0);
-    return true;
-}
-
 // World normal of the box face that box point p lies on (the side walls of the solid).
 vec3 box_face_normal(vec3 p) {
     vec3 dist = min(p, 1.0 - p);
@@ -92,11 +44,12 @@ vec3 box_face_normal(vec3 p) {
 }
 
 void main() {
-    vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
-    // the ray inside the box: s = 0 where it enters (or at the near plane), s = 1 where it
-    // leaves; a projective box_to_world maps lines to lines, so it stays a line there
+    vec2 ndc = fragment_ndc();
+    // the pixel's ray from the near to the far plane inside the box: s = 0 where it enters
+    // (or at the near plane), s = 1 where it leaves; a projective box_to_world maps lines to
+    // lines, so it stays a line there, and no proxy depth is involved
     vec3 a, b;
-    if (!box_segment(ndc, a, b)) discard;
+    if (!box_segment(u_world_to_box, unproject(ndc, -1.0), unproject(ndc, 1.0), a, b)) discard;
     vec3 d = b - a;
     if (dot(d, d) == 0.0) discard;
     float s0 = 0.0, s1 = 1.0;
@@ -109,7 +62,7 @@ void main() {
 #if defined COUNT_ITERATIONS
         // the instrumented pass keeps misses (uncovered: coverage 0) to count their work
         f_color = vec4(0.0); f_position = vec4(0.0); f_normal = vec4(0.0);
-        f_iterations = vec4(float(iters), 0.0, 1.0, 0.0);
+        write_iterations(iters, 0, false);
         return;
 #else
         discard;
@@ -120,7 +73,7 @@ void main() {
     vec4 base = texture(u_color, hit_box.xy);
     vec3 n = normalize(texture(u_normal, hit_box.xy).xyz);
     if (s_hit <= s0 && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
-    vec3 to_eye = u_orthographic ? u_view_dir : normalize(u_eye - hit);
+    vec3 to_eye = towards_eye(hit);
     if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
 
     float lit = 1.0;
@@ -144,12 +97,9 @@ void main() {
     }
 #endif
     write_frame(vec4(shade_phong(base.rgb, n, to_eye, lit), base.a), hit, n);
-#if defined COUNT_ITERATIONS
-    f_iterations = vec4(float(iters), float(shadow_iters), 1.0, 1.0);
-#endif
+    write_iterations(iters, shadow_iters, true);
 #if defined WRITE_DEPTH
-    vec4 clip = u_proj * u_view * vec4(hit, 1.0);
-    gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+    gl_FragDepth = window_depth(hit);
 #endif
 }
 #endif

@@ -70,62 +70,40 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numba
 import numpy as np
 from numba import njit, prange
 
-from ..errors import UsageError
-from ..reference.heightfield import (
-    _as_height,
-    _cell_quadratic,
-    _clip_box,
-    _crossings,
-    _first_hit_range,
-    _max_below,
-    _surface,
-    _walk_segments,
-)
+from ...errors import UsageError
+from .reference_heightfield import JIT_OPTIONS, as_height
 
 __all__ = [
     "NUMERIC_FLOOR",
-    "CHECK_FLOOR",
     "TOLERANCE_SLACK",
-    "Violation",
     "safety_radii",
-    "check_safety",
     "zero_radius_fraction",
 ]
 
 NUMERIC_FLOOR = 1e-9
 """Depths (height units) at or below this are float noise: the baker never counts them."""
 
-CHECK_FLOOR = 1e-6
-"""The checker ignores crossing pairs whose depth exceeds the tolerance by at most this.
-
-Sampling the directions and walk positions can miss dips that exist only in a vanishingly
-thin set of rays (typically grazing a crease with all but the same blocking); their depth
-is then a few 1e-7, far below what a float32 walk with hardware bilinear filtering resolves.
-"""
-
 TOLERANCE_SLACK = 0.01
 """The baker uses ``tolerance * (1 - TOLERANCE_SLACK)`` so that dips whose depth crosses the
 tolerance between two sampled directions or walk positions are still counted."""
 
-_JIT = {"cache": True, "error_model": "numpy", "nogil": True}
 _NEG_INF = -np.inf
 
 
 # ---------------------------------------------------------------------------------------------
 # small numeric helpers
 # ---------------------------------------------------------------------------------------------
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _qv(a, b, c, u):
     return (a * u + b) * u + c
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _root_between(a, b, c, lo, hi):
     """Root of ``a u^2 + b u + c`` on ``[lo, hi]`` where its sign differs at the two ends."""
     flo = _qv(a, b, c, lo) > 0.0
@@ -155,7 +133,7 @@ def _root_between(a, b, c, lo, hi):
     return 0.5 * (lo + hi)
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _first_positive(a, b, c, lo, hi):
     """Smallest ``u`` in ``[lo, hi]`` where ``a u^2 + b u + c > 0`` (``inf`` if none)."""
     if _qv(a, b, c, lo) > 0.0:
@@ -174,7 +152,7 @@ def _first_positive(a, b, c, lo, hi):
 # ---------------------------------------------------------------------------------------------
 # the profile of one projected line
 # ---------------------------------------------------------------------------------------------
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _line_range(hh, ww, m, yc):
     """x-range of the line ``y = yc + m x`` inside the rectangle ``[0, W] x [0, H]``."""
     if m == 0.0:
@@ -184,7 +162,7 @@ def _line_range(hh, ww, m, yc):
     return max(0.0, -yc / m), min(float(ww), (hh - yc) / m)
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _line_pieces(height, m, yc, xlo, xstop, work):
     """Split the profile ``f(x) = S(x, yc + m x)`` on ``[xlo, xstop]`` into quadratic pieces.
 
@@ -242,7 +220,7 @@ def _line_pieces(height, m, yc, xlo, xstop, work):
 # ---------------------------------------------------------------------------------------------
 # upper convex hull of the profile behind P
 # ---------------------------------------------------------------------------------------------
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _hull_push(work, nh, x, z):
     """Append a point (increasing x) to the upper hull kept as a stack in ``work[4]`` (x) and
     ``work[5]`` (z); returns the new size."""
@@ -262,7 +240,7 @@ def _hull_push(work, nh, x, z):
     return nh + 1
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _tangent_vertex(work, nh, a, z):
     """Hull vertex minimising the slope from it to ``(a, z)`` (``a`` right of the hull)."""
     lo = 0
@@ -285,7 +263,7 @@ _ZERO = 1e-13  # |value| below which a quadratic is "on" its threshold (decided 
 _ZERO_SLOPE = 1e-11  # |slope| below which the curvature decides
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _first_rise(a, b, c, lo, hi):
     """First ``u`` in ``[lo, hi]`` where ``a u^2 + b u + c`` becomes strictly positive.
 
@@ -308,7 +286,7 @@ def _first_rise(a, b, c, lo, hi):
     return np.inf
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _phi(u, x0, c0, c1, c2, xt, zt, eps):
     """Slope of the ray from hull vertex ``(xt, zt)`` through ``(x0 + u, f - eps)``."""
     w = x0 + u - xt
@@ -317,7 +295,7 @@ def _phi(u, x0, c0, c1, c2, xt, zt, eps):
     return (_qv(c2, c1, c0, u) - eps - zt) / w
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _vertex_at(u, x0, c0, c1, c2, work, nh, eps):
     """Tangent vertex of the ray through ``(x0 + u, f - eps)``, with the limit at ``P``."""
     a = x0 + u
@@ -329,7 +307,7 @@ def _vertex_at(u, x0, c0, c1, c2, work, nh, eps):
     return _tangent_vertex(work, nh, a, _qv(c2, c1, c0, u) - eps)
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _next_switch(u, length, t, came_from, x0, c0, c1, c2, work, nh, eps):
     """Where the tangent vertex ``t`` stops being optimal in ``[u, length]``, and the next one.
 
@@ -357,7 +335,7 @@ def _next_switch(u, length, t, came_from, x0, c0, c1, c2, work, nh, eps):
     return us, tn
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _scan(work, npieces, kp, xlimit, nh, eps, floor):
     """First violation ``b*`` (absolute x) after the walk position at piece ``kp``.
 
@@ -467,7 +445,7 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor):
 # ---------------------------------------------------------------------------------------------
 # one direction (all parallel lines of one slope, in one of the eight octant frames)
 # ---------------------------------------------------------------------------------------------
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _radius_from(dist, margin):
     """Largest radius ``n`` with ``n < dist - margin`` (the first violation is at ``dist``).
 
@@ -480,7 +458,7 @@ def _radius_from(dist, margin):
     return int(math.ceil(dist - margin)) - 1
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _to_original(ip, jp, wp, hp, transpose, flipx, flipy):
     i2 = wp - 1 - ip if flipx else ip
     j2 = hp - 1 - jp if flipy else jp
@@ -489,7 +467,7 @@ def _to_original(ip, jp, wp, hp, transpose, flipx, flipy):
     return j2, i2
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _current_bound(bufs, r, c):
     best = bufs[0, r, c]
     for b in range(1, bufs.shape[0]):
@@ -497,7 +475,7 @@ def _current_bound(bufs, r, c):
     return best
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _rows_of(y0, hp):
     """Rows whose texel contains the centerline point at height ``y0`` (two on a border)."""
     j = min(max(int(math.floor(y0)), 0), hp - 1)
@@ -507,7 +485,7 @@ def _rows_of(y0, hp):
     return j, j2
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose, flipx, flipy,
                 work, only_first):
     """Scan every walk position of one sample line (only the first when ``only_first``)."""
@@ -582,7 +560,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
                 bufs[tid, r2, c2] = n
 
 
-@njit(parallel=True, **_JIT)
+@njit(parallel=True, **JIT_OPTIONS)
 def _sweep_direction(height, m, offsets, eps, floor, margin, bufs, transpose, flipx, flipy):
     """All sample lines of slope ``m`` in one octant frame, in parallel.
 
@@ -644,8 +622,8 @@ def _coarse_to_fine(count: int) -> list[int]:
     return order
 
 
-def _checked_height(height) -> np.ndarray:
-    h = _as_height(height)
+def checked_height(height) -> np.ndarray:
+    h = as_height(height)
     if h.min() < 0.0 or h.max() > 1.0:
         raise UsageError(f"height must be within [0, 1] (box units), got values in "
                          f"[{h.min():.4g}, {h.max():.4g}]; normalise the heightfield first")
@@ -694,7 +672,7 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     The walk positions are processed by numba in parallel (all sample lines of one direction
     at a time); the cost grows with the texel count, the number of samples and the radii.
     """
-    h = _checked_height(height)
+    h = checked_height(height)
     if not 0.0 <= float(tolerance) < np.inf:
         raise UsageError(f"tolerance must be a finite number >= 0, got {tolerance!r}")
     if not 0 <= int(max_radius) <= 65535:
@@ -732,309 +710,3 @@ def zero_radius_fraction(safety) -> float:
     if s.size == 0:
         raise UsageError("safety is empty")
     return float(np.count_nonzero(s == 0)) / s.size
-
-
-# ---------------------------------------------------------------------------------------------
-# public API: brute-force checker
-# ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Violation:
-    """A ray for which a safety radius does not hold.
-
-    Attributes
-    ----------
-    row, col : int
-        Texel of the walk position ``P`` (``safety[row, col]`` is the radius used).
-    radius : int
-        The radius that was checked.
-    major : str
-        ``"x"`` or ``"y"``: which centerlines the walk position lies on.
-    origin, direction : tuple of float
-        The ray in box coordinates; ``t = 0`` is ``P`` and ``t = radius`` the jump target.
-    crossings : tuple of float
-        Crossing parameters strictly between ``P`` and the target.
-    depth : float
-        Largest depth below the surface between a down and the next up crossing.
-    """
-
-    row: int
-    col: int
-    radius: int
-    major: str
-    origin: tuple
-    direction: tuple
-    crossings: tuple
-    depth: float
-
-
-@njit(**_JIT)
-def _xy_range(o, d):
-    """Parameter range of the ray's projection inside the unit square (z ignored)."""
-    return _clip_box(o, d, -np.inf, np.inf, 2)
-
-
-@njit(**_JIT)
-def _lowest_clear_height(height, o, d, t0, t1):
-    """Smallest ``o[2]`` keeping the ray on or above the surface on ``[t0, t1]`` (xy only)."""
-    hh, ww = height.shape
-    oz = o.copy()
-    oz[2] = 0.0
-    ts, cxs, cys, n = _walk_segments(hh, ww, oz, d, t0, t1)
-    best = _surface(height, (o[0] + t1 * d[0]) * ww, (o[1] + t1 * d[1]) * hh) - t1 * d[2]
-    for k in range(n):
-        ta = ts[k]
-        length = ts[k + 1] - ta
-        a, b, c = _cell_quadratic(height, oz, d, cxs[k], cys[k], ta)
-        best = max(best, -c, -((a * length + b) * length + c))
-        if a != 0.0:
-            sc = -b / (2.0 * a)
-            if 0.0 < sc < length:
-                best = max(best, -((a * sc + b) * sc + c))
-    return best
-
-
-@njit(**_JIT)
-def _check_one(height, o, d, radius, tol):
-    """(status, depth, crossings) of one ray: status 0 ok, 1 blocked/irrelevant, 2 violation."""
-    t_in, t_out = _clip_box(o, d, -np.inf, np.inf)
-    empty = np.empty(0)
-    if t_in > t_out or radius <= 0:
-        return 1, 0.0, empty
-    if t_in <= 0.0 and _first_hit_range(height, o, d, t_in, min(0.0, t_out)) <= 0.0:
-        return 1, 0.0, empty
-    cr = _crossings(height, o, d, 0.0, float(radius))
-    start = max(t_in, 0.0)
-    # state at the start of the checked range
-    x = (o[0] + start * d[0]) * height.shape[1]
-    y = (o[1] + start * d[1]) * height.shape[0]
-    below = o[2] + start * d[2] <= _surface(height, x, y)
-    down = start if below else -1.0
-    worst = 0.0
-    status = 0
-    for c in cr:
-        if not below:
-            down = c
-            below = True
-        else:
-            below = False
-            if down > 0.0 and c < radius:
-                depth = _max_below(height, o, d, down, c)
-                if depth > tol + CHECK_FLOOR and depth > worst:
-                    worst = depth
-                    status = 2
-    return status, worst, cr
-
-
-@njit(**_JIT)
-def _profile(height, px, py, ddx, ddy, s0, s1, step):
-    """Samples ``(s, S(P + s (ddx, ddy)))`` on ``[s0, s1]`` with about ``step`` spacing."""
-    n = max(2, int(math.ceil((s1 - s0) / step)) + 1)
-    ss = np.empty(n)
-    ff = np.empty(n)
-    for q in range(n):
-        sv = s0 + (s1 - s0) * q / (n - 1)
-        ss[q] = sv
-        ff[q] = _surface(height, px + sv * ddx, py + sv * ddy)
-    return ss, ff
-
-
-@njit(**_JIT)
-def _tangent_candidate(height, px, py, ddx, ddy, radius, tol, delta):
-    """Brute-force extremal ray of Fig. 8 on a densely sampled profile.
-
-    For every sampled point ``a`` after ``P`` the steepest ray through ``(a, f(a) - tol -
-    delta)`` clearing the sampled profile behind ``P`` is built; the one that rises above the
-    profile again first (before the jump target) is returned as ``(found, k, z_at_P)``.
-    """
-    hh, ww = height.shape
-    # parameter range of the line inside the texture rectangle
-    s_lo = -np.inf
-    s_hi = np.inf
-    for p0, dp, n in ((px, ddx, ww), (py, ddy, hh)):
-        if dp != 0.0:
-            ta = (0.0 - p0) / dp
-            tb = (n - p0) / dp
-            s_lo = max(s_lo, min(ta, tb))
-            s_hi = min(s_hi, max(ta, tb))
-    s_end = min(float(radius), s_hi)
-    if not s_end > 0.0 or s_lo > 0.0:
-        return False, 0.0, 0.0
-    bs, bf = _profile(height, px, py, ddx, ddy, s_lo, 0.0, 0.125)
-    hull = np.empty((6, bs.shape[0]))
-    nh = 0
-    for q in range(bs.shape[0]):
-        nh = _hull_push(hull, nh, bs[q], bf[q])
-    fs, ff = _profile(height, px, py, ddx, ddy, 0.0, s_end, max(1.0 / 16.0, s_end / 512.0))
-    best_b = np.inf
-    best_k = 0.0
-    best_z = 0.0
-    for q in range(1, fs.shape[0]):
-        za = ff[q] - tol - delta
-        t = _tangent_vertex(hull, nh, fs[q], za)
-        k = (za - hull[5, t]) / (fs[q] - hull[4, t])
-        for r in range(q + 1, fs.shape[0]):
-            if fs[r] >= best_b:
-                break
-            if za + k * (fs[r] - fs[q]) > ff[r]:
-                best_b = fs[r]
-                best_k = k
-                best_z = za - k * fs[q]
-                break
-    if best_b == np.inf:
-        return False, 0.0, 0.0
-    return True, best_k, best_z
-
-
-@njit(**_JIT)
-def _check_one_ray(height, radius, j, i, major, sign, off, slope, kz, lift, mode, tol, o, d):
-    """Build one checker ray (see :func:`check_safety`) into ``o, d``; returns its status
-    (0 fine, 1 blocked or not generated, 2 violation) and the violating depth."""
-    hh, ww = height.shape
-    if major == 0:
-        px = i + 0.5
-        py = j + off
-        ddx = sign
-        ddy = sign * slope
-    else:
-        px = i + off
-        py = j + 0.5
-        ddx = sign * slope
-        ddy = sign
-    o[0] = px / ww
-    o[1] = py / hh
-    d[0] = ddx / ww
-    d[1] = ddy / hh
-    d[2] = kz
-    if mode == 0:
-        # plain ray at a random height above P
-        o[2] = _surface(height, px, py) + lift
-    else:
-        o[2] = -np.inf
-        if mode == 2:
-            found, k, z = _tangent_candidate(height, px, py, ddx, ddy, radius, tol, lift)
-            if not found:
-                return 1, 0.0
-            d[2] = k
-            o[2] = z
-        # never below the lowest ray that clears the surface up to P (extremal ray)
-        t0, _ = _xy_range(o, d)
-        low = _lowest_clear_height(height, o, d, t0, 0.0)
-        if o[2] <= low:
-            o[2] = low + (lift if mode == 1 else 1e-12 + 1e-12 * abs(low))
-    s, dep, _ = _check_one(height, o, d, radius, tol)
-    return s, dep
-
-
-@njit(parallel=True, **_JIT)
-def _check_batch(height, safety, rows, cols, majors, signs, offs, slopes, ks, lifts, modes, tol,
-                 status, depth, origins, dirs):
-    for r in prange(rows.shape[0]):
-        s, dep = _check_one_ray(height, int(safety[rows[r], cols[r]]), rows[r], cols[r],
-                                majors[r], signs[r], offs[r], slopes[r], ks[r], lifts[r],
-                                modes[r], tol, origins[r], dirs[r])
-        status[r] = s
-        depth[r] = dep
-
-
-def _ray_parameters(shape, rays: int, rng, adversarial: bool):
-    """Random walk positions, directions, slopes, heights and generator modes.
-
-    Modes: 0 plain ray above ``P``; 1 extremal ray (lowest clearing ray, lifted by ``lift``);
-    2 brute-force tangent ray (``lift`` is the extra depth below ``f - tolerance``).
-    """
-    hh, ww = shape
-    n = int(rays)
-    rows = rng.integers(0, hh, n)
-    cols = rng.integers(0, ww, n)
-    majors = rng.integers(0, 2, n)
-    signs = rng.choice(np.array([-1.0, 1.0]), n)
-    offs = rng.random(n)
-    slopes = np.tan(rng.uniform(-np.pi / 4, np.pi / 4, n))
-    ks = rng.choice(np.array([-1.0, 1.0]), n) * 10.0 ** rng.uniform(-4.0, 0.7, n)
-    steep = rng.random(n) < 0.2
-    ks[steep] = np.tan(rng.uniform(-1.5, 1.5, steep.sum()))
-    lifts = 10.0 ** rng.uniform(-6.0, -0.3, n)
-    modes = np.zeros(n, np.int64)
-    if adversarial:
-        special = rng.random(n) < 0.2
-        offs[special] = rng.choice(np.array([0.0, 0.5, 1.0, 1e-9, 1.0 - 1e-9]), special.sum())
-        rational = np.array([0.0, 1.0, -1.0, 0.5, -0.5, 1 / 3, -1 / 3, 2 / 3, -2 / 3, 0.25, -0.25])
-        special = rng.random(n) < 0.2
-        slopes[special] = rng.choice(rational, special.sum())
-        flat = rng.random(n) < 0.15
-        ks[flat] = rng.choice(np.array([-1.0, 1.0]), flat.sum()) * 10.0 ** rng.uniform(
-            -7.0, -3.0, flat.sum())
-        u = rng.random(n)
-        modes[u < 0.8] = 1
-        modes[u < 0.5] = 2
-        lifts[modes == 1] = 10.0 ** rng.uniform(-10.0, -1.5, (modes == 1).sum())
-        lifts[modes == 2] = 2.0 * CHECK_FLOOR + 10.0 ** rng.uniform(-8.0, -2.5, (modes == 2).sum())
-    return rows, cols, majors, signs, offs, slopes, ks, lifts, modes
-
-
-def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, seed: int = 0,
-                 adversarial: bool = True) -> list[Violation]:
-    """Brute-force check of safety radii with the exact reference intersection.
-
-    Rays are built in the walk's own terms: a texel, a walk position ``P`` on one of its
-    centerline segments, a projected direction (x- or y-major, either sign) and a vertical
-    slope. Three generators are mixed (the last two only when ``adversarial``):
-
-    * plain rays at a random height above ``P``;
-    * extremal rays (Fig. 8): for a random slope, the lowest ray that clears the surface
-      from the box side up to ``P`` (exact), lifted by a tiny random amount; texel edges and
-      centres as offsets, rational projected slopes (rays through texel centres) and
-      near-horizontal slopes are over-sampled;
-    * brute-force tangent rays: on a densely sampled profile of the line, the steepest ray
-      through a point ``tolerance`` (plus a tiny margin) below the surface after ``P`` that
-      clears the profile behind ``P``, choosing the one that resurfaces first.
-
-    A ray is discarded when it is blocked (the exact first hit from its box entry is at or
-    before ``P``). For the others every pair of crossings (down, then up) strictly between
-    ``P`` and the jump target ``radius`` centerlines further (cut at the box boundary) whose
-    largest depth exceeds ``tolerance + CHECK_FLOOR`` is a violation. Crossings, depths and
-    blocking use only :mod:`reliefkit.reference.heightfield`, not the baker.
-
-    Parameters
-    ----------
-    height : (H, W) array_like
-    safety : (H, W) array_like of int
-        Radii to check.
-    tolerance : float
-        The tolerance the radii were baked with.
-    rays : int
-        Number of rays.
-    seed : int
-        Seed of ``numpy.random.default_rng``.
-    adversarial : bool
-        Mix in the adversarial generators (otherwise plain random rays only).
-
-    Returns
-    -------
-    list of Violation
-        Empty when no violation was found.
-    """
-    h = _checked_height(height)
-    s = np.asarray(safety)
-    if s.shape != h.shape:
-        raise UsageError(f"safety shape {s.shape} does not match height shape {h.shape}")
-    s = np.ascontiguousarray(s, dtype=np.int64)
-    rng = np.random.default_rng(seed)
-    params = _ray_parameters(h.shape, rays, rng, adversarial)
-    rows, cols, majors = params[:3]
-    n = rows.shape[0]
-    status = np.zeros(n, np.int64)
-    depth = np.zeros(n)
-    origins = np.zeros((n, 3))
-    dirs = np.zeros((n, 3))
-    _check_batch(h, s, *params, float(tolerance), status, depth, origins, dirs)
-    out = []
-    for r in np.nonzero(status == 2)[0]:
-        radius = int(s[rows[r], cols[r]])
-        cr = _crossings(h, origins[r], dirs[r], 0.0, float(radius))
-        out.append(Violation(int(rows[r]), int(cols[r]), radius, "xy"[int(majors[r])],
-                             tuple(float(v) for v in origins[r]),
-                             tuple(float(v) for v in dirs[r]),
-                             tuple(float(c) for c in cr if 0.0 < c < radius),
-                             float(depth[r])))
-    return out

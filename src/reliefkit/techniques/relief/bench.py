@@ -10,14 +10,16 @@ from __future__ import annotations
 import json
 import platform
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..fileio import atomic_path
+from ...io.atomic import atomic_path
 
-METHODS = ("exact", "robust", "binary")
+from .bake import DEFAULT_TOLERANCE
+
+METHODS = ("exact", "robust", "binary")  # the table's column order
 
 
 @dataclass
@@ -31,20 +33,19 @@ class BenchConfig:
     correctness_res: int = 256
     correctness_views: tuple = ((30, 45), (120, 20), (200, 10), (300, 5))
     correctness_size: tuple = (400, 300)
-    tolerance: float = 0.01
-    out: Path = field(default_factory=lambda: Path("docs"))
+    tolerance: float = DEFAULT_TOLERANCE
 
     @classmethod
-    def quick(cls, out: Path) -> BenchConfig:
+    def quick(cls) -> BenchConfig:
         return cls(models=("terrain", "vehicle"), resolutions=(32, 64, 128), size=(320, 240),
                    repeats=1, tolerances=(0.0, 0.01, 0.05), tolerance_res=64,
                    correctness_res=64, correctness_views=((30, 45), (200, 10)),
-                   correctness_size=(160, 120), out=out)
+                   correctness_size=(160, 120))
 
 
 def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
     """Orbit camera at ``elevation`` whose view of the box fills ``fill`` of the image."""
-    from ..scene.views import orbit_bounds
+    from ...scene.views import orbit_bounds
 
     corners = np.array([[bounds[i & 1][0], bounds[(i >> 1) & 1][1], bounds[(i >> 2) & 1][2]]
                         for i in range(8)])
@@ -61,11 +62,11 @@ def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
 
 def table1(cfg: BenchConfig, log) -> list[dict]:
     """Frame time per method and for the mesh, iterations per covered pixel (Table 1)."""
-    from ..bake import bake_relief
-    from ..bake.safety import safety_radii
-    from ..render import render
-    from ..scene.assets import make_asset
-    from .timing import time_render
+    from .bake import bake_relief
+    from .safety import safety_radii
+    from ...render import render
+    from ...scene.assets import make_asset
+    from ...bench.timing import time_render
 
     safety_radii(np.zeros((8, 8), np.float32))  # compile before measuring
     rows = []
@@ -96,11 +97,11 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
 
 def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
     """Fig. 12: tolerance vs mean radius vs iterations vs silhouette (wrong-hit) error."""
-    from ..bake import bake_relief
-    from ..bake.safety import safety_radii
-    from ..reference.relief import wrong_hits
-    from ..render import render
-    from ..scene.assets import make_asset
+    from .bake import bake_relief
+    from .safety import safety_radii
+    from .reference import wrong_hits
+    from ...render import render
+    from ...scene.assets import make_asset
 
     mesh = make_asset("terrain")
     relief = bake_relief(mesh, depth_res=cfg.tolerance_res, safety=False)
@@ -124,11 +125,11 @@ def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
 
 def correctness(cfg: BenchConfig, log) -> list[dict]:
     """Wrong-hit fraction of each method against the exact reference, grazing views too."""
-    from ..bake import bake_relief
-    from ..reference.relief import wrong_hits
-    from ..render import render
-    from ..scene.assets import make_asset
-    from ..scene.views import orbit_bounds
+    from .bake import bake_relief
+    from .reference import wrong_hits
+    from ...render import render
+    from ...scene.assets import make_asset
+    from ...scene.views import orbit_bounds
 
     rows = []
     for name in ("terrain", "blob", "vehicle"):
@@ -147,7 +148,7 @@ def correctness(cfg: BenchConfig, log) -> list[dict]:
 
 
 def run(cfg: BenchConfig, log=print) -> dict:
-    from ..gl.context import gl_info
+    from ...gl.context import gl_info
 
     info = gl_info()
     results = {"machine": {"renderer": info["renderer"], "gl": info["version"],
@@ -273,3 +274,10 @@ def write(results: dict, out: Path) -> list[Path]:
     with atomic_path(paths[1]) as tmp:
         tmp.write_text(markdown(results))
     return paths
+
+
+def run_suite(quick: bool, out: Path, log) -> tuple[str, list[Path]]:
+    """The ``relief`` bench suite: run, write json/md/png into ``out``, return the markdown."""
+    cfg = BenchConfig.quick() if quick else BenchConfig()
+    results = run(cfg, log=log)
+    return markdown(results), write(results, out)

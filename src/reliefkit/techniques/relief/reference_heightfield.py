@@ -31,9 +31,18 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..errors import UsageError
+from ...errors import UsageError
 
 __all__ = [
+    "JIT_OPTIONS",
+    "as_height",
+    "surface_at",
+    "clip_box",
+    "walk_segments",
+    "cell_quadratic",
+    "first_hit_in",
+    "crossings_between",
+    "max_depth_below",
     "surface_height",
     "intersect_ray",
     "intersect_rays",
@@ -42,14 +51,14 @@ __all__ = [
     "cells_visited",
 ]
 
-_JIT = {"cache": True, "error_model": "numpy", "nogil": True}
+JIT_OPTIONS = {"cache": True, "error_model": "numpy", "nogil": True}
 
 
 # ---------------------------------------------------------------------------------------------
 # scalar kernels
 # ---------------------------------------------------------------------------------------------
-@njit(**_JIT)
-def _surface(height, x, y):
+@njit(**JIT_OPTIONS)
+def surface_at(height, x, y):
     """Bilinear, border-clamped surface height at texel coordinates (x, y)."""
     hh, ww = height.shape
     xc = min(max(x, 0.5), ww - 0.5) - 0.5
@@ -65,8 +74,8 @@ def _surface(height, x, y):
     return top * (1.0 - fy) + bot * fy
 
 
-@njit(**_JIT)
-def _clip_box(o, d, t_min, t_max, axes=3):
+@njit(**JIT_OPTIONS)
+def clip_box(o, d, t_min, t_max, axes=3):
     """Clip the parameter range [t_min, t_max] of ``o + t d`` to the unit box (to the unit
     square of the first two coordinates when ``axes`` is 2).
 
@@ -88,7 +97,7 @@ def _clip_box(o, d, t_min, t_max, axes=3):
     return t0, t1
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _start_cell(pos, step):
     """Index of the cell (between centerlines) that contains ``pos`` when moving by ``step``."""
     if step < 0.0:
@@ -96,7 +105,7 @@ def _start_cell(pos, step):
     return int(math.floor(pos + 0.5))
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _next_boundary_t(cell, n, o_a, d_a):
     """t of the next cell boundary along one axis (inf when there is none)."""
     if d_a > 0.0:
@@ -110,8 +119,8 @@ def _next_boundary_t(cell, n, o_a, d_a):
     return np.inf
 
 
-@njit(**_JIT)
-def _walk_segments(hh, ww, o, d, t0, t1):
+@njit(**JIT_OPTIONS)
+def walk_segments(hh, ww, o, d, t0, t1):
     """Amanatides-Woo walk of the cells between centerlines crossed on ``[t0, t1]``.
 
     Returns ``(ts, cxs, cys, n)``: segment ``k`` is ``[ts[k], ts[k+1]]`` in cell
@@ -154,8 +163,8 @@ def _walk_segments(hh, ww, o, d, t0, t1):
     return ts, cxs, cys, n
 
 
-@njit(**_JIT)
-def _cell_quadratic(height, o, d, cx, cy, ta):
+@njit(**JIT_OPTIONS)
+def cell_quadratic(height, o, d, cx, cy, ta):
     """Coefficients (A, B, C) of ``F(ta + s) = h - S = A s^2 + B s + C`` inside a cell."""
     hh, ww = height.shape
     i0 = min(max(cx - 1, 0), ww - 1)
@@ -180,12 +189,12 @@ def _cell_quadratic(height, o, d, cx, cy, ta):
     return -s2, d[2] - s1, h0 - s0
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _quad(a, b, c, s):
     return (a * s + b) * s + c
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _first_root(a, b, c, length):
     """Smallest ``s`` in ``[0, length]`` with ``a s^2 + b s + c <= 0``, given ``c > 0``.
 
@@ -215,7 +224,7 @@ def _first_root(a, b, c, length):
     return best
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _bisect_root(a, b, c, lo, hi):
     """Root of a quadratic on ``[lo, hi]`` with ``F(lo) > 0 >= F(hi)`` (or the reverse)."""
     flo = _quad(a, b, c, lo) > 0.0
@@ -230,22 +239,22 @@ def _bisect_root(a, b, c, lo, hi):
     return 0.5 * (lo + hi)
 
 
-@njit(**_JIT)
-def _first_hit_range(height, o, d, t_lo, t_hi):
+@njit(**JIT_OPTIONS)
+def first_hit_in(height, o, d, t_lo, t_hi):
     """First ``t`` in ``[t_lo, t_hi]`` (already clipped to the box) with ``h <= S``."""
     hh, ww = height.shape
-    ts, cxs, cys, n = _walk_segments(hh, ww, o, d, t_lo, t_hi)
+    ts, cxs, cys, n = walk_segments(hh, ww, o, d, t_lo, t_hi)
     if n == 0:
         # Degenerate range (a single point): test it directly.
         if t_lo <= t_hi:
             x = (o[0] + t_lo * d[0]) * ww
             y = (o[1] + t_lo * d[1]) * hh
-            if o[2] + t_lo * d[2] <= _surface(height, x, y):
+            if o[2] + t_lo * d[2] <= surface_at(height, x, y):
                 return t_lo
         return np.inf
     for k in range(n):
         ta = ts[k]
-        a, b, c = _cell_quadratic(height, o, d, cxs[k], cys[k], ta)
+        a, b, c = cell_quadratic(height, o, d, cxs[k], cys[k], ta)
         if c <= 0.0:
             return ta
         s = _first_root(a, b, c, ts[k + 1] - ta)
@@ -254,16 +263,16 @@ def _first_hit_range(height, o, d, t_lo, t_hi):
     return np.inf
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _intersect(height, o, d):
-    t0, t1 = _clip_box(o, d, 0.0, np.inf)
+    t0, t1 = clip_box(o, d, 0.0, np.inf)
     if t0 > t1:
         return np.inf
-    return _first_hit_range(height, o, d, t0, t1)
+    return first_hit_in(height, o, d, t0, t1)
 
 
-@njit(**_JIT)
-def _crossings(height, o, d, t_lo, t_hi):
+@njit(**JIT_OPTIONS)
+def crossings_between(height, o, d, t_lo, t_hi):
     """Every sign change of ``F = h - S`` on ``[t_lo, t_hi]`` clipped to the box.
 
     "Above" is ``F > 0``; a crossing is a change between above and on-or-below. Returns an
@@ -271,10 +280,10 @@ def _crossings(height, o, d, t_lo, t_hi):
     """
     hh, ww = height.shape
     out = np.empty(0)
-    t0, t1 = _clip_box(o, d, t_lo, t_hi)
+    t0, t1 = clip_box(o, d, t_lo, t_hi)
     if t0 > t1:
         return out
-    ts, cxs, cys, n = _walk_segments(hh, ww, o, d, t0, t1)
+    ts, cxs, cys, n = walk_segments(hh, ww, o, d, t0, t1)
     buf = np.empty(2 * n + 4)
     m = 0
     prev_above = False
@@ -282,7 +291,7 @@ def _crossings(height, o, d, t_lo, t_hi):
     for k in range(n):
         ta = ts[k]
         length = ts[k + 1] - ta
-        a, b, c = _cell_quadratic(height, o, d, cxs[k], cys[k], ta)
+        a, b, c = cell_quadratic(height, o, d, cxs[k], cys[k], ta)
         # Sample points: start, interior extremum, end; F is monotone between them.
         pts = np.empty(3)
         pts[0] = 0.0
@@ -310,23 +319,23 @@ def _crossings(height, o, d, t_lo, t_hi):
     return buf[:m].copy()
 
 
-@njit(**_JIT)
-def _max_below(height, o, d, t_lo, t_hi):
+@njit(**JIT_OPTIONS)
+def max_depth_below(height, o, d, t_lo, t_hi):
     """``max (S - h)`` over ``[t_lo, t_hi]`` clipped to the box (``-inf`` when empty)."""
     hh, ww = height.shape
-    t0, t1 = _clip_box(o, d, t_lo, t_hi)
+    t0, t1 = clip_box(o, d, t_lo, t_hi)
     if t0 > t1:
         return -np.inf
-    ts, cxs, cys, n = _walk_segments(hh, ww, o, d, t0, t1)
+    ts, cxs, cys, n = walk_segments(hh, ww, o, d, t0, t1)
     best = -np.inf
     if n == 0:
         x = (o[0] + t0 * d[0]) * ww
         y = (o[1] + t0 * d[1]) * hh
-        return _surface(height, x, y) - (o[2] + t0 * d[2])
+        return surface_at(height, x, y) - (o[2] + t0 * d[2])
     for k in range(n):
         ta = ts[k]
         length = ts[k + 1] - ta
-        a, b, c = _cell_quadratic(height, o, d, cxs[k], cys[k], ta)
+        a, b, c = cell_quadratic(height, o, d, cxs[k], cys[k], ta)
         best = max(best, -c, -_quad(a, b, c, length))
         if a != 0.0:
             sc = -b / (2.0 * a)
@@ -335,22 +344,22 @@ def _max_below(height, o, d, t_lo, t_hi):
     return best
 
 
-@njit(parallel=True, **_JIT)
+@njit(parallel=True, **JIT_OPTIONS)
 def _intersect_many(height, origins, directions, out):
     for r in prange(origins.shape[0]):
         out[r] = _intersect(height, origins[r], directions[r])
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _surface_many(height, xs, ys, out):
     for k in range(xs.shape[0]):
-        out[k] = _surface(height, xs[k], ys[k])
+        out[k] = surface_at(height, xs[k], ys[k])
 
 
 # ---------------------------------------------------------------------------------------------
 # public API
 # ---------------------------------------------------------------------------------------------
-def _as_height(height) -> np.ndarray:
+def as_height(height) -> np.ndarray:
     arr = np.asarray(height)
     if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
         raise UsageError(f"height must be a non-empty 2D array, got shape {arr.shape}")
@@ -384,7 +393,7 @@ def surface_height(height, x, y):
     float or numpy.ndarray
         ``S(x, y)``; a float for scalar input, otherwise an array of the broadcast shape.
     """
-    h = _as_height(height)
+    h = as_height(height)
     xs, ys = np.broadcast_arrays(np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64))
     out = np.empty(xs.size)
     _surface_many(h, np.ascontiguousarray(xs).reshape(-1), np.ascontiguousarray(ys).reshape(-1),
@@ -410,7 +419,7 @@ def intersect_ray(height, origin, direction) -> float:
         The smallest ``t >= 0`` inside the unit box where ``h <= S`` (the entry ``t`` when the
         ray enters the box on or below the surface), or ``numpy.inf`` when the ray misses.
     """
-    return float(_intersect(_as_height(height), _as_vec3(origin, "origin"),
+    return float(_intersect(as_height(height), _as_vec3(origin, "origin"),
                             _as_vec3(direction, "direction")))
 
 
@@ -427,7 +436,7 @@ def intersect_rays(height, origins, directions) -> np.ndarray:
     numpy.ndarray
         (N,) float64 first-hit parameters, ``inf`` for misses.
     """
-    h = _as_height(height)
+    h = as_height(height)
     o = np.ascontiguousarray(np.asarray(origins, dtype=np.float64).reshape(-1, 3))
     d = np.ascontiguousarray(np.asarray(directions, dtype=np.float64).reshape(-1, 3))
     if o.shape != d.shape:
@@ -451,8 +460,8 @@ def ray_crossings(height, origin, direction, t0, t1) -> np.ndarray:
     numpy.ndarray
         Sorted crossing parameters (float64).
     """
-    h = _as_height(height)
-    return _crossings(h, _as_vec3(origin, "origin"), _as_vec3(direction, "direction"),
+    h = as_height(height)
+    return crossings_between(h, _as_vec3(origin, "origin"), _as_vec3(direction, "direction"),
                       float(t0), float(t1))
 
 
@@ -462,8 +471,8 @@ def max_penetration(height, origin, direction, t0, t1) -> float:
     Exact per cell (endpoints and the extremum of the cell's quadratic). Negative when the
     ray stays above the surface; ``-inf`` when the range misses the box.
     """
-    h = _as_height(height)
-    return float(_max_below(h, _as_vec3(origin, "origin"), _as_vec3(direction, "direction"),
+    h = as_height(height)
+    return float(max_depth_below(h, _as_vec3(origin, "origin"), _as_vec3(direction, "direction"),
                             float(t0), float(t1)))
 
 
@@ -473,15 +482,15 @@ def cells_visited(height, origin, direction, t_max: float | None = None) -> int:
     The walk starts at the box entry and stops at the first hit (or the box exit, or
     ``t_max``); the count is the iteration count of the exact method of section 3.3.
     """
-    h = _as_height(height)
+    h = as_height(height)
     o = _as_vec3(origin, "origin")
     d = _as_vec3(direction, "direction")
-    t0, t1 = _clip_box(o, d, 0.0, np.inf)
+    t0, t1 = clip_box(o, d, 0.0, np.inf)
     if t0 > t1:
         return 0
-    hit = _first_hit_range(h, o, d, t0, t1)
+    hit = first_hit_in(h, o, d, t0, t1)
     end = min(t1, hit, np.inf if t_max is None else float(t_max))
     if end == t0:
         return 1
     hh, ww = h.shape
-    return int(_walk_segments(hh, ww, o, d, t0, end)[3])
+    return int(walk_segments(hh, ww, o, d, t0, end)[3])

@@ -6,7 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import UsageError
+from ...core.transforms import transform_points, unit_cube_corners
+from ...errors import UsageError
 
 
 @dataclass(eq=False)
@@ -28,6 +29,8 @@ class ReliefTexture:
         reverse-perspective frustum; affine for a box).
     safety : (H, W) uint8/uint16 safety radii in texels, or None (then only the binary and
         exact methods can render it).
+    clip_bounds : (2, 3) float64 world box (min, max corner) that the drawn proxy is cut to
+        (§4.1: fewer fragments for a frustum), or None to draw the whole box.
     params : bake parameters (JSON), kept in the .rk manifest.
     """
 
@@ -36,6 +39,7 @@ class ReliefTexture:
     normal: np.ndarray
     box_to_world: np.ndarray
     safety: np.ndarray | None = None
+    clip_bounds: np.ndarray | None = None
     params: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -60,6 +64,11 @@ class ReliefTexture:
             if self.safety.shape != self.height.shape or self.safety.dtype not in (
                     np.uint8, np.uint16):
                 raise UsageError("safety must be uint8/uint16 with the height's shape")
+        if self.clip_bounds is not None:
+            self.clip_bounds = np.asarray(self.clip_bounds, dtype=np.float64)
+            if self.clip_bounds.shape != (2, 3) or not np.isfinite(self.clip_bounds).all() \
+                    or (self.clip_bounds[0] >= self.clip_bounds[1]).any():
+                raise UsageError("clip_bounds must be finite (min, max) corners with min < max")
 
     @property
     def depth_resolution(self) -> tuple[int, int]:
@@ -77,32 +86,24 @@ class ReliefTexture:
     @property
     def corners(self) -> np.ndarray:
         """(8, 3) world positions of the box (frustum) corners, index = u + 2v + 4h."""
-        unit = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1, 1.0] for i in range(8)])
-        world = unit @ self.box_to_world.T
-        return world[:, :3] / world[:, 3:4]
+        return transform_points(self.box_to_world, unit_cube_corners())
 
     @property
     def bounds(self) -> np.ndarray:
-        """World bounding box: of the box (frustum), cut to ``params['clip_bounds']``."""
+        """World bounding box: of the box (frustum), cut to ``clip_bounds``."""
         c = self.corners
         lo, hi = c.min(axis=0), c.max(axis=0)
-        clip = self.params.get("clip_bounds")
-        if clip is not None:
-            lo, hi = np.maximum(lo, clip[0]), np.minimum(hi, clip[1])
+        if self.clip_bounds is not None:
+            lo, hi = np.maximum(lo, self.clip_bounds[0]), np.minimum(hi, self.clip_bounds[1])
         return np.stack([lo, hi])
 
     def to_world(self, uvh: np.ndarray) -> np.ndarray:
         """Box coordinates (..., 3) -> world positions (..., 3)."""
-        uvh = np.asarray(uvh, dtype=np.float64)
-        hom = np.concatenate([uvh, np.ones(uvh.shape[:-1] + (1,))], axis=-1) @ self.box_to_world.T
-        return hom[..., :3] / hom[..., 3:4]
+        return transform_points(self.box_to_world, uvh)
 
     def to_box(self, world: np.ndarray) -> np.ndarray:
         """World positions (..., 3) -> box coordinates (..., 3)."""
-        world = np.asarray(world, dtype=np.float64)
-        hom = np.concatenate([world, np.ones(world.shape[:-1] + (1,))], axis=-1)
-        hom = hom @ self.world_to_box.T
-        return hom[..., :3] / hom[..., 3:4]
+        return transform_points(self.world_to_box, world)
 
     def memory_bytes(self) -> dict:
         """Bytes of each array as stored."""

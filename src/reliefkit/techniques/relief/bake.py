@@ -1,7 +1,6 @@
 """Baking relief textures: project a mesh onto the bottom face of a box or reverse frustum.
 
-The projection runs on the GPU: the mesh is rasterized through a matrix that maps box
-coordinates (u, v, h) to clip space (x = 2u - 1, y = 2v - 1, z = 1 - 2h), so the depth
+The projection runs on the GPU through the core's `reliefkit.bake.project`: the depth
 buffer keeps the highest surface and height = 1 - window depth (§3).
 """
 
@@ -9,37 +8,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colorspace import to_rgba8
-from ..errors import UsageError
-from ..represent.relief import ReliefTexture
-from ..scene.camera import MatrixCamera
-from ..scene.light import DirectionalLight
-from ..scene.mesh import RenderMesh
+from ...bake.project import axis_frame, project_mesh
+from ...colorspace import srgb_decode, to_rgba8
+from ...core.transforms import transform_points
+from ...errors import UsageError
+from ...scene.mesh import RenderMesh
+from .representation import ReliefTexture
 
-AXES = {"x": 0, "y": 1, "z": 2}
 BORDER_TEXELS = 1.5      # empty margin around the footprint (the border ring must be 0)
 HEIGHT_MARGIN = 0.01     # the box bottom lies this fraction of the height below the mesh
 # Safety-radius tolerance of bakes (height units, Fig. 12): with 0 most texels of a bilinear
 # terrain get radius 0 (every non-planar patch bends down along some direction); 1% of the
 # box height keeps radii growing with resolution at a bounded silhouette error.
 DEFAULT_TOLERANCE = 0.01
-FLAT_LIGHT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
-
-# box (u, v, h) -> clip: x = 2u - 1, y = 2v - 1, z = 1 - 2h (the top is nearest)
-BOX_TO_CLIP = np.array([[2.0, 0, 0, -1], [0, 2.0, 0, -1], [0, 0, -2.0, 1], [0, 0, 0, 1]])
-
-
-def axis_frame(axis: str) -> np.ndarray:
-    """Rows u, v, h: a right-handed frame whose h points along ``axis`` ('y', '-z', ...)."""
-    sign = -1.0 if axis.startswith("-") else 1.0
-    name = axis.lstrip("+-")
-    if name not in AXES:
-        raise UsageError(f"axis must be one of x, y, z, -x, -y, -z; got {axis!r}")
-    h = np.zeros(3)
-    h[AXES[name]] = sign
-    u = np.zeros(3)
-    u[0 if name != "x" else 2] = 1.0
-    return np.stack([u, np.cross(h, u), h])
 
 
 def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, tuple[int, int]]:
@@ -69,27 +50,12 @@ def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, 
     return box_to_world, (size[0], size[1])
 
 
-def project_mesh(mesh: RenderMesh, box_to_world: np.ndarray, size: tuple[int, int], ctx=None):
-    """Rasterize ``mesh`` through the box: (height, linear RGBA, world normal, coverage)."""
-    from ..render import render
-
-    world_to_box = np.linalg.inv(box_to_world)
-    up = box_to_world[:3, 2] - box_to_world[3, 2] * box_to_world[:3, 3] / box_to_world[3, 3]
-    camera = MatrixCamera(view=world_to_box, proj=BOX_TO_CLIP, size=tuple(size),
-                          view_dir=tuple(up / np.linalg.norm(up)))
-    frame = render(mesh, camera, light=FLAT_LIGHT, ctx=ctx)
-    rows = slice(None, None, -1)  # frames have row 0 at the top (v = 1); textures at v = 0
-    mask = frame.mask[rows]
-    height = np.where(mask, 1.0 - frame.depth[rows], 0.0).astype(np.float32)
-    return height, frame.color[rows], frame.normal[rows], mask
-
-
 def _orient_normals(normal: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
     """Unit normals turned to face the viewer of the bake (up the box's h lines)."""
     h, w = normal.shape[:2]
     u, v = np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
-    top = _to_world(box_to_world, np.stack([u, v, np.full_like(u, 0.9)], -1))
-    bottom = _to_world(box_to_world, np.stack([u, v, np.full_like(u, 0.1)], -1))
+    top = transform_points(box_to_world, np.stack([u, v, np.full_like(u, 0.9)], -1))
+    bottom = transform_points(box_to_world, np.stack([u, v, np.full_like(u, 0.1)], -1))
     up = top - bottom
     n = normal.astype(np.float64)
     flip = (n * up).sum(-1) < 0
@@ -97,11 +63,6 @@ def _orient_normals(normal: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
     length = np.linalg.norm(n, axis=-1, keepdims=True)
     up_unit = up / np.linalg.norm(up, axis=-1, keepdims=True)
     return np.where(length > 1e-6, n / np.maximum(length, 1e-12), up_unit).astype(np.float32)
-
-
-def _to_world(box_to_world: np.ndarray, uvh: np.ndarray) -> np.ndarray:
-    hom = np.concatenate([uvh, np.ones(uvh.shape[:-1] + (1,))], -1) @ box_to_world.T
-    return hom[..., :3] / hom[..., 3:4]
 
 
 def _zero_border(height: np.ndarray) -> np.ndarray:
@@ -121,7 +82,7 @@ def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int,
 def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
                  safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
                  params: dict | None = None, zero_border: bool = True,
-                 ctx=None) -> ReliefTexture:
+                 clip_bounds=None, ctx=None) -> ReliefTexture:
     """Bake ``mesh`` through any box/frustum matrix at the given resolutions.
 
     ``zero_border`` empties the outer ring of texels so every ray enters above the surface
@@ -130,14 +91,15 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
     for label, (w, h) in (("depth", depth_size), ("color", color_size)):
         if w > 8192 or h > 8192:
             raise UsageError(f"{label} resolution {w}x{h} is above 8192")
-    height, _, _, _ = project_mesh(mesh, box_to_world, depth_size, ctx)
-    _, color, normal, mask = project_mesh(mesh, box_to_world, color_size, ctx)
-    height = np.clip(height, 0.0, 1.0)
+    height = np.clip(project_mesh(mesh, box_to_world, depth_size, ctx).height, 0.0, 1.0)
+    colors = project_mesh(mesh, box_to_world, color_size, ctx)
+    color, normal, mask = colors.color, colors.normal, colors.mask
     if zero_border:
         height = _zero_border(height)
     relief = ReliefTexture(height=height, color=to_rgba8(color * mask[..., None]),
                            normal=_orient_normals(normal, box_to_world),
-                           box_to_world=box_to_world, params=dict(params or {}))
+                           box_to_world=box_to_world, clip_bounds=clip_bounds,
+                           params=dict(params or {}))
     if safety:
         from .safety import safety_radii
 
@@ -210,8 +172,6 @@ _RAMP_SRGB = np.array([[40, 90, 110], [90, 140, 60], [140, 120, 80], [150, 150, 
 
 def height_ramp(h: np.ndarray) -> np.ndarray:
     """(H, W, 3) linear colours for heights in [0, 1]."""
-    from ..colorspace import srgb_decode
-
     rgb = np.stack([np.interp(h, _RAMP_STOPS, _RAMP_SRGB[:, k]) for k in range(3)], -1)
     return srgb_decode(rgb)
 

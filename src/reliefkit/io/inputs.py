@@ -10,21 +10,21 @@ DEMO_PREFIX = "demo:"
 def load_input(spec: str):
     """``demo:NAME`` -> a procedural RenderMesh, ``*.rk`` -> its representation, else a mesh."""
     if spec.startswith(DEMO_PREFIX):
-        from .scene.assets import make_asset
+        from ..scene.assets import make_asset
 
         return make_asset(spec[len(DEMO_PREFIX):])
     if Path(spec).suffix.lower() == ".rk":
-        from .formats import load
+        from .rk import load
 
         return load(spec)
-    from .scene.loader import load_mesh
+    from ..scene.loader import load_mesh
 
     return load_mesh(spec)
 
 
 def describe(obj) -> dict:
     """A short JSON-able summary for `reliefkit info`."""
-    from .scene.mesh import RenderMesh
+    from ..scene.mesh import RenderMesh
 
     if isinstance(obj, RenderMesh):
         lo, hi = obj.bounds

@@ -1,0 +1,151 @@
+"""Typed options: baker parameters and render options declared once, as dataclass fields.
+
+A technique writes
+
+    @dataclass(frozen=True)
+    class ReliefRender:
+        method: str = param("robust", "ray/heightfield intersection", choices=METHODS)
+        linear_steps: int = param(16, "binary: fixed pre-steps", lo=1, hi=4096)
+
+and gets validation (`make`), the CLI's flags, defaults and help (`Option`), and one place
+where each default lives.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from functools import cache
+
+from ..errors import UsageError
+
+KINDS = ("bool", "int", "float", "str", "floats")
+
+
+def param(default, help: str, *, choices: tuple | None = None, lo: float | None = None,
+          hi: float | None = None, kind: str | None = None, count: int | None = None):
+    """A dataclass field carrying what an `Option` needs.
+
+    ``kind`` is inferred from the default (give it when the default is None); ``"floats"``
+    is a comma-separated list of ``count`` numbers (``--box 2,0.5,2``). ``lo``/``hi`` bound
+    numbers (inclusive), every entry of a ``floats``.
+    """
+    if kind is None:
+        kind = {bool: "bool", int: "int", float: "float", str: "str"}.get(type(default))
+    if kind not in KINDS:
+        raise TypeError(f"param({default!r}): give kind= (one of {', '.join(KINDS)})")
+    meta = {"help": help, "choices": tuple(choices) if choices else None, "lo": lo, "hi": hi,
+            "kind": kind, "count": count}
+    if isinstance(default, list | dict | set):
+        raise TypeError("param defaults must be immutable (use a tuple)")
+    return dataclasses.field(default=default, metadata={"reliefkit": meta})
+
+
+@dataclass(frozen=True)
+class Option:
+    """One declared option: name, default, help, and how to parse and check a value."""
+
+    name: str
+    default: object
+    help: str
+    kind: str
+    choices: tuple | None = None
+    lo: float | None = None
+    hi: float | None = None
+    count: int | None = None
+
+    @property
+    def flag(self) -> str:
+        return self.name.replace("_", "-")
+
+    def check(self, value, owner: str):
+        """The value converted to this option's kind, or UsageError saying what is allowed."""
+        where = f"{owner}: {self.flag}"
+        if value is None:
+            if self.default is None:
+                return None
+            raise UsageError(f"{where} needs a value")
+        try:
+            value = _convert(self.kind, value, self.count)
+        except (TypeError, ValueError):
+            shape = f"{self.count} comma-separated numbers" if self.kind == "floats" else \
+                f"a {self.kind}"
+            raise UsageError(f"{where} must be {shape}, got {value!r}") from None
+        if self.choices and value not in self.choices:
+            raise UsageError(f"{where} must be one of {', '.join(map(str, self.choices))}, "
+                             f"got {value!r}")
+        for v in (value if self.kind == "floats" else (value,)):
+            if self.kind in ("int", "float", "floats") and not (
+                    (self.lo is None or v >= self.lo) and (self.hi is None or v <= self.hi)):
+                raise UsageError(f"{where} must be within [{_num(self.lo)}, {_num(self.hi)}], "
+                                 f"got {v!r}")
+        return value
+
+
+def _num(x) -> str:
+    return "-inf" if x is None else f"{x:g}"
+
+
+def _convert(kind: str, value, count: int | None):
+    if kind == "bool":
+        if isinstance(value, bool):
+            return value
+        raise TypeError
+    if kind == "int":
+        if isinstance(value, bool) or (isinstance(value, float) and not value.is_integer()):
+            raise TypeError
+        return int(value)
+    if kind == "float":
+        if isinstance(value, bool):
+            raise TypeError
+        out = float(value)
+        if out != out or out in (float("inf"), float("-inf")):
+            raise ValueError
+        return out
+    if kind == "str":
+        if not isinstance(value, str):
+            raise TypeError
+        return value
+    items = value.split(",") if isinstance(value, str) else list(value)
+    out = tuple(float(x) for x in items)
+    if (count is not None and len(out) != count) or any(v != v for v in out):
+        raise ValueError
+    return out
+
+
+@cache
+def options_of(cls: type) -> tuple[Option, ...]:
+    """The `Option`s of a params dataclass, in field order; every field must use `param`."""
+    if not dataclasses.is_dataclass(cls):
+        raise TypeError(f"{cls!r} is not a dataclass of options")
+    out = []
+    for f in dataclasses.fields(cls):
+        meta = f.metadata.get("reliefkit")
+        if meta is None:
+            raise TypeError(f"{cls.__qualname__}.{f.name} is not declared with param()")
+        out.append(Option(f.name, f.default, meta["help"], meta["kind"], meta["choices"],
+                          meta["lo"], meta["hi"], meta["count"]))
+    return tuple(out)
+
+
+def make(cls: type, values: dict, owner: str, *, strict: bool = True):
+    """An instance of the params dataclass ``cls`` from ``values``, every value checked.
+
+    With ``strict`` a key that is no field of ``cls`` is an error naming the known ones.
+    """
+    options = {opt.name: opt for opt in options_of(cls)}
+    unknown = sorted(set(values) - set(options))
+    if strict and unknown:
+        raise UsageError(f"{owner}: unknown option(s) {', '.join(unknown)} (it has: "
+                         f"{', '.join(options) or 'none'})")
+    kwargs = {name: options[name].check(v, owner) for name, v in values.items() if name in options}
+    return cls(**kwargs)
+
+
+def describe_default(opt: Option) -> str:
+    if opt.default is None:
+        return "none"
+    if opt.kind == "floats":
+        return ",".join(f"{x:g}" for x in opt.default)
+    return str(opt.default)
+

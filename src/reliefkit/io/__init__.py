@@ -1,0 +1,1 @@
+"""Files: the .rk container (`rk`), the mesh kind, the one atomic writer, opening inputs."""

@@ -1,0 +1,85 @@
+"""The relief bakers and their typed parameters (the CLI's ``bake --as relief...`` options)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core.params import param
+from .bake import DEFAULT_TOLERANCE, bake_relief, relief_from_heights
+from .frustum import bake_relief_cube, bake_relief_frustum
+
+AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+def _depth_res(default: int):
+    return param(default, "heightfield resolution (longest side, texels)", lo=8, hi=8192)
+
+
+def _color_res():
+    return param(None, "colour/normal resolution, longest side (none: the depth resolution)",
+                 kind="int", lo=2, hi=8192)
+
+
+def _safety():
+    return param(True, "bake safety radii (needed by the robust method)")
+
+
+def _tolerance():
+    return param(DEFAULT_TOLERANCE, "safety radii: ignored dip depth (height units, Fig. 12); "
+                 "larger radii and fewer iterations for a bounded silhouette error",
+                 lo=0.0, hi=1.0)
+
+
+def _axis():
+    return param("y", "projection axis (the heightfield's up direction)", choices=AXES)
+
+
+@dataclass(frozen=True)
+class ReliefParams:
+    depth_res: int = _depth_res(256)
+    color_res: int | None = _color_res()
+    safety: bool = _safety()
+    safety_tolerance: float = _tolerance()
+    axis: str = _axis()
+    box: tuple = param((2.0, 0.5, 2.0), "heightmaps: world size SX,SY,SZ of the box",
+                       kind="floats", count=3, lo=1e-9)
+
+
+@dataclass(frozen=True)
+class ReliefFrustumParams:
+    depth_res: int = _depth_res(256)
+    color_res: int | None = _color_res()
+    safety: bool = _safety()
+    safety_tolerance: float = _tolerance()
+    axis: str = _axis()
+    spread: float = param(30.0, "reverse frustum: side tilt in degrees", lo=1.0, hi=75.0)
+    clip: bool = param(True, "cut the drawn frustum to the mesh's bounds (§4.1)")
+
+
+@dataclass(frozen=True)
+class ReliefCubeParams:
+    depth_res: int = _depth_res(128)
+    color_res: int | None = _color_res()
+    safety: bool = _safety()
+    safety_tolerance: float = _tolerance()
+
+
+def bake_orthographic(source, p: ReliefParams, progress=None):
+    if isinstance(source, np.ndarray):
+        return relief_from_heights(source, size=p.box, safety=p.safety,
+                                   tolerance=p.safety_tolerance, progress=progress)
+    return bake_relief(source, p.depth_res, p.color_res, p.axis, safety=p.safety,
+                       tolerance=p.safety_tolerance, progress=progress)
+
+
+def bake_frustum(source, p: ReliefFrustumParams, progress=None):
+    return bake_relief_frustum(source, depth_res=p.depth_res, color_res=p.color_res,
+                               axis=p.axis, spread_deg=p.spread, clip=p.clip, safety=p.safety,
+                               tolerance=p.safety_tolerance, progress=progress)
+
+
+def bake_cube(source, p: ReliefCubeParams, progress=None):
+    return bake_relief_cube(source, depth_res=p.depth_res, color_res=p.color_res,
+                            safety=p.safety, tolerance=p.safety_tolerance, progress=progress)

@@ -1,0 +1,165 @@
+"""Relief textures: draw the box (or frustum) and intersect each pixel's ray in the shader."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core.params import param
+from ...errors import UsageError
+from ...gl.context import check_gl_error
+from ...gl.shaders import program
+from ...gl.textures import texture2d
+from ...gl.uniforms import camera_uniforms, set_uniforms
+from ...render.frame import window_depth
+from ...render.proxy import aabb_planes, box_planes, convex_proxy
+from .representation import ReliefObject, ReliefTexture
+
+METHODS = ("binary", "exact", "robust")
+PROGRAM = "relief:relief.glsl"
+
+
+@dataclass(frozen=True)
+class ReliefRenderOptions:
+    """The render options of relief textures (``reliefkit render --help`` shows them)."""
+
+    method: str = param("robust", "ray/heightfield intersection (robust needs safety radii)",
+                        choices=METHODS)
+    depth_mode: str = param("conservative", "keep the box depth in the Z-buffer, or write "
+                            "the hit's depth (exact: correct with other objects)",
+                            choices=("conservative", "exact"))
+    shadows: bool = param(False, "self-shadowing: a ray from each hit to the light")
+    zero_radius: str = param("exact", "robust method at a zero safety radius: walk exactly "
+                             "to the next centreline, or clamp the radius to 1",
+                             choices=("exact", "clamp"))
+    cell_test: str = param("quadratic", "exact/robust: test each cell's exact quadratic, or "
+                           "assume heights linear between centrelines as the paper does",
+                           choices=("quadratic", "linear"))
+    linear_steps: int = param(16, "binary: fixed pre-steps", lo=1, hi=4096)
+    binary_steps: int = param(8, "binary search steps once a hit is bracketed", lo=1, hi=4096)
+    max_iterations: int = param(0, "bound on every walk (0: 4 (W + H) + 64)", lo=0,
+                                hi=16384)
+
+
+def relief_proxy(relief: ReliefTexture):
+    """The box (frustum) of a relief texture, cut to its ``clip_bounds`` when it has them."""
+    planes = box_planes(relief.world_to_box)
+    if relief.clip_bounds is not None:
+        planes = np.vstack([planes, aabb_planes(relief.clip_bounds)])
+    return convex_proxy(planes)
+
+
+class ReliefDrawable:
+    """GPU textures and proxy of one ReliefTexture, drawn with one intersection method.
+
+    ``cell_test="linear"`` is the paper's exact walk (heights linear between centreline
+    crossings, §3.3); ``"quadratic"`` (default) also tests the exact quadratic inside each
+    cell with one more fetch per step, so saddle grazes (Fig. 3) are found too.
+    """
+
+    def __init__(self, ctx, relief: ReliefTexture, options: ReliefRenderOptions | None = None,
+                 instrument: bool = False):
+        opts = options or ReliefRenderOptions()
+        if opts.method == "robust" and relief.safety is None:
+            raise UsageError("this relief texture has no safety radii: bake it with them or "
+                             "render with --method binary or exact")
+        self.ctx, self.relief, self.options = ctx, relief, opts
+        self.extra_attachments = 1 if instrument else 0
+        w, h = relief.depth_resolution
+        self.prog = program(ctx, PROGRAM, {
+            f"METHOD_{opts.method.upper()}": True, "WRITE_DEPTH": opts.depth_mode == "exact",
+            "SHADOWS": opts.shadows, "COUNT_ITERATIONS": instrument})
+        self.textures = {}
+        self.vao = self.vbo = self.ibo = None
+        try:
+            self.textures["u_height"] = texture2d(ctx, relief.height, what="height",
+                                                  filter="nearest")
+            self.textures["u_color"] = texture2d(ctx, relief.color, what="color", srgb=True,
+                                                 mipmaps=True)
+            self.textures["u_normal"] = texture2d(ctx, relief.normal, what="normal")
+            if opts.method == "robust":
+                self.textures["u_safety"] = texture2d(ctx, relief.safety.astype(np.float32),
+                                                      what="safety", filter="nearest")
+            self.proxy = relief_proxy(relief)
+            self.vbo = ctx.buffer(self.proxy.positions.tobytes())
+            self.ibo = ctx.buffer(self.proxy.triangles.tobytes())
+            self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f", "in_position")], self.ibo,
+                                        index_element_size=4)
+        except BaseException:
+            self.release()
+            raise
+        self.uniforms = {
+            "u_box_to_world": relief.box_to_world, "u_world_to_box": relief.world_to_box,
+            "u_hf_size": (w, h), "u_linear_steps": opts.linear_steps,
+            "u_binary_steps": opts.binary_steps,
+            "u_max_iterations": opts.max_iterations or 4 * (w + h) + 64,
+            "u_zero_exact": opts.zero_radius == "exact",
+            "u_quadratic_cells": opts.cell_test == "quadratic",
+        }
+        check_gl_error(ctx, "uploading a relief texture")
+
+    def reaches_near_plane(self, camera) -> bool:
+        """Does the proxy extend in front of the near plane (camera inside or close)?
+
+        Then its front faces would be clipped and the back faces are drawn instead; the
+        shader builds the ray from the window position, not from the face it was drawn for.
+        """
+        eye_z = np.c_[self.proxy.positions, np.ones(len(self.proxy.positions))] @ camera.view[2]
+        return bool(eye_z.max() > -camera.near * 1.001)
+
+    def draw(self, camera, light) -> None:
+        import moderngl
+
+        set_uniforms(self.prog, self.uniforms | camera_uniforms(camera) | light.uniforms())
+        for unit, (name, tex) in enumerate(self.textures.items()):
+            tex.use(unit)
+            set_uniforms(self.prog, {name: unit})
+        self.ctx.enable(moderngl.CULL_FACE)
+        self.ctx.cull_face = "front" if self.reaches_near_plane(camera) else "back"
+        self.vao.render()
+        self.ctx.disable(moderngl.CULL_FACE)
+
+    def finish(self, frame) -> None:
+        """Depth AOV from the hit positions (in conservative mode the Z-buffer holds the box)."""
+        frame.depth = window_depth(frame.position, frame.view, frame.proj, frame.depth)
+
+    def release(self) -> None:
+        for obj in (self.vao, self.vbo, self.ibo, *self.textures.values()):
+            if obj is not None:
+                obj.release()
+        self.vao = self.vbo = self.ibo = None
+        self.textures = {}
+
+
+class ReliefObjectDrawable:
+    """Every part of a ReliefObject (six frusta of a cube) with the same options.
+
+    The parts always write their hit depth: a part whose proxy reaches the near plane is
+    drawn by its back faces, and box depths of front and back faces would not order parts.
+    """
+
+    def __init__(self, ctx, obj: ReliefObject, options: ReliefRenderOptions | None = None,
+                 instrument: bool = False):
+        from dataclasses import replace
+
+        opts = replace(options or ReliefRenderOptions(), depth_mode="exact")
+        self.parts = []
+        try:
+            for part in obj.parts:
+                self.parts.append(ReliefDrawable(ctx, part, opts, instrument))
+        except BaseException:
+            self.release()
+            raise
+        self.extra_attachments = self.parts[0].extra_attachments
+
+    def draw(self, camera, light) -> None:
+        for part in self.parts:
+            part.draw(camera, light)
+
+    def finish(self, frame) -> None:
+        self.parts[0].finish(frame)
+
+    def release(self) -> None:
+        for part in self.parts:
+            part.release()
