@@ -9,6 +9,8 @@ import sys
 import numpy as np
 import pytest
 
+sys.path.insert(0, os.path.dirname(__file__))  # `import helpers` from any test folder
+
 PROBE = ("from reliefkit.gl.context import create_context; "
          "print(create_context().info['GL_RENDERER'])")
 _probe_result: tuple[bool, str] | None = None

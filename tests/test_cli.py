@@ -122,7 +122,7 @@ def test_bake_heightmap_png16_and_npy(gl, tmp_path):
         out = run_cli("bake", tmp_path / name, "--as", "relief", "--box", "3,0.5,2", "-o",
                       tmp_path / "h.rk")
         assert out.returncode == 0, out.stderr
-        from reliefkit.formats import load
+        from reliefkit.io.rk import load
 
         relief = load(tmp_path / "h.rk")
         assert relief.height.shape == (24, 32)
@@ -136,7 +136,7 @@ def test_compare_writes_picture_and_metrics(gl, tmp_path):
                   "--size", "64x64", "--out", tmp_path / "cmp")
     assert out.returncode == 0, out.stderr
     report = json.loads((tmp_path / "cmp" / "metrics.json").read_text())
-    assert set(report["methods"]) == {"binary", "exact", "robust"}
-    assert report["methods"]["exact"]["wrong_hit_fraction"] <= 0.001
+    assert set(report["variants"]) == {"binary", "exact", "robust"}
+    assert report["variants"]["exact"]["wrong_hit_fraction"] <= 0.001
     assert (tmp_path / "cmp" / "compare.png").stat().st_size > 1000
     assert "| robust |" in (tmp_path / "cmp" / "metrics.md").read_text()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .fileio import atomic_path
+from .io.atomic import atomic_path
 
 SHEET_BACKGROUND = (32, 34, 38)
 TITLE_COLOR = (235, 235, 235)

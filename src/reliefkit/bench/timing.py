@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from ..gl.context import bind_home_framebuffer, get_context
+from ..gl.targets import FRAME_ATTACHMENTS
 from ..gl.textures import render_target
 from ..gl.timing import gpu_time_ms
-from ..gl.targets import FRAME_ATTACHMENTS
 from ..render.registry import make_drawables, release_all
 from ..scene.light import DirectionalLight
 

@@ -56,13 +56,13 @@ def register_namespace(name: str, package: str) -> None:
     if _namespaces.get(name, package) != package:
         raise GPUError(f"shader namespace {name!r} is already taken by {_namespaces[name]}")
     _namespaces[name] = package
-    read_shader_file.cache_clear()
+    _read_text.cache_clear()
 
 
 def unregister_namespace(name: str) -> None:
     if name != "core":
         _namespaces.pop(name, None)
-        read_shader_file.cache_clear()
+        _read_text.cache_clear()
 
 
 def qualify(name: str, base: str | None = None) -> str:
@@ -80,10 +80,14 @@ def qualify(name: str, base: str | None = None) -> str:
     return f"{ns}:{path}"
 
 
-@cache
 def read_shader_file(name: str) -> str:
     """The text of the shader ``ns:path``."""
-    ns, path = qualify(name).split(":", 1)
+    return _read_text(qualify(name))
+
+
+@cache
+def _read_text(name: str) -> str:
+    ns, path = name.split(":", 1)
     if ns not in _namespaces:
         from ..core.technique import load_all
 

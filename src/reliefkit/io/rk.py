@@ -16,14 +16,11 @@ checksums and finiteness. Every problem raises `FormatError`. See ``docs/format.
 from __future__ import annotations
 
 import contextlib
-import functools
 import hashlib
 import io
 import json
 import math
-import os
 import re
-import tempfile
 import zipfile
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass

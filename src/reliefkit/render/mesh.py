@@ -4,13 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.technique import DrawableSpec, ProgramVariant
 from ..gl.context import check_gl_error
 from ..gl.shaders import program
 from ..gl.textures import texture2d
+from ..gl.uniforms import camera_uniforms, set_uniforms
 from ..scene.light import DirectionalLight
 from ..scene.mesh import RenderMesh
-from ..gl.uniforms import camera_uniforms, set_uniforms
 from .registry import register_core_drawable
+
+PROGRAM = "core:mesh.glsl"
+MESH_PROGRAMS = tuple(  # the draw-path variants (compiled as GLSL ES by the tests too)
+    ProgramVariant(PROGRAM, {"HAS_TEXTURE": textured, "COUNT_ITERATIONS": counted})
+    for textured in (False, True) for counted in (False, True))
 
 
 class MeshDrawable:
@@ -20,8 +26,8 @@ class MeshDrawable:
         self.ctx, self.mesh = ctx, mesh
         textured = mesh.texture is not None
         self.extra_attachments = 1 if instrument else 0
-        self.prog = program(ctx, "core:mesh.glsl", {"HAS_TEXTURE": textured,
-                                                    "COUNT_ITERATIONS": instrument})
+        self.prog = program(ctx, PROGRAM, {"HAS_TEXTURE": textured,
+                                           "COUNT_ITERATIONS": instrument})
         uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2), np.float32)
         interleaved = np.hstack([mesh.positions, mesh.normals, mesh.colors, uvs]).astype(np.float32)
         self.vbo = ctx.buffer(interleaved.tobytes())
@@ -59,8 +65,6 @@ def render_mesh(mesh: RenderMesh, camera, *, light: DirectionalLight | None = No
 
 
 def _register() -> None:
-    from ..core.technique import DrawableSpec
-
     register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable))
 
 

@@ -16,7 +16,6 @@ from pathlib import Path
 import numpy as np
 
 from ...io.atomic import atomic_path
-
 from .bake import DEFAULT_TOLERANCE
 
 METHODS = ("exact", "robust", "binary")  # the table's column order
@@ -62,11 +61,11 @@ def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
 
 def table1(cfg: BenchConfig, log) -> list[dict]:
     """Frame time per method and for the mesh, iterations per covered pixel (Table 1)."""
-    from .bake import bake_relief
-    from .safety import safety_radii
+    from ...bench.timing import time_render
     from ...render import render
     from ...scene.assets import make_asset
-    from ...bench.timing import time_render
+    from .bake import bake_relief
+    from .safety import safety_radii
 
     safety_radii(np.zeros((8, 8), np.float32))  # compile before measuring
     rows = []
@@ -97,11 +96,11 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
 
 def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
     """Fig. 12: tolerance vs mean radius vs iterations vs silhouette (wrong-hit) error."""
-    from .bake import bake_relief
-    from .safety import safety_radii
-    from .reference import wrong_hits
     from ...render import render
     from ...scene.assets import make_asset
+    from .bake import bake_relief
+    from .reference import wrong_hits
+    from .safety import safety_radii
 
     mesh = make_asset("terrain")
     relief = bake_relief(mesh, depth_res=cfg.tolerance_res, safety=False)
@@ -125,11 +124,11 @@ def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
 
 def correctness(cfg: BenchConfig, log) -> list[dict]:
     """Wrong-hit fraction of each method against the exact reference, grazing views too."""
-    from .bake import bake_relief
-    from .reference import wrong_hits
     from ...render import render
     from ...scene.assets import make_asset
     from ...scene.views import orbit_bounds
+    from .bake import bake_relief
+    from .reference import wrong_hits
 
     rows = []
     for name in ("terrain", "blob", "vehicle"):

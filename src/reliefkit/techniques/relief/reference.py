@@ -24,7 +24,7 @@ def _pixel_rays_in_box(relief: ReliefTexture, camera):
 def reference_hits(relief, camera) -> tuple[np.ndarray, np.ndarray]:
     """(mask (H, W), world positions (H, W, 3) NaN where no hit) of the exact first hits.
 
-    The bottom face of the box is not a surface where the height is 0 (represent/relief.py),
+    The bottom face of the box is not a surface where the height is 0 (representation.py),
     so reference hits on the floor of empty texels count as misses.
     """
     parts = relief.parts if isinstance(relief, ReliefObject) else [relief]

@@ -3,8 +3,8 @@
 Definition (the contract the renderer's robust walk relies on)
 --------------------------------------------------------------
 Texel coordinates, heights and the bilinear, border-clamped surface ``S`` are those of
-:mod:`reliefkit.reference.heightfield`. Let a ray have projected direction ``(dx, dy)`` in
-texel units. If ``|dx| >= |dy|`` it is *x-major*: its walk positions ``P`` are the points
+:mod:`reliefkit.techniques.relief.reference_heightfield`. Let a ray have projected
+direction ``(dx, dy)`` in texel units. If ``|dx| >= |dy|`` it is *x-major*: its walk positions ``P`` are the points
 where it crosses the vertical centerlines ``x = i + 0.5``; the texel of such a ``P`` is
 ``(i, j)`` with ``j = clamp(floor(y_P), 0, H - 1)``, its radius is ``r = safety[j, i]`` and
 the walk jumps to the centerline ``x = i + 0.5 + sign(dx) * r``. A *y-major* ray
@@ -221,7 +221,7 @@ def _line_pieces(height, m, yc, xlo, xstop, work):
 # upper convex hull of the profile behind P
 # ---------------------------------------------------------------------------------------------
 @njit(inline="always", **JIT_OPTIONS)
-def _hull_push(work, nh, x, z):
+def hull_push(work, nh, x, z):
     """Append a point (increasing x) to the upper hull kept as a stack in ``work[4]`` (x) and
     ``work[5]`` (z); returns the new size."""
     if nh > 0 and x <= work[4, nh - 1] + 1e-12:
@@ -241,7 +241,7 @@ def _hull_push(work, nh, x, z):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _tangent_vertex(work, nh, a, z):
+def tangent_vertex(work, nh, a, z):
     """Hull vertex minimising the slope from it to ``(a, z)`` (``a`` right of the hull)."""
     lo = 0
     hi = nh - 1
@@ -304,7 +304,7 @@ def _vertex_at(u, x0, c0, c1, c2, work, nh, eps):
             return nh - 1
         elast = (work[5, nh - 1] - work[5, nh - 2]) / (work[4, nh - 1] - work[4, nh - 2])
         return nh - 1 if c1 <= elast else nh - 2
-    return _tangent_vertex(work, nh, a, _qv(c2, c1, c0, u) - eps)
+    return tangent_vertex(work, nh, a, _qv(c2, c1, c0, u) - eps)
 
 
 @njit(inline="always", **JIT_OPTIONS)
@@ -533,9 +533,9 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
                 # maximum of a concave piece: a better (still conservative) hull sample
                 uc = -work[2, k - 1] / (2.0 * work[3, k - 1])
                 if 0.0 < uc < work[0, k] - work[0, k - 1]:
-                    nh = _hull_push(work, nh, work[0, k - 1] + uc,
+                    nh = hull_push(work, nh, work[0, k - 1] + uc,
                                     _qv(work[3, k - 1], work[2, k - 1], work[1, k - 1], uc))
-            nh = _hull_push(work, nh, work[0, k], work[1, k])
+            nh = hull_push(work, nh, work[0, k], work[1, k])
             k += 1
         if k == 0 or work[0, k - 1] < xp - 1e-9:
             continue  # P is the end of the line: nothing after it

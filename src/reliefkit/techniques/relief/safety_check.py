@@ -24,7 +24,7 @@ from .reference_heightfield import (
     surface_at,
     walk_segments,
 )
-from .safety import checked_height
+from .safety import checked_height, hull_push, tangent_vertex
 
 __all__ = ["CHECK_FLOOR", "Violation", "check_safety"]
 
@@ -167,14 +167,14 @@ def _tangent_candidate(height, px, py, ddx, ddy, radius, tol, delta):
     hull = np.empty((6, bs.shape[0]))
     nh = 0
     for q in range(bs.shape[0]):
-        nh = _hull_push(hull, nh, bs[q], bf[q])
+        nh = hull_push(hull, nh, bs[q], bf[q])
     fs, ff = _profile(height, px, py, ddx, ddy, 0.0, s_end, max(1.0 / 16.0, s_end / 512.0))
     best_b = np.inf
     best_k = 0.0
     best_z = 0.0
     for q in range(1, fs.shape[0]):
         za = ff[q] - tol - delta
-        t = _tangent_vertex(hull, nh, fs[q], za)
+        t = tangent_vertex(hull, nh, fs[q], za)
         k = (za - hull[5, t]) / (fs[q] - hull[4, t])
         for r in range(q + 1, fs.shape[0]):
             if fs[r] >= best_b:
@@ -297,7 +297,7 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     before ``P``). For the others every pair of crossings (down, then up) strictly between
     ``P`` and the jump target ``radius`` centerlines further (cut at the box boundary) whose
     largest depth exceeds ``tolerance + CHECK_FLOOR`` is a violation. Crossings, depths and
-    blocking use only :mod:`reliefkit.reference.heightfield`, not the baker.
+    blocking use only :mod:`reliefkit.techniques.relief.reference_heightfield`, not the baker.
 
     Parameters
     ----------

@@ -7,13 +7,9 @@ import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter
 
-from reliefkit.bake.safety import (
-    CHECK_FLOOR,
-    check_safety,
-    safety_radii,
-    zero_radius_fraction,
-)
 from reliefkit.errors import UsageError
+from reliefkit.techniques.relief.safety import safety_radii, zero_radius_fraction
+from reliefkit.techniques.relief.safety_check import CHECK_FLOOR, check_safety
 
 
 # ---------------------------------------------------------------------------------------------

@@ -3,28 +3,13 @@
 import numpy as np
 import pytest
 import trimesh
+from helpers import BOX, make_relief
 
-from reliefkit.bake.heightfield import heightfield_normals
 from reliefkit.render import render
-from reliefkit.represent.relief import ReliefTexture
 from reliefkit.scene.camera import Camera
 from reliefkit.scene.mesh import RenderMesh, vertex_normals
 
-# box [-1, 1] x [0, 1] x [-1, 1]: u along +x, v along -z, h along +y
-BOX = np.array([[2.0, 0, 0, -1], [0, 0, 1.0, 0], [0, -2.0, 0, 1], [0, 0, 0, 1]])
 METHODS = ["binary", "exact", "robust"]
-
-
-def make_relief(height, box_to_world=BOX, safety=None, rgb=(0.2, 0.6, 0.3)):
-    height = np.asarray(height, np.float32)
-    color = np.zeros(height.shape + (4,), np.uint8)
-    color[..., :3] = np.round(np.array(rgb) * 255)
-    color[..., 3] = 255
-    if safety is None:
-        safety = np.ones(height.shape, np.uint8)
-    return ReliefTexture(height=height, color=color,
-                         normal=heightfield_normals(height, box_to_world),
-                         box_to_world=box_to_world, safety=safety)
 
 
 def flat(level, n=32):
@@ -115,7 +100,7 @@ def test_unknown_option_and_method_are_errors(gl):
 
     relief = make_relief(flat(0.5))
     camera = Camera.orbit((0, 0, 0), 0, 30, 3.0, size=(8, 8))
-    with pytest.raises(UsageError, match="unknown method"):
+    with pytest.raises(UsageError, match="method must be one of binary, exact, robust"):
         render(relief, camera, method="magic")
     with pytest.raises(UsageError, match="unknown render option"):
         render(relief, camera, colour="red")

@@ -9,13 +9,13 @@ guarantee: on rough fields at grazing angles it must be visibly worse, as Fig. 1
 
 import numpy as np
 import pytest
+from helpers import make_relief
 from scipy.ndimage import gaussian_filter
-from test_relief_render import make_relief
 
-from reliefkit.bake.safety import safety_radii
-from reliefkit.reference.relief import wrong_hits
 from reliefkit.render import render
 from reliefkit.scene.camera import Camera
+from reliefkit.techniques.relief.reference import wrong_hits
+from reliefkit.techniques.relief.safety import safety_radii
 
 VIEWS = [(30, 45), (120, 20), (250, 8)]
 

@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 from reliefkit import metrics
-from reliefkit.bake.frustum import bake_relief_cube, bake_relief_frustum
-from reliefkit.bake.heightfield import bake_relief, relief_from_heights
 from reliefkit.render import render
 from reliefkit.scene.assets import make_asset
 from reliefkit.scene.mesh import RenderMesh, vertex_normals
 from reliefkit.scene.views import orbit_bounds
+from reliefkit.techniques.relief.bake import bake_relief, relief_from_heights
+from reliefkit.techniques.relief.frustum import bake_relief_cube, bake_relief_frustum
 
 
 def tilted_plane(n=24):

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from numpy.lib import format as npy
 
-from reliefkit import formats
 from reliefkit.errors import FormatError
-from reliefkit.formats import ArraySpec, Codec
+from reliefkit.io import rk as formats
+from reliefkit.io.rk import ArraySpec, Codec
 from reliefkit.scene.mesh import RenderMesh
 
 SOURCE_HASH = hashlib.sha256(b"source mesh").hexdigest()
