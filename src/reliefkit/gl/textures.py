@@ -78,11 +78,13 @@ def render_target(ctx, width: int, height: int, color_attachments: int):
     return fbo
 
 
-def read_rgba(fbo, attachment: int) -> np.ndarray:
-    """Read one RGBA32F attachment as an (H, W, 4) array with row 0 at the top."""
+def read_rgba(fbo, attachment: int, *, top_row_first: bool = True) -> np.ndarray:
+    """Read one RGBA32F attachment as an (H, W, 4) array with row 0 at the top (a picture),
+    or with ``top_row_first=False`` row 0 at GL's y = 0 (a bake's texture rows)."""
     width, height = fbo.size
     data = fbo.read(attachment=attachment, components=4, dtype="f4")
-    return np.frombuffer(data, np.float32).reshape(height, width, 4)[::-1].copy()
+    image = np.frombuffer(data, np.float32).reshape(height, width, 4)
+    return image[::-1].copy() if top_row_first else image.copy()
 
 
 def read_depth(fbo) -> np.ndarray:
@@ -90,3 +92,59 @@ def read_depth(fbo) -> np.ndarray:
     width, height = fbo.size
     data = fbo.depth_attachment.read()
     return np.frombuffer(data, np.float32).reshape(height, width)[::-1].copy()
+
+
+MAX_TEXTURE3D_BYTES = 2 << 30  # refuse 3D textures above 2 GiB (checked before allocating)
+_DTYPES_3D = {np.dtype(np.uint8): "f1", np.dtype(np.float32): "f4", np.dtype(np.float16): "f2"}
+
+
+def check_3d_size(ctx, width: int, height: int, depth: int, what: str,
+                  nbytes: int | None = None) -> None:
+    """Refuse a 3D texture over GL_MAX_3D_TEXTURE_SIZE or the byte cap, before allocating."""
+    if min(width, height, depth) < 1:
+        raise GPUError(f"{what}: 3D texture size must be positive, got {width}x{height}x{depth}")
+    limit = int(ctx.info["GL_MAX_3D_TEXTURE_SIZE"])
+    if max(width, height, depth) > limit:
+        raise GPUError(f"{what}: a {width}x{height}x{depth} 3D texture exceeds this GPU's limit "
+                       f"of {limit} per side; use a smaller resolution")
+    if nbytes is not None and nbytes > MAX_TEXTURE3D_BYTES:
+        raise GPUError(f"{what}: a {width}x{height}x{depth} 3D texture needs "
+                       f"{nbytes / 2**30:.1f} GiB (limit {MAX_TEXTURE3D_BYTES / 2**30:.0f} GiB); "
+                       "use a smaller resolution or fewer channels")
+
+
+def texture3d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "linear",
+              repeat: bool = False):
+    """Upload a (D, H, W) or (D, H, W, C<=4) array indexed [w, v, u] as a 3D texture.
+
+    numpy C order matches GL's layout: the last axis is the texture's width (u), then its
+    height (v), then its depth (w), so ``array[k, j, i]`` is the texel sampled at
+    ``((i + 0.5) / W, (j + 0.5) / H, (k + 0.5) / D)``. uint8 arrays become normalised
+    textures, float32 and float16 stay float. Sizes are checked before anything is allocated.
+    """
+    import moderngl
+
+    if filter not in ("linear", "nearest"):
+        raise GPUError(f"{what}: filter must be 'linear' or 'nearest', got {filter!r}")
+    arr = np.asarray(array)
+    if arr.ndim == 3:
+        arr = arr[..., None]
+    if arr.ndim != 4 or not 1 <= arr.shape[3] <= 4:
+        raise GPUError(f"{what}: a 3D texture needs a (D, H, W) or (D, H, W, 1..4) array, "
+                       f"got shape {np.shape(array)}")
+    if arr.dtype not in _DTYPES_3D:
+        raise GPUError(f"{what}: unsupported 3D texture dtype {arr.dtype} "
+                       "(use uint8, float16 or float32)")
+    depth, height, width, comps = (int(s) for s in arr.shape)
+    check_3d_size(ctx, width, height, depth, what, nbytes=arr.size * arr.dtype.itemsize)
+    data = np.ascontiguousarray(arr).tobytes()
+    tex = ctx.texture3d((width, height, depth), comps, data, dtype=_DTYPES_3D[arr.dtype])
+    try:
+        mode = moderngl.NEAREST if filter == "nearest" else moderngl.LINEAR
+        tex.filter = (mode, mode)
+        tex.repeat_x = tex.repeat_y = tex.repeat_z = repeat
+        check_gl_error(ctx, f"creating {what} ({width}x{height}x{depth}x{comps} {arr.dtype})")
+    except BaseException:
+        tex.release()
+        raise
+    return tex
