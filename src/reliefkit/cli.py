@@ -35,7 +35,7 @@ def _examples(command: str | None = None) -> list[str]:
 
     table = {name: list(lines) for name, lines in CORE_EXAMPLES.items()}
     for tech in techniques():
-        for name, lines in tech.examples.items():
+        for name, lines in tech.cli_examples.items():
             table.setdefault(name, []).extend(lines)
     names = [command] if command else [n for n in ORDER if n in table]
     return [line for name in names for line in table.get(name, [])]
@@ -267,7 +267,7 @@ def _background(text: str):
 
 def cmd_render(args) -> int:
     from .io.inputs import load_input
-    from .pictures import save_gif
+    from .pictures import TILE_BACKGROUND, save_gif
     from .render import render, render_options
     from .scene.views import orbit_bounds, parse_size, parse_view, turntable
 
@@ -292,7 +292,7 @@ def cmd_render(args) -> int:
         with progress_bar("turntable", len(cameras)) as advance:
             for k, camera in enumerate(cameras):
                 frames.append(render(obj, camera, **options).rgba8(
-                    background or (0.12, 0.12, 0.13)))
+                    background or TILE_BACKGROUND))
                 advance(k + 1)
         save_gif(frames, args.output)
         print(f"wrote {args.output} ({len(frames)} views)")

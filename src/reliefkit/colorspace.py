@@ -1,4 +1,4 @@
-"""The sRGB transfer function (exact piecewise form), used for files and pictures."""
+"""The sRGB transfer function (exact piecewise form, IEC 61966-2-1): the one copy of it."""
 
 from __future__ import annotations
 
@@ -13,10 +13,9 @@ def srgb_encode(linear) -> np.ndarray:
 
 
 def srgb_decode(encoded) -> np.ndarray:
-    """sRGB-encoded [0, 1] -> linear [0, 1] (float32)."""
+    """sRGB-encoded [0, 1] -> linear [0, 1] (float64; values outside [0, 1] are clipped)."""
     x = np.clip(np.asarray(encoded, dtype=np.float64), 0.0, 1.0)
-    return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4)).astype(
-        np.float32)
+    return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))
 
 
 def to_rgba8(color: np.ndarray) -> np.ndarray:

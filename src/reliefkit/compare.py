@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from .io.atomic import atomic_path
+from .pictures import TILE_BACKGROUND
 
-SHEET_BACKGROUND = (0.05, 0.055, 0.065)  # linear grey behind every tile of a picture
 CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
                 "iterations_max")
 
@@ -67,7 +67,7 @@ def comparison_sheet(result: dict, title: str):
     from .pictures import contact_sheet
 
     frames, truth = result["frames"], result["frames"]["mesh"]
-    tiles = [(name, frame.rgba8(SHEET_BACKGROUND)) for name, frame in frames.items()]
+    tiles = [(name, frame.rgba8(TILE_BACKGROUND)) for name, frame in frames.items()]
     last = frames[list(result["errors"])[-1]]
     tiles.append(("coverage vs mesh", _rgba(metrics.error_image(last, truth, "mask"))))
     for name, mask in result["errors"].items():

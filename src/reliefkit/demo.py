@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .compare import SHEET_BACKGROUND
 from .core.technique import DemoTile
 from .io.atomic import atomic_path
+from .pictures import TILE_BACKGROUND
 
 
 def _asset(name: str) -> Callable[[], object]:
@@ -58,7 +58,7 @@ def build_demo(out_dir: Path, tile_size=(256, 256), columns: int = 4) -> Path:
         for k, tile in enumerate(tiles):
             obj = tile.make()
             camera = orbit_bounds(obj.bounds, *tile.view, size=tile_size)
-            rgba = render(obj, camera, **(tile.options or {})).rgba8(SHEET_BACKGROUND)
+            rgba = render(obj, camera, **(tile.options or {})).rgba8(TILE_BACKGROUND)
             with atomic_path(out_dir / f"{tile.slug}.png") as tmp:
                 Image.fromarray(rgba, "RGBA").save(tmp, format="PNG")
             images.append((tile.title, rgba))

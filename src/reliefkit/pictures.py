@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import UsageError
 from .io.atomic import atomic_path
 
-SHEET_BACKGROUND = (32, 34, 38)
+TILE_BACKGROUND = (0.05, 0.055, 0.065)  # linear grey behind every rendered tile and frame
+SHEET_BACKGROUND = (32, 34, 38)         # sRGB bytes between the tiles of a sheet
 TITLE_COLOR = (235, 235, 235)
 
 
@@ -25,7 +27,7 @@ def contact_sheet(tiles: list[tuple[str, np.ndarray]], columns: int = 4, *,
     from PIL import Image, ImageDraw
 
     if not tiles:
-        raise ValueError("contact_sheet needs at least one tile")
+        raise UsageError("contact_sheet needs at least one tile")
     tile_h = max(img.shape[0] for _, img in tiles)
     tile_w = max(img.shape[1] for _, img in tiles)
     columns = max(1, min(columns, len(tiles)))

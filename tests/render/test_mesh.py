@@ -93,7 +93,7 @@ def test_sphere_positions_lie_on_sphere_and_on_pixel_rays(gl):
 
 
 def test_lambert_shading_follows_light(gl):
-    from reliefkit.render.mesh import render_mesh
+    from reliefkit.render import render as render_mesh
     from reliefkit.scene.light import DirectionalLight
 
     camera = Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(16, 16))
@@ -138,7 +138,7 @@ def test_textured_glb_renders_its_texture_the_right_way_up(gl, tmp_path):
         material=trimesh.visual.material.SimpleMaterial(image=image, diffuse=(255, 255, 255)))
     quad.export(tmp_path / "quad.glb")
     mesh = load_mesh(tmp_path / "quad.glb")
-    from reliefkit.render.mesh import render_mesh
+    from reliefkit.render import render as render_mesh
     from reliefkit.scene.light import DirectionalLight
 
     flat = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)

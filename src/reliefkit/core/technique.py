@@ -127,6 +127,9 @@ class Technique:
 
     ``package`` is the technique's Python package (``__name__`` of its ``__init__``); its
     ``shaders/`` folder becomes the shader namespace ``name`` (``"relief:relief.glsl"``).
+    ``samples()`` returns one small representation per kind, which the contract tests
+    (tests/contracts/) round-trip, forge and render; ``programs`` are the draw-path shader
+    variants the portability test compiles as GLSL ES.
     """
 
     name: str
@@ -141,7 +144,8 @@ class Technique:
     bench_suites: tuple[BenchSuite, ...] = ()
     demo_tiles: Callable[[], list[DemoTile]] | None = None
     programs: tuple[ProgramVariant, ...] = ()
-    examples: dict = field(default_factory=dict)  # CLI command -> example lines for --help
+    samples: Callable[[], dict] | None = None  # kind -> a small representation (contract tests)
+    cli_examples: dict = field(default_factory=dict)  # CLI command -> example lines for --help
 
     @property
     def kinds(self) -> tuple[str, ...]:

@@ -77,11 +77,6 @@ def gl_info(ctx=None) -> dict:
     return out
 
 
-def is_llvmpipe(ctx=None) -> bool:
-    """True on Mesa's CPU rasterizer, the reference the pixel tests are written for."""
-    return "llvmpipe" in str((ctx or get_context()).info.get("GL_RENDERER", "")).lower()
-
-
 def check_gl_error(ctx, what: str) -> None:
     """Raise GPUError if the GL error flag is set (moderngl does not check it for us)."""
     err = ctx.error

@@ -57,13 +57,6 @@ class MeshDrawable:
                 obj.release()
 
 
-def render_mesh(mesh: RenderMesh, camera, *, light: DirectionalLight | None = None, ctx=None):
-    """Rasterize ``mesh`` seen by ``camera`` with Phong shading; returns a Frame."""
-    from .registry import render
-
-    return render(mesh, camera, light=light, ctx=ctx)
-
-
 def _register() -> None:
     register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable))
 

@@ -7,10 +7,11 @@ is the ray through window coordinates (c + 0.5, H - 1 - r + 0.5); row 0 is the t
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.transforms import transform_points
 from ..errors import UsageError
 
 
@@ -133,9 +134,6 @@ class Camera:
         """(x, y, width, height) as GL's glViewport takes it."""
         return np.array([0, 0, self.size[0], self.size[1]], dtype=np.int32)
 
-    def with_size(self, size) -> Camera:
-        return replace(self, size=tuple(size))
-
     def pixel_rays(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space ray origins and unit directions per pixel, (H, W, 3) each, row 0 on top."""
         w, h = self.size
@@ -150,9 +148,7 @@ class Camera:
 
 
 def _unproject(inv: np.ndarray, x: np.ndarray, y: np.ndarray, z: float) -> np.ndarray:
-    clip = np.stack([x, y, np.full_like(x, z), np.ones_like(x)], axis=-1)
-    world = clip @ inv.T
-    return world[..., :3] / world[..., 3:4]
+    return transform_points(inv, np.stack([x, y, np.full_like(x, z)], axis=-1))
 
 
 @dataclass(frozen=True, eq=False)

@@ -54,6 +54,22 @@ def _demo_tiles():
     return demo_tiles()
 
 
+def _samples() -> dict:
+    """A 16x16 terrain-like relief with safety radii, and a two-part object of two boxes."""
+    import numpy as np
+
+    u, v = np.meshgrid(np.linspace(0, 1, 16), np.linspace(0, 1, 16))
+    heights = 0.5 + 0.3 * np.sin(6 * u) * np.cos(5 * v)
+    relief = relief_from_heights(heights, size=(2.0, 0.5, 2.0))
+    lifted = relief.box_to_world.copy()
+    lifted[1, 3] += 0.6
+    second = ReliefTexture(height=relief.height, color=relief.color,
+                           normal=relief.normal, box_to_world=lifted, safety=relief.safety,
+                           clip_bounds=np.array([[-1.0, 0.6, -1.0], [1.0, 1.0, 1.0]]))
+    return {"relief": relief,
+            "relief-object": ReliefObject(parts=[relief, second], params={"projection": "test"})}
+
+
 def _programs() -> tuple[ProgramVariant, ...]:
     flags = {"WRITE_DEPTH": True, "SHADOWS": True, "COUNT_ITERATIONS": True}
     return tuple(ProgramVariant(PROGRAM, {f"METHOD_{m.upper()}": True} | extra)
@@ -85,7 +101,8 @@ TECHNIQUE = Technique(
                              _bench),),
     demo_tiles=_demo_tiles,
     programs=_programs(),
-    examples={
+    samples=_samples,
+    cli_examples={
         "render": ["reliefkit render terrain.rk --method robust --shadows -o terrain.png",
                    "reliefkit render terrain.rk --method exact --stats stats.json -o t.png"],
         "bake": ["reliefkit bake demo:terrain --as relief --depth-res 256 -o terrain.rk",

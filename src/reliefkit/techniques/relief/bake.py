@@ -173,7 +173,7 @@ _RAMP_SRGB = np.array([[40, 90, 110], [90, 140, 60], [140, 120, 80], [150, 150, 
 def height_ramp(h: np.ndarray) -> np.ndarray:
     """(H, W, 3) linear colours for heights in [0, 1]."""
     rgb = np.stack([np.interp(h, _RAMP_STOPS, _RAMP_SRGB[:, k]) for k in range(3)], -1)
-    return srgb_decode(rgb)
+    return srgb_decode(rgb).astype(np.float32)
 
 
 def _heightmap_color(h: np.ndarray, color) -> np.ndarray:

@@ -17,8 +17,7 @@ import numpy as np
 
 from ...io.atomic import atomic_path
 from .bake import DEFAULT_TOLERANCE
-
-METHODS = ("exact", "robust", "binary")  # the table's column order
+from .render import METHODS
 
 
 @dataclass
@@ -200,13 +199,14 @@ def markdown(results: dict) -> str:
              f"Relief textures baked with safety tolerance {results['config']['tolerance']} "
              "(robust method, zero radii walked exactly).", "",
              "#### Table 1: frame time (ms) and loop iterations per fragment (mean / max)", "",
-             "| model | depth res | mesh ms | exact ms | robust ms | binary ms | exact it | "
-             "robust it | binary it | robust/binary time |", "|---" * 10 + "|"]
+             "| model | depth res | mesh ms | " + " | ".join(f"{m} ms" for m in METHODS)
+             + " | " + " | ".join(f"{m} it" for m in METHODS) + " | robust/binary time |",
+             "|---" * (4 + 2 * len(METHODS)) + "|"]
     for r in results["table1"]:
+        times = [f"{r[f'{k}_ms']:.1f}" for k in METHODS]
         its = [f"{r[f'{k}_it_mean']:.1f} / {r[f'{k}_it_max']}" for k in METHODS]
-        lines.append(f"| {r['model']} | {r['res']}² | {r['mesh_ms']:.1f} | {r['exact_ms']:.1f} | "
-                     f"{r['robust_ms']:.1f} | {r['binary_ms']:.1f} | " + " | ".join(its)
-                     + f" | {r['robust_ms'] / r['binary_ms']:.2f} |")
+        lines.append(f"| {r['model']} | {r['res']}² | {r['mesh_ms']:.1f} | " + " | ".join(times)
+                     + " | " + " | ".join(its) + f" | {r['robust_ms'] / r['binary_ms']:.2f} |")
     lines += ["", "#### Fig. 12: safety tolerance (terrain, robust method)", "",
               "| tolerance | zero radius | mean radius | zero-radius texels | iterations | "
               "wrong pixels |", "|---" * 6 + "|"]
@@ -215,10 +215,11 @@ def markdown(results: dict) -> str:
                      f"{r['zero_fraction']:.1%} | {r['iterations_mean']:.1f} | "
                      f"{r['wrong_fraction']:.3%} |")
     lines += ["", "#### Correctness: wrong-hit fraction against the exact reference", "",
-              "| model | view (az, el) | exact | robust | binary |", "|---" * 5 + "|"]
+              "| model | view (az, el) | " + " | ".join(METHODS) + " |",
+              "|---" * (2 + len(METHODS)) + "|"]
     for r in results["correctness"]:
-        lines.append(f"| {r['model']} | {r['azimuth']}, {r['elevation']} | {r['exact']:.3%} | "
-                     f"{r['robust']:.3%} | {r['binary']:.3%} |")
+        lines.append(f"| {r['model']} | {r['azimuth']}, {r['elevation']} | "
+                     + " | ".join(f"{r[m]:.3%}" for m in METHODS) + " |")
     lines += ["", f"#### Safety radii (tolerance {results['config']['tolerance']})", "",
               "| model | resolution | seconds | mean radius |", "|---" * 4 + "|"]
     for r in results["table1"]:

@@ -3,12 +3,13 @@
 Definition (the contract the renderer's robust walk relies on)
 --------------------------------------------------------------
 Texel coordinates, heights and the bilinear, border-clamped surface ``S`` are those of
-:mod:`reliefkit.techniques.relief.reference_heightfield`. Let a ray have projected
-direction ``(dx, dy)`` in texel units. If ``|dx| >= |dy|`` it is *x-major*: its walk positions ``P`` are the points
-where it crosses the vertical centerlines ``x = i + 0.5``; the texel of such a ``P`` is
-``(i, j)`` with ``j = clamp(floor(y_P), 0, H - 1)``, its radius is ``r = safety[j, i]`` and
-the walk jumps to the centerline ``x = i + 0.5 + sign(dx) * r``. A *y-major* ray
-(``|dy| > |dx|``) is the same with the roles of x and y (rows and columns) swapped.
+:mod:`reliefkit.techniques.relief.reference_heightfield`. Let a ray have projected direction
+``(dx, dy)`` in texel units. If ``|dx| >= |dy|`` it is *x-major*: its walk positions ``P``
+are the points where it crosses the vertical centerlines ``x = i + 0.5``; the texel of such
+a ``P`` is ``(i, j)`` with ``j = clamp(floor(y_P), 0, H - 1)``, its radius is ``r =
+safety[j, i]`` and the walk jumps to the centerline ``x = i + 0.5 + sign(dx) * r``. A
+*y-major* ray (``|dy| > |dx|``) is the same with the roles of x and y (rows and columns)
+swapped.
 
 ``safety[j, i]`` is the largest ``n <= max_radius`` such that, for every ray (every
 projected direction, every vertical slope up or down, every crossing point ``P`` of that
