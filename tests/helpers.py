@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
 from reliefkit.techniques.relief.bake import heightfield_normals
@@ -21,3 +23,40 @@ def make_relief(height, box_to_world=BOX, safety=None, rgb=(0.2, 0.6, 0.3)):
     return ReliefTexture(height=height, color=color,
                          normal=heightfield_normals(height, box_to_world),
                          box_to_world=box_to_world, safety=safety)
+
+
+@contextlib.contextmanager
+def toy_technique():
+    """Plug the toy technique (tests/toy_technique) in for the duration of a test."""
+    import toy_technique
+
+    from reliefkit.core.technique import load_all, register, unregister
+
+    load_all()
+    register(toy_technique.TECHNIQUE)
+    try:
+        yield toy_technique
+    finally:
+        unregister(toy_technique.TECHNIQUE.name)
+
+
+def technique_samples() -> list[tuple[str, str]]:
+    """(technique, kind) of every sample representation: the built-ins and the toy's."""
+    import toy_technique
+
+    from reliefkit.core.technique import load_all
+
+    out = []
+    for tech in (*load_all(), toy_technique.TECHNIQUE):
+        assert tech.samples is not None, f"technique {tech.name} declares no samples"
+        out += [(tech.name, kind) for kind in tech.samples()]
+    return out
+
+
+def sample(technique_name: str, kind: str):
+    import toy_technique
+
+    from reliefkit.core.technique import load_all
+
+    table = {t.name: t for t in (*load_all(), toy_technique.TECHNIQUE)}
+    return table[technique_name].samples()[kind]

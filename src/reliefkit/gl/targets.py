@@ -79,22 +79,33 @@ def draw_passes(ctx, size, opaque: Callable[[], None], transparent: list[Callabl
         depth.release()
 
 
+class _Owned:
+    """A lone texture in the list of framebuffers to release (it has no attachments)."""
+
+    color_attachments = ()
+
+    def __init__(self, texture):
+        self.texture = texture
+
+    def release(self) -> None:
+        self.texture.release()
+
+
 def _transparent_pass(ctx, opaque_fbo, draws, made) -> tuple:
     import moderngl
 
     width, height = opaque_fbo.size
-    colors = [ctx.texture((width, height), 4, dtype="f4") for _ in range(3)]
+    # cleared by uploading zeros: fbo.clear() would also clear the shared opaque depth
+    zeros = np.zeros((height, width, 4), np.float32).tobytes()
+    colors = [ctx.texture((width, height), 4, zeros, dtype="f4") for _ in range(3)]
     fbo = ctx.framebuffer(color_attachments=colors, depth_attachment=opaque_fbo.depth_attachment)
     made.append(fbo)
-    front = ctx.texture((width, height), 4, dtype="f4")
+    front = ctx.texture((width, height), 4, zeros, dtype="f4")
     front.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    holder = ctx.framebuffer(color_attachments=[front])
-    made.append(holder)
+    made.append(_Owned(front))
+    fbo.depth_mask = False
     fbo.use()
     fbo.viewport = (0, 0, width, height)
-    fbo.clear(0.0, 0.0, 0.0, 0.0)
-    holder.clear(0.0, 0.0, 0.0, 0.0)
-    fbo.depth_mask = False
     for draw in draws:
         fbo.use()
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
@@ -102,6 +113,6 @@ def _transparent_pass(ctx, opaque_fbo, draws, made) -> tuple:
         front.use(FRONT_OPACITY_UNIT)
         draw()
         ctx.disable(moderngl.BLEND)
-        ctx.copy_framebuffer(holder, fbo)  # attachment 0: the opacity accumulated so far
+        ctx.copy_framebuffer(front, fbo)  # attachment 0: the opacity accumulated so far
     check_gl_error(ctx, "drawing the transparent pass")
     return tuple(read_rgba(fbo, i) for i in range(3))

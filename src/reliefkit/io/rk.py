@@ -417,7 +417,7 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
         return codec.from_arrays(dict(rk.arrays), dict(rk.params))
     except FormatError as exc:
         raise FormatError(f"{path}: {exc}") from exc
-    except (ReliefkitError, KeyError, TypeError, ValueError) as exc:
+    except (ReliefkitError, KeyError, TypeError, ValueError, ArithmeticError) as exc:
         raise FormatError(f"{path}: invalid {rk.kind} data ({exc}); the file is corrupt or "
                           "forged") from exc
 

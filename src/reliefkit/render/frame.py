@@ -88,7 +88,7 @@ def frame_from_passes(camera, images) -> Frame:
     color = np.where(covered[..., None], images.color, 0.0)
     pos = np.where(covered[..., None], images.position[..., :3], np.nan)
     nrm = np.where(covered[..., None], images.normal[..., :3], 0.0)
-    depth = images.depth
+    depth = np.where(covered, images.depth, 1.0)  # counted misses leave depth below 1
     mask = covered
     if images.transparent is not None:
         t_color, t_pos, t_nrm = images.transparent

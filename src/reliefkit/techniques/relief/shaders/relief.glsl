@@ -60,9 +60,7 @@ void main() {
     float s_hit;
     if (!relief_intersect(o_t, d_t, s0, s1, s_hit, iters)) {
 #if defined COUNT_ITERATIONS
-        // the instrumented pass keeps misses (uncovered: coverage 0) to count their work
-        f_color = vec4(0.0); f_position = vec4(0.0); f_normal = vec4(0.0);
-        write_iterations(iters, 0, false);
+        write_counted_miss(iters);  // count the work of a miss without drawing it
         return;
 #else
         discard;
@@ -100,6 +98,8 @@ void main() {
     write_iterations(iters, shadow_iters, true);
 #if defined WRITE_DEPTH
     gl_FragDepth = window_depth(hit);
+#elif defined COUNT_ITERATIONS
+    gl_FragDepth = gl_FragCoord.z;  // the counted-miss path writes depth, so every path does
 #endif
 }
 #endif
