@@ -220,14 +220,6 @@ def test_bad_parameters_raise_usage_error(call):
         call()
 
 
-def test_srgb_to_linear_known_values():
-    np.testing.assert_allclose(
-        assets.srgb_to_linear([0.0, 0.04045, 0.5, 1.0]),
-        [0.0, 0.04045 / 12.92, 0.21404114, 1.0],
-        rtol=1e-6,
-    )
-
-
 # ----------------------------------------------------------------------------- terrain
 
 

@@ -14,7 +14,6 @@ import trimesh
 from PIL import Image
 
 from reliefkit.errors import MeshError
-from reliefkit.scene import loader
 from reliefkit.scene.loader import SUPPORTED_EXTENSIONS, load_mesh
 from reliefkit.scene.mesh import vertex_normals
 
@@ -380,7 +379,7 @@ def test_keyboard_interrupt_is_not_converted(tmp_path, monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(loader.trimesh, "load_scene", interrupted)
+    monkeypatch.setattr(trimesh, "load_scene", interrupted)
     with pytest.raises(KeyboardInterrupt):
         load_mesh(write_export(quad(), tmp_path / "q.obj"))
 

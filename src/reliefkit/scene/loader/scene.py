@@ -1,0 +1,99 @@
+"""Flattening a trimesh scene into `Part`s: every instance of every triangle geometry, placed.
+
+Scene-graph transforms are applied in the file's own world coordinates (never rescaled or
+recentred).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import trimesh
+
+from .badfile import BadFile, check_range
+from .materials import base_color, decode_colors, is_face_colored
+from .normals import file_normals
+
+
+@dataclass(frozen=True)
+class Part:
+    """One triangle geometry as it will enter the merged mesh."""
+
+    positions: np.ndarray  # (V, 3) float64
+    faces: np.ndarray  # (F, 3) int64, indices into this part
+    normals: np.ndarray  # (V, 3) float64 from the file; NaN rows where there are none
+    colors: np.ndarray  # (V, 4) float64 linear RGBA
+    uvs: np.ndarray | None = None  # (V, 2) float64
+    texture: np.ndarray | None = None  # (h, w, 4) uint8 sRGB, row 0 at v = 0
+
+
+def scene_parts(scene: trimesh.Scene, srgb: bool) -> list[Part]:
+    """Every instance of every triangle geometry, placed in world space."""
+    local: dict[str, Part | None] = {}
+    parts = []
+    several = len(scene.geometry) > 1
+    for node in scene.graph.nodes_geometry:
+        matrix, geometry_name = scene.graph[node]
+        if geometry_name not in local:
+            geometry = scene.geometry[geometry_name]
+            where = f" in mesh '{geometry_name}'" if several else ""
+            local[geometry_name] = _local_part(geometry, srgb, where)
+        part = local[geometry_name]
+        if part is not None:
+            parts.append(_placed(part, np.asarray(matrix, dtype=np.float64)))
+    return parts
+
+
+def _local_part(geometry, srgb: bool, where: str) -> Part | None:
+    """A trimesh geometry as a `Part`; None for points, lines and meshes without faces."""
+    if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
+        return None
+    positions = np.asarray(geometry.vertices, dtype=np.float64)
+    faces = np.asarray(geometry.faces, dtype=np.int64)
+    check_range(faces, len(positions), where)
+    bad = int((~np.isfinite(positions)).any(axis=1).sum())
+    if bad:
+        raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates{where}")
+    surface = base_color(geometry.visual, len(positions), srgb)
+    part = Part(positions, faces, file_normals(geometry), *surface)
+    if is_face_colored(geometry.visual):
+        corner_colors = np.repeat(decode_colors(geometry.visual.face_colors, srgb), 3, axis=0)
+        part = replace(_unshared(part), colors=corner_colors)
+    return part
+
+
+def _vertices_have(count: int) -> str:
+    return "1 vertex has" if count == 1 else f"{count} vertices have"
+
+
+def _unshared(part: Part) -> Part:
+    """The same triangles with three vertices of their own each (for per-face attributes)."""
+    corners = part.faces.reshape(-1)
+    return Part(
+        positions=part.positions[corners],
+        faces=np.arange(len(corners), dtype=np.int64).reshape(-1, 3),
+        normals=part.normals[corners],
+        colors=part.colors[corners],
+        uvs=None if part.uvs is None else part.uvs[corners],
+        texture=part.texture,
+    )
+
+
+def _placed(part: Part, matrix: np.ndarray) -> Part:
+    """`part` moved by a 4x4 scene-graph matrix; a mirroring matrix reverses the winding."""
+    if np.array_equal(matrix, np.eye(4)):
+        return part
+    linear = matrix[:3, :3]
+    det = np.linalg.det(linear)
+    with np.errstate(all="ignore"):
+        positions = part.positions @ linear.T + matrix[:3, 3]
+        # the cofactor matrix is det * inverse-transpose (and defined for singular matrices):
+        # times sign(det) it maps normals to the side the transformed winding faces
+        cofactor = np.cross(linear.T[[1, 2, 0]], linear.T[[2, 0, 1]])
+        normals = part.normals @ (np.sign(det) * cofactor).T
+    bad = int((~np.isfinite(positions)).any(axis=1).sum())
+    if bad:
+        raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates after the scene transforms")
+    faces = part.faces[:, ::-1] if det < 0 else part.faces
+    return replace(part, positions=positions, faces=np.ascontiguousarray(faces), normals=normals)
