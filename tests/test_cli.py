@@ -82,8 +82,21 @@ def test_bake_render_info_relief(gl, tmp_path):
     info = json.loads(run_cli("info", "--json", rk).stdout)
     assert info["file"]["kind"] == "relief" and "safety" in info["file"]["arrays"]
     out = run_cli("render", rk, "--method", "exact", "--shadows", "--size", "32x32", "-o",
-                  tmp_path / "t.png")
+                  tmp_path / "t.png", "--stats", tmp_path / "s.json")
     assert out.returncode == 0, out.stderr
+    from PIL import Image
+
+    stats = json.loads((tmp_path / "s.json").read_text())
+    covered = int((np.asarray(Image.open(tmp_path / "t.png"))[..., 3] > 0).sum())
+    assert stats["covered"] == covered > 0
+    assert stats["fragments"] >= stats["covered"]
+    assert stats["iterations_max"] >= stats["iterations_mean"] > 0
+    assert_one_line_error(run_cli("render", "demo:tree", "--method", "exact", "-o",
+                                  tmp_path / "m.png"), "--method does not apply", "RenderMesh")
+    assert_one_line_error(run_cli("render", rk, "--method", "magic", "-o", tmp_path / "m.png"),
+                          "method must be one of binary, exact, robust")
+    assert_one_line_error(run_cli("bake", "demo:tree", "--as", "relief-cube", "--spread", "9",
+                                  "-o", tmp_path / "c.rk"), "--spread does not apply")
 
 
 @pytest.mark.parametrize("args, words", [

@@ -47,7 +47,7 @@ class ToyQuad:
         self.color = np.asarray(self.color, dtype=np.float32)
         if self.corners.shape != (4, 3) or self.color.shape != (4,):
             raise UsageError("a toy quad has (4, 3) corners and an RGBA colour")
-        if not (np.isfinite(self.color).all() and (0 <= self.color).all()
+        if not (np.isfinite(self.color).all() and (self.color >= 0).all()
                 and (self.color <= 1).all()):
             raise UsageError("toy quad colour must lie in [0, 1]")
 
