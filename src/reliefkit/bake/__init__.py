@@ -3,6 +3,9 @@
 
 from __future__ import annotations
 
+from .project import Projection, axis_frame, cube_face_frames, project_mesh
+from .voxelize import VoxelGrid, voxelize
+
 
 def bake(source, kind: str, *, progress=None, **params):
     """Bake a RenderMesh (or a 2D height array) into the representation ``kind``.
@@ -32,4 +35,5 @@ def bake_kinds() -> tuple[str, ...]:
     return tuple(bakers())
 
 
-__all__ = ["bake", "bake_kinds"]
+__all__ = ["bake", "bake_kinds", "project_mesh", "Projection", "axis_frame", "cube_face_frames",
+           "voxelize", "VoxelGrid"]
