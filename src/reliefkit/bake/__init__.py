@@ -1,10 +1,8 @@
-"""Baking: `bake(source, kind, **params)` through the registered bakers, and what bakers share
-(`project`: a mesh through any box; `voxelize`: a mesh into a 3D grid)."""
+"""Baking: `bake(source, kind, **params)` through the registered bakers, and what bakers share:
+`reliefkit.bake.project.project_mesh` (a mesh through any box) and
+`reliefkit.bake.voxelize.voxelize` (a mesh into a 3D grid)."""
 
 from __future__ import annotations
-
-from .project import Projection, axis_frame, cube_face_frames, project_mesh
-from .voxelize import VoxelGrid, voxelize
 
 
 def bake(source, kind: str, *, progress=None, **params):
@@ -35,5 +33,4 @@ def bake_kinds() -> tuple[str, ...]:
     return tuple(bakers())
 
 
-__all__ = ["bake", "bake_kinds", "project_mesh", "Projection", "axis_frame", "cube_face_frames",
-           "voxelize", "VoxelGrid"]
+__all__ = ["bake", "bake_kinds"]
