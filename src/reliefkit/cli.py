@@ -62,10 +62,11 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _add_view_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--view", default=",".join(f"{x:g}" for x in DEFAULT_VIEW),
-                   metavar="AZ,EL,DIST",
-                   help="orbit the bounding-box centre: azimuth and elevation in degrees, "
-                        "distance in bounding-sphere radii (default: %(default)s)")
+    p.add_argument("--view", default=",".join(f"{x:g}" for x in DEFAULT_VIEW[:2]),
+                   metavar="AZ,EL[,DIST]",
+                   help="orbit the bounding-box centre (of the source mesh for a baked .rk): "
+                        "azimuth and elevation in degrees, distance in bounding-sphere radii "
+                        "(default: %(default)s, at the distance that fits the sphere in view)")
     p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
                    help="image size in pixels (default: %(default)s)")
     p.add_argument("--fov", type=float, default=40.0, help="vertical field of view in degrees")
@@ -269,7 +270,7 @@ def cmd_render(args) -> int:
     from .io.inputs import load_input
     from .pictures import TILE_BACKGROUND, save_gif
     from .render import render, render_options
-    from .scene.views import orbit_bounds, parse_size, parse_view, turntable
+    from .scene.views import framing_bounds, orbit_bounds, parse_size, parse_view, turntable
 
     az, el, dist = parse_view(args.view)
     size = parse_size(args.size)
@@ -287,7 +288,7 @@ def cmd_render(args) -> int:
     if args.turntable is not None:
         from .progress import progress_bar
 
-        cameras = turntable(obj.bounds, args.turntable, el, dist, size, args.fov)
+        cameras = turntable(framing_bounds(obj), args.turntable, el, dist, size, args.fov)
         frames = []
         with progress_bar("turntable", len(cameras)) as advance:
             for k, camera in enumerate(cameras):
@@ -297,7 +298,7 @@ def cmd_render(args) -> int:
         save_gif(frames, args.output)
         print(f"wrote {args.output} ({len(frames)} views)")
         return 0
-    camera = orbit_bounds(obj.bounds, az, el, dist, size, args.fov)
+    camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
     frame = render(obj, camera, **options)
     frame.save(args.output, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")

@@ -1,4 +1,9 @@
-"""Placing cameras around anything with ``bounds``: the CLI's --view and --size."""
+"""Placing cameras around anything with ``bounds``: the CLI's --view and --size.
+
+A mesh and every representation baked from it are framed by the same box: a baked
+representation keeps its source mesh's bounds (``source_bounds``), so one ``--view`` gives one
+camera for all of them (`framing_bounds`).
+"""
 
 from __future__ import annotations
 
@@ -7,17 +12,24 @@ import numpy as np
 from ..errors import UsageError
 from .camera import Camera
 
-DEFAULT_VIEW = (30.0, 25.0, 2.6)
+DEFAULT_VIEW = (30.0, 25.0, None)  # distance None: fit the bounding sphere in the view
+FIT_MARGIN = 1.05                  # the fitted sphere fills 1 / FIT_MARGIN of the view
 DEFAULT_SIZE = (512, 512)
 
 
-def parse_view(text: str) -> tuple[float, float, float]:
-    """'AZ,EL,DIST' -> floats (degrees, degrees, bounding-sphere radii)."""
+def parse_view(text: str) -> tuple[float, float, float | None]:
+    """'AZ,EL[,DIST]' -> (degrees, degrees, bounding-sphere radii or None: fit the view)."""
+    parts = text.split(",")
     try:
-        az, el, dist = (float(part) for part in text.split(","))
+        if len(parts) not in (2, 3):
+            raise ValueError
+        az, el = float(parts[0]), float(parts[1])
+        dist = float(parts[2]) if len(parts) == 3 else None
     except ValueError:
-        raise UsageError(f"--view must be AZ,EL,DIST (e.g. 30,25,2.6), got {text!r}") from None
-    if not all(np.isfinite((az, el, dist))) or dist <= 0:
+        raise UsageError(f"--view must be AZ,EL or AZ,EL,DIST (e.g. 30,25 or 30,25,2.6), got "
+                         f"{text!r}") from None
+    if not np.isfinite((az, el)).all() or (dist is not None and not (np.isfinite(dist)
+                                                                      and dist > 0)):
         raise UsageError(f"--view needs finite angles and a positive distance, got {text!r}")
     if abs(el) >= 90:
         raise UsageError(f"--view elevation must be strictly between -90 and 90, got {el}")
@@ -42,10 +54,28 @@ def bounds_radius(bounds) -> float:
     return r if r > 0 else 1.0
 
 
-def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float,
+def fit_distance(size, fov_deg: float = 40.0) -> float:
+    """Distance in bounding-sphere radii at which the sphere fits the view (both directions)."""
+    w, h = size
+    half_v = np.radians(fov_deg) / 2
+    half_h = np.arctan(np.tan(half_v) * w / h)
+    return FIT_MARGIN / float(np.sin(min(half_v, half_h)))
+
+
+def framing_bounds(obj) -> np.ndarray:
+    """The box a view of ``obj`` is framed by: its source mesh's bounds for a baked
+    representation that keeps them, else its own bounds."""
+    source = getattr(obj, "source_bounds", None)
+    return np.asarray(source if source is not None else obj.bounds, dtype=np.float64)
+
+
+def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float | None = None,
                  size=DEFAULT_SIZE, fov_deg: float = 40.0) -> Camera:
-    """Orbit the box centre at ``distance`` bounding-sphere radii, near/far hugging the box."""
+    """Orbit the box centre at ``distance`` bounding-sphere radii (None: fit the view),
+    near/far hugging the box."""
     b = np.asarray(bounds, dtype=np.float64)
+    if distance is None:
+        distance = fit_distance(size, fov_deg)
     radius = bounds_radius(b)
     d = distance * radius
     near = max(d - 1.05 * radius, 0.005 * d)
@@ -53,7 +83,7 @@ def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float,
                         size=size, near=near, far=d + 1.05 * radius)
 
 
-def turntable(bounds, count: int, elevation: float, distance: float, size=DEFAULT_SIZE,
+def turntable(bounds, count: int, elevation: float, distance: float | None, size=DEFAULT_SIZE,
               fov_deg: float = 40.0) -> list[Camera]:
     """``count`` cameras evenly spaced in azimuth around the box."""
     if count < 1 or count > 3600:
