@@ -136,19 +136,21 @@ class Camera:
 
     def pixel_rays(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space ray origins and unit directions per pixel, (H, W, 3) each, row 0 on top."""
-        w, h = self.size
-        cols, rows = np.meshgrid(np.arange(w) + 0.5, np.arange(h) + 0.5)
-        ndc_x = 2.0 * cols / w - 1.0
-        ndc_y = 1.0 - 2.0 * rows / h  # row 0 is the top of the image
-        inv = np.linalg.inv(self.proj @ self.view)
-        near = _unproject(inv, ndc_x, ndc_y, -1.0)
-        far = _unproject(inv, ndc_x, ndc_y, 1.0)
+        near, far = pixel_segments(self)
         d = far - near
         return near, d / np.linalg.norm(d, axis=-1, keepdims=True)
 
 
-def _unproject(inv: np.ndarray, x: np.ndarray, y: np.ndarray, z: float) -> np.ndarray:
-    return transform_points(inv, np.stack([x, y, np.full_like(x, z)], axis=-1))
+def pixel_segments(camera) -> tuple[np.ndarray, np.ndarray]:
+    """World points where each pixel's ray meets the near and the far plane, (H, W, 3) each,
+    row 0 on top; for any camera with ``view``, ``proj`` and ``size``."""
+    w, h = camera.size
+    cols, rows = np.meshgrid(np.arange(w) + 0.5, np.arange(h) + 0.5)
+    ndc_x = 2.0 * cols / w - 1.0
+    ndc_y = 1.0 - 2.0 * rows / h  # row 0 is the top of the image
+    inv = np.linalg.inv(np.asarray(camera.proj) @ np.asarray(camera.view))
+    return tuple(transform_points(inv, np.stack([ndc_x, ndc_y, np.full_like(ndc_x, z)], axis=-1))
+                 for z in (-1.0, 1.0))
 
 
 @dataclass(frozen=True, eq=False)
