@@ -79,3 +79,19 @@ def project_mesh(mesh, box_to_world: np.ndarray, size, ctx=None) -> Projection:
     mask = frame.mask[rows]
     height = np.where(mask, 1.0 - frame.depth[rows], 0.0).astype(np.float32)
     return Projection(height, frame.color[rows], frame.normal[rows], mask)
+
+
+def dilate(mask: np.ndarray, *images: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Each image with its empty texels (``~mask``) filled from the nearest covered texel.
+
+    Impostor bakers pad their maps this way so bilinear and mipmapped lookups at the edge of
+    a footprint never mix in the empty texels' zeros (dark, semi-transparent fringes).
+    Images come back unchanged when nothing is covered.
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    mask = np.asarray(mask, dtype=bool)
+    if mask.all() or not mask.any():
+        return tuple(np.array(image, copy=True) for image in images)
+    _, (rows, cols) = distance_transform_edt(~mask, return_indices=True)
+    return tuple(np.asarray(image)[rows, cols] for image in images)

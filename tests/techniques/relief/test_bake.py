@@ -113,3 +113,36 @@ def test_six_frusta_represent_a_closed_object(gl):
         scores, _ = _scores(cube, mesh, view)
         assert scores["iou"] > 0.97
         assert scores["position_p95_rel"] < 0.02
+
+
+def plate(color, half=0.5):
+    """A square over x, z in [-half, half], y = 0.3 + 0.2 x, one colour."""
+    xz = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
+    pos = np.column_stack([xz[:, 0], 0.3 + 0.2 * xz[:, 0], xz[:, 1]]).astype(np.float32)
+    faces = np.array([[0, 3, 2], [0, 2, 1]])
+    return RenderMesh(pos, faces, vertex_normals(pos, faces), np.tile(color, (4, 1)),
+                      name="plate")
+
+
+def test_maps_are_padded_so_lookups_at_the_edge_stay_opaque(gl):
+    """Empty texels take the nearest covered texel's colour and normal (impostor padding)."""
+    relief = bake_relief(plate([0.9, 0.1, 0.1, 1.0]), depth_res=32, color_res=40, safety=False)
+    assert (relief.height == 0).sum() > 100  # the border ring and the margin are empty
+    assert (relief.color[..., 3] == 255).all()
+    inner = relief.color[relief.color.shape[0] // 2, relief.color.shape[1] // 2, :3]
+    np.testing.assert_array_equal(relief.color[..., :3],
+                                  np.broadcast_to(inner, relief.color.shape[:2] + (3,)))
+    n = np.array([-0.2, 1.0, 0.0]) / np.linalg.norm([-0.2, 1.0, 0.0])
+    np.testing.assert_allclose(relief.normal.reshape(-1, 3), np.tile(n, (relief.normal.size
+                                                                       // 3, 1)), atol=1e-5)
+
+
+@pytest.mark.parametrize("kind", ["relief", "relief-frustum", "relief-cube"])
+def test_hits_are_opaque(gl, vehicle, kind):
+    from reliefkit.bake import bake
+
+    rep = bake(vehicle, kind, depth_res=64, safety=False)
+    for view in ((40, 20, 2.2), (200, 5, 2.0)):
+        frame = render(rep, orbit_bounds(vehicle.bounds, *view, size=(96, 96)), method="exact")
+        assert frame.mask.sum() > 500
+        np.testing.assert_array_equal(frame.color[frame.mask, 3], 1.0)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...bake.project import axis_frame, project_mesh
+from ...bake.project import axis_frame, dilate, project_mesh
 from ...colorspace import srgb_decode, to_rgba8
 from ...core.transforms import transform_points
 from ...errors import UsageError
@@ -93,10 +93,11 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
             raise UsageError(f"{label} resolution {w}x{h} is above 8192")
     height = np.clip(project_mesh(mesh, box_to_world, depth_size, ctx).height, 0.0, 1.0)
     colors = project_mesh(mesh, box_to_world, color_size, ctx)
-    color, normal, mask = colors.color, colors.normal, colors.mask
+    # pad colour and normals into the empty texels: lookups near a footprint's edge stay opaque
+    color, normal = dilate(colors.mask, colors.color, colors.normal)
     if zero_border:
         height = _zero_border(height)
-    relief = ReliefTexture(height=height, color=to_rgba8(color * mask[..., None]),
+    relief = ReliefTexture(height=height, color=to_rgba8(color),
                            normal=_orient_normals(normal, box_to_world),
                            box_to_world=box_to_world, clip_bounds=clip_bounds,
                            params=dict(params or {}))

@@ -94,7 +94,7 @@ void main() {
         lit = 0.0;
     }
 #endif
-    write_frame(vec4(shade_phong(base.rgb, n, to_eye, lit), base.a), hit, n);
+    write_frame(vec4(shade_phong(base.rgb, n, to_eye, lit), 1.0), hit, n);  // a hit is opaque
     write_iterations(iters, shadow_iters, true);
 #if defined WRITE_DEPTH
     gl_FragDepth = window_depth(hit);
