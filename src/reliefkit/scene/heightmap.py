@@ -17,7 +17,8 @@ def is_heightmap(path) -> bool:
 
 
 def load_heightmap(path) -> np.ndarray:
-    """(H, W) float64 heights; row 0 of the file becomes v = 0 (the image's top row)."""
+    """(H, W) float64 heights; row 0 is the image's top row, which a relief bake puts at the
+    far edge (-z) seen from above (`relief_from_heights`)."""
     path = Path(path)
     if not path.is_file():
         raise FormatError(f"{path}: no such file")

@@ -146,3 +146,24 @@ def test_hits_are_opaque(gl, vehicle, kind):
         frame = render(rep, orbit_bounds(vehicle.bounds, *view, size=(96, 96)), method="exact")
         assert frame.mask.sum() > 500
         np.testing.assert_array_equal(frame.color[frame.mask, 3], 1.0)
+
+
+def test_heightmaps_read_like_a_map_from_above(gl, tmp_path):
+    """An asymmetric image (an L of high ground in its top-left corner) seen from above with
+    north (-z) up and east (+x) right shows the L where the image has it."""
+    from PIL import Image
+
+    from reliefkit.scene.camera import Camera
+    from reliefkit.scene.heightmap import load_heightmap
+
+    image = np.zeros((40, 60), np.uint8)
+    image[2:20, 3:9] = 255      # the L's stem, top-left
+    image[14:20, 3:30] = 255    # its foot, running right
+    Image.fromarray(image).save(tmp_path / "l.png")
+    relief = relief_from_heights(load_heightmap(tmp_path / "l.png"), size=(3.0, 0.5, 2.0),
+                                 safety=False)
+    camera = Camera(eye=(0, 5, 0), target=(0, 0, 0), up=(0, 0, -1), size=(60, 40),
+                    ortho_height=1.0, near=0.1, far=10)
+    frame = render(relief, camera, method="exact")
+    high = frame.position[..., 1] > 0.3
+    np.testing.assert_array_equal(high, image > 0)

@@ -125,9 +125,12 @@ def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bo
                         tolerance: float = DEFAULT_TOLERANCE, progress=None) -> ReliefTexture:
     """A relief texture straight from a height array (values scaled to [0, 1]).
 
-    ``size`` is the world extent (x, y, z) of the box: u along +x, v along -z, h along +y,
-    centred on the origin with the bottom at y = 0. ``color`` is an (H', W', 3|4) uint8 sRGB
-    or float linear image; by default the heights are shaded with a terrain colour ramp.
+    Orientation is that of a map seen from above: row 0 (an image's top row) is the far
+    edge, -z, and columns run along +x, so with north up (-z) and east right (+x) the picture
+    reads as the image does. ``size`` is the world extent (x, y, z) of the box: u along +x,
+    v along +z, h along +y, centred on the origin with the bottom at y = 0. ``color`` is an
+    (H', W', 3|4) uint8 sRGB or float linear image in the same orientation; by default the
+    heights are shaded with a terrain colour ramp.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2 or min(h.shape) < 4:
@@ -138,7 +141,7 @@ def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bo
     h = (h - h.min()) / span if span > 0 else np.zeros_like(h)
     h = np.clip(h * (1 - HEIGHT_MARGIN) + HEIGHT_MARGIN, 0, 1).astype(np.float32)
     sx, sy, sz = (float(s) for s in size)
-    box_to_world = np.array([[sx, 0, 0, -sx / 2], [0, 0, sy, 0], [0, -sz, 0, sz / 2],
+    box_to_world = np.array([[sx, 0, 0, -sx / 2], [0, 0, sy, 0], [0, sz, 0, -sz / 2],
                              [0, 0, 0, 1.0]])
     color8 = _heightmap_color(h, color)
     normal = heightfield_normals(h, box_to_world)
