@@ -196,3 +196,19 @@ def test_bad_typed_fields_are_refused_or_valid(written, forgery):
             pytest.fail(f"{kind}: array {name} with dtype {bad.dtype} was accepted")
         if forgery == "nan" and rk._codec_for_kind(kind).arrays[name].finite:
             pytest.fail(f"{kind}: NaN accepted in finite array {name}")
+
+
+def test_members_are_deflated_and_stored_copies_load_the_same(written):
+    """Files are written deflated; a stored copy (what earlier versions wrote) reads the same."""
+    kind, rep, path = written
+    with zipfile.ZipFile(path) as zf:
+        assert {info.compress_type for info in zf.infolist()} == {zipfile.ZIP_DEFLATED}
+    deflated = rk.read_rk(path).arrays
+    _rewrite(path, _members(path))  # zipfile's default: ZIP_STORED
+    with zipfile.ZipFile(path) as zf:
+        assert {info.compress_type for info in zf.infolist()} == {zipfile.ZIP_STORED}
+    stored = rk.read_rk(path).arrays
+    assert deflated.keys() == stored.keys()
+    for name in deflated:
+        assert deflated[name].dtype == stored[name].dtype, name
+        assert deflated[name].tobytes() == stored[name].tobytes(), name

@@ -7,8 +7,10 @@ import io
 import json
 import os
 import re
+import struct
 import tracemalloc
 import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -112,8 +114,10 @@ def forged_npy(descr: str, shape: tuple, payload: bytes) -> bytes:
 
 
 def rewrite(path: Path, *, members: dict | None = None, manifest=None,
-            compress: set = frozenset(), raw_manifest: bytes | None = None) -> None:
-    """Rebuild the zip at `path` (valid CRCs) with members replaced (None deletes one)."""
+            method: int = zipfile.ZIP_DEFLATED, methods: dict | None = None,
+            raw_manifest: bytes | None = None) -> None:
+    """Rebuild the zip at `path` (valid CRCs) with members replaced (None deletes one), every
+    member written with `method` unless `methods` names another for it."""
     with zipfile.ZipFile(path) as zf:
         content = {info.filename: zf.read(info) for info in zf.infolist()}
     man = json.loads(content["manifest.json"])
@@ -127,7 +131,60 @@ def rewrite(path: Path, *, members: dict | None = None, manifest=None,
             content[name] = data
     with zipfile.ZipFile(path, "w") as zf:
         for name, data in content.items():
-            zf.writestr(name, data, zipfile.ZIP_DEFLATED if name in compress else None)
+            zf.writestr(name, data, (methods or {}).get(name, method))
+
+
+def deflate(data: bytes, level: int = 1) -> bytes:
+    """A raw deflate stream, as zip members hold it."""
+    co = zlib.compressobj(level, zlib.DEFLATED, -zlib.MAX_WBITS)
+    return co.compress(data) + co.flush()
+
+
+def local_header(name: str, method: int, crc: int, csize: int, usize: int) -> bytes:
+    raw = name.encode()
+    return struct.pack("<4s5H3L2H", b"PK\x03\x04", 20, 0, method, 0, 0x21, crc, csize, usize,
+                       len(raw), 0) + raw
+
+
+def central_entry(name: str, method: int, crc: int, csize: int, usize: int,
+                  offset: int) -> bytes:
+    raw = name.encode()
+    return struct.pack("<4s6H3L5H2L", b"PK\x01\x02", 20, 20, 0, method, 0, 0x21, crc, csize,
+                       usize, len(raw), 0, 0, 0, 0, 0o644 << 16, offset) + raw
+
+
+def end_record(count: int, cd_size: int, cd_offset: int) -> bytes:
+    return struct.pack("<4s4H2LH", b"PK\x05\x06", 0, 0, count, count, cd_size, cd_offset, 0)
+
+
+def members_of(path: Path) -> dict[str, bytes]:
+    with zipfile.ZipFile(path) as zf:
+        return {info.filename: zf.read(info) for info in zf.infolist()}
+
+
+def write_raw_zip(path: Path, members: dict[str, bytes], forged: dict | None = None) -> None:
+    """Write a zip by hand, each member deflated at level 1 unless `forged` gives it other
+    directory fields: name -> dict of raw (the bytes as stored), method, crc, usize (the
+    declared uncompressed size), csize (the compressed size in both headers)."""
+    body, central = b"", b""
+    for name, data in members.items():
+        entry = {"raw": deflate(data), "method": zipfile.ZIP_DEFLATED,
+                 "crc": zlib.crc32(data), "usize": len(data)}
+        entry.update((forged or {}).get(name, {}))
+        entry.setdefault("csize", len(entry["raw"]))
+        fields = (entry["method"], entry["crc"], entry["csize"], entry["usize"])
+        central += central_entry(name, *fields, offset=len(body))
+        body += local_header(name, *fields) + entry["raw"]
+    path.write_bytes(body + central + end_record(len(members), len(central), len(body)))
+
+
+def data_offset(path: Path, member: str) -> tuple[int, zipfile.ZipInfo]:
+    """Where a member's raw (stored or deflated) bytes start in the file, and its ZipInfo."""
+    with zipfile.ZipFile(path) as zf:
+        info = zf.getinfo(member)
+    head = path.read_bytes()[info.header_offset:info.header_offset + 30]
+    name_len, extra_len = struct.unpack("<2H", head[26:30])
+    return info.header_offset + 30 + name_len + extra_len, info
 
 
 def replace_array(path: Path, name: str, data: bytes, *, dtype=None, shape=None) -> None:
@@ -229,21 +286,27 @@ def test_plain_numpy_can_open_the_file(tmp_path):
         assert json.loads(npz["manifest.json"])["format"] == "reliefkit"
 
 
-def test_manifest_fields_and_stored_members(tmp_path):
+def test_manifest_fields_and_deflated_members(tmp_path):
     path = rk_file(tmp_path, source_hash=SOURCE_HASH)
     man = formats.read_manifest(path)
     assert man["format"] == "reliefkit" and man["format_version"] == 1
-    assert man["kind_version"] == 1 and man["params"] == {"name": "quad"}
+    assert man["kind_version"] == formats._codec_for_kind("mesh").version
+    assert man["params"] == {"name": "quad"}
     assert man["created_by"].startswith("reliefkit ")
     assert man["arrays"]["indices"]["dtype"] == "<u4"
     assert man["arrays"]["positions"]["shape"] == [4, 3]
+    whole = path.read_bytes()
     with zipfile.ZipFile(path) as zf:
         for info in zf.infolist():
-            assert info.compress_type == zipfile.ZIP_STORED
-            assert info.compress_size == info.file_size
+            assert info.compress_type == zipfile.ZIP_DEFLATED
+            assert info.date_time == (1980, 1, 1, 0, 0, 0)
+            data = zf.read(info)
+            start, _ = data_offset(path, info.filename)
+            # deflate at the fixed level, nothing else (so the bytes are reproducible)
+            assert whole[start:start + info.compress_size] == deflate(data, level=1)
             if info.filename.endswith(".npy"):
                 name = info.filename[:-4]
-                digest = hashlib.sha256(zf.read(info)).hexdigest()
+                digest = hashlib.sha256(data).hexdigest()  # of the uncompressed .npy
                 assert man["arrays"][name]["sha256"] == digest
 
 
@@ -303,14 +366,34 @@ def test_flipped_data_byte_is_a_checksum_mismatch(tmp_path):
 
 def test_flipped_byte_on_disk_is_a_checksum_mismatch(tmp_path):
     path = rk_file(tmp_path)
-    with zipfile.ZipFile(path) as zf:
-        info = zf.getinfo("colors.npy")
+    rewrite(path, method=zipfile.ZIP_STORED)  # a stored member: the byte is the data's own
+    data_at, info = data_offset(path, "colors.npy")
     raw = bytearray(path.read_bytes())
-    local_name_len, local_extra_len = np.frombuffer(raw, "<u2", 2, info.header_offset + 26)
-    data_at = info.header_offset + 30 + int(local_name_len) + int(local_extra_len)
     raw[data_at + info.file_size - 1] ^= 0x40  # last data byte: the CRC no longer matches
     path.write_bytes(bytes(raw))
-    fails(path, "checksum mismatch for array 'colors'")
+    fails(path, "checksum mismatch for array 'colors' \\(zip CRC-32\\)")
+
+
+def test_every_flipped_byte_of_a_deflated_member_is_refused_or_harmless(tmp_path):
+    """A flip anywhere in a deflate stream is refused with FormatError naming the array, or
+    (a flip in the padding bits after the last block) decodes to the very same bytes."""
+    mesh = make_mesh(textured=True)
+    path = rk_file(tmp_path, mesh)
+    data_at, info = data_offset(path, "colors.npy")
+    whole = path.read_bytes()
+    harmless = 0
+    for i in range(data_at, data_at + info.compress_size):
+        raw = bytearray(whole)
+        raw[i] ^= 0xFF
+        path.write_bytes(bytes(raw))
+        try:
+            back = formats.load(path)
+        except FormatError as exc:
+            assert "array 'colors'" in str(exc) and "\n" not in str(exc), str(exc)
+            continue
+        harmless += 1
+        assert back.colors.tobytes() == mesh.colors.tobytes()
+    assert harmless < 3
 
 
 def test_tampered_manifest_checksum(tmp_path):
@@ -457,10 +540,29 @@ def test_duplicate_member(tmp_path):
     fails(path, "duplicate member")
 
 
-def test_compressed_member(tmp_path):
+def test_deflated_and_stored_members_may_be_mixed(tmp_path):
+    mesh = make_mesh()
+    path = rk_file(tmp_path, mesh)
+    rewrite(path, method=zipfile.ZIP_STORED, methods={"indices.npy": zipfile.ZIP_DEFLATED})
+    np.testing.assert_array_equal(formats.load(path).indices, mesh.indices)
+
+
+@pytest.mark.parametrize("method, label", [(zipfile.ZIP_BZIP2, "bzip2"),
+                                           (zipfile.ZIP_LZMA, "lzma")])
+def test_other_compression_methods_are_refused(tmp_path, method, label):
     path = rk_file(tmp_path)
-    rewrite(path, compress={"indices.npy"})
-    fails(path, "'indices' is compressed", "uncompressed")
+    rewrite(path, methods={"indices.npy": method})
+    fails(path, f"array 'indices' uses zip compression method {method} \\({label}\\)",
+          "stored or deflated")
+    rewrite(path, methods={"manifest.json": method})
+    fails(path, f"manifest.json uses zip compression method {method}")
+
+
+def test_unknown_compression_method_is_refused(tmp_path):
+    path = tmp_path / "x.rk"
+    content = members_of(rk_file(tmp_path))
+    write_raw_zip(path, content, {"normals.npy": {"method": 99}})  # AES, say
+    fails(path, "array 'normals' uses zip compression method 99 \\(unknown\\)")
 
 
 def test_nan_in_finite_array(tmp_path):
@@ -500,6 +602,192 @@ def test_read_manifest_validates_headers_but_reads_no_data(tmp_path):
     consistent_array(path, "positions", np.zeros((4, 3), np.float64))
     with pytest.raises(FormatError, match="dtype <f8"):
         formats.read_manifest(path)
+
+
+# ------------------------------------------------------------------ compressed members
+
+
+def test_deflated_round_trip_is_bit_exact_and_smaller(tmp_path):
+    bag = make_bag()
+    big = np.zeros((256, 256))  # compressible, 512 KiB, with the NaN payloads of make_bag
+    big[:5, :7] = bag.arrays["f64"]
+    bag.arrays["f64"] = big
+    path = formats.save(tmp_path / "b.rk", bag)
+    with zipfile.ZipFile(path) as zf:
+        assert {i.compress_type for i in zf.infolist()} == {zipfile.ZIP_DEFLATED}
+        big = zf.getinfo("f64.npy")
+        assert big.compress_size * 100 < big.file_size
+    assert path.stat().st_size < 16 * 1024
+    back = formats.load(path)
+    assert_same_arrays(back.arrays, bag.arrays)  # NaN payloads, -0.0 and all
+    with np.load(path, allow_pickle=False) as npz:  # plain numpy inflates it too
+        assert_same_arrays({k: npz[k] for k in bag.arrays}, bag.arrays)
+
+
+def test_old_stored_files_still_load(tmp_path):
+    bag = make_bag()
+    path = rk_file(tmp_path, bag)
+    rewrite(path, method=zipfile.ZIP_STORED)  # the layout every earlier reliefkit wrote
+    with zipfile.ZipFile(path) as zf:
+        assert {i.compress_type for i in zf.infolist()} == {zipfile.ZIP_STORED}
+    assert formats.read_manifest(path)["kind"] == "test-bag"
+    assert_same_arrays(formats.load(path).arrays, bag.arrays)
+    mesh = make_mesh(True)
+    path = rk_file(tmp_path, mesh, name="m.rk")
+    rewrite(path, method=zipfile.ZIP_STORED)
+    assert formats.load(path).texture.tobytes() == mesh.texture.tobytes()
+
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 4096])
+@pytest.mark.parametrize("method", [zipfile.ZIP_DEFLATED, zipfile.ZIP_STORED])
+def test_any_read_chunk_size_gives_the_same_arrays(tmp_path, monkeypatch, chunk, method):
+    """Stream ends, header ends and chunk ends may fall anywhere: a valid file always loads."""
+    bag = make_bag()
+    bag.arrays["f64"] = np.linspace(0, 1, 3000).reshape(60, 50)
+    path = rk_file(tmp_path, bag)
+    rewrite(path, method=method)
+    monkeypatch.setattr(formats, "_CHUNK", chunk)
+    assert_same_arrays(formats.load(path).arrays, bag.arrays)
+
+@pytest.mark.parametrize("extra", [1, 64 << 20], ids=["one-byte", "64MiB"])
+def test_deflated_member_longer_than_declared_is_refused_without_inflating_it(tmp_path,
+                                                                              extra):
+    """The directory declares the real .npy (size, CRC-32 and manifest SHA-256 all of it),
+    but the deflate stream goes on: a zip bomb or a lying size. Nothing past the declared
+    size is inflated, let alone allocated."""
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    declared = content["i64.npy"]
+    stream = deflate(declared + bytes(extra))
+    tracemalloc.start()
+    try:
+        write_raw_zip(path, content, {"i64.npy": {"raw": stream}})
+        fails(path, "array 'i64' inflates to more than its declared "
+              f"{len(declared)} bytes", "forged")
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 2 * 2**20 + 2 * len(stream)
+
+
+def test_deflated_member_shorter_than_declared_is_refused(tmp_path):
+    """A lying size the other way: the directory and the .npy header claim more than the
+    stream holds. The read stops at the stream's end, and never goes past what was declared."""
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    arr = np.arange(1000, dtype=np.int64)
+    claimed = npy_bytes(arr)
+    real = claimed[:len(claimed) - 800]  # the header and the first 200 bytes only
+    content["i64.npy"] = claimed
+
+    def edit(man):
+        man["arrays"]["i64"].update(shape=[1000], sha256=hashlib.sha256(claimed).hexdigest())
+
+    man = json.loads(content["manifest.json"])
+    edit(man)
+    content["manifest.json"] = json.dumps(man).encode()
+    write_raw_zip(path, content, {"i64.npy": {"raw": deflate(real)}})
+    fails(path, f"array 'i64' inflates to {len(real)} bytes, fewer than its declared "
+          f"{len(claimed)}", "truncated, corrupt or forged")
+
+
+def test_impossible_deflate_ratio_is_refused_before_allocating(tmp_path, monkeypatch):
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    shape = (1000, 1000)  # 8 MB claimed from about a hundred deflated bytes
+    claimed = forged_npy("<f8", shape, b"")
+    content["f64.npy"] = claimed
+
+    def edit(man):
+        man["arrays"]["f64"].update(shape=list(shape), dtype="<f8")
+
+    man = json.loads(content["manifest.json"])
+    edit(man)
+    content["manifest.json"] = json.dumps(man).encode()
+    write_raw_zip(path, content, {"f64.npy": {"usize": len(claimed) + 8 * 10**6}})
+    made = []
+    real_empty = np.empty
+    monkeypatch.setattr(np, "empty", lambda *a, **k: made.append(a) or real_empty(*a, **k))
+    fails(path, "array 'f64' claims 8000128 bytes from", "more than deflate can expand")
+    assert made == []
+
+
+def test_truncated_deflate_stream_is_refused(tmp_path):
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    stream = deflate(content["f32.npy"])
+    write_raw_zip(path, content, {"f32.npy": {"raw": stream[:len(stream) // 2]}})
+    fails(path, "array 'f32'", "ends early|fewer than its declared", "truncated")
+    write_raw_zip(path, content, {"f32.npy": {"raw": stream[:-1]}})
+    fails(path, "array 'f32'", "truncated")
+
+
+def test_bytes_after_the_deflate_stream_are_refused(tmp_path):
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    stream = deflate(content["f32.npy"]) + b"\0" * 16
+    write_raw_zip(path, content, {"f32.npy": {"raw": stream}})
+    fails(path, "array 'f32' has compressed bytes after the end of its deflate stream")
+
+
+def test_corrupt_deflate_stream_is_refused(tmp_path):
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    write_raw_zip(path, content, {"f32.npy": {"raw": b"\xff" * 64}})  # invalid block type
+    fails(path, "array 'f32': its deflate stream is corrupt")
+
+
+def test_stored_member_with_lying_sizes_is_refused(tmp_path):
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    data = content["f32.npy"]
+    write_raw_zip(path, content, {"f32.npy": {"raw": data + bytes(64), "method": 0,
+                                              "usize": len(data)}})
+    fails(path, f"array 'f32' is stored in {len(data) + 64} bytes but claims {len(data)}")
+
+
+def test_compressed_size_past_the_end_of_the_file_is_refused(tmp_path):
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    write_raw_zip(path, content, {"f32.npy": {"csize": 10**6}})
+    fails(path, "zip member 'f32.npy' claims 1000000 bytes of data", "more than the zip holds")
+
+
+def test_overlapping_members_are_refused(tmp_path):
+    """One member's data holds another's local header and data: the classic way to make a
+    small zip inflate many times its size."""
+    path = rk_file(tmp_path, make_bag())
+    content = members_of(path)
+    inner_data = content["f32.npy"]
+    inner_raw = deflate(inner_data)
+    inner = local_header("f32.npy", 8, zlib.crc32(inner_data), len(inner_raw),
+                         len(inner_data)) + inner_raw
+    outer = local_header("f64.npy", 0, zlib.crc32(inner), len(inner), len(inner))
+    body = outer + inner
+    central = central_entry("f64.npy", 0, zlib.crc32(inner), len(inner), len(inner), 0)
+    central += central_entry("f32.npy", 8, zlib.crc32(inner_data), len(inner_raw),
+                             len(inner_data), len(outer))
+    for name, data in content.items():
+        if name in ("f32.npy", "f64.npy"):
+            continue
+        raw = deflate(data)
+        fields = (8, zlib.crc32(data), len(raw), len(data))
+        central += central_entry(name, *fields, offset=len(body))
+        body += local_header(name, *fields) + raw
+    count = len(content)
+    path.write_bytes(body + central + end_record(count, len(central), len(body)))
+    fails(path, "zip members 'f64.npy' and 'f32.npy' overlap")
+
+
+def test_local_header_name_must_match_the_directory(tmp_path):
+    path = rk_file(tmp_path)
+    whole = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as zf:
+        at = zf.getinfo("normals.npy").header_offset + 30
+    whole[at:at + 7] = b"NORMALS"
+    path.write_bytes(bytes(whole))
+    fails(path, "zip member 'normals.npy' has the name 'NORMALS.npy' in its local header")
 
 
 # ---------------------------------------------------------------------- writing checks

@@ -1,16 +1,20 @@
 """The .rk container: one baked representation in a zip that plain numpy can open.
 
-An .rk file is an uncompressed (``ZIP_STORED``) zip holding ``manifest.json`` and one
-``NAME.npy`` member per array, so ``numpy.load(path, allow_pickle=False)`` reads it. The
-manifest names the format and its version, the representation *kind* and the kind's version,
-the bake parameters, the source file's SHA-256 and, per array, its dtype, shape and the
-SHA-256 of its ``.npy`` member.
+An .rk file is a zip of ``ZIP_DEFLATED`` members (``ZIP_STORED`` ones, as older versions
+wrote, are read too): ``manifest.json`` and one ``NAME.npy`` member per array, so
+``numpy.load(path, allow_pickle=False)`` reads it. The manifest names the format and its
+version, the representation *kind* and the kind's version, the bake parameters, the source
+file's SHA-256 and, per array, its dtype, shape and the SHA-256 of its (uncompressed)
+``.npy`` member.
 
 Kinds are a registry of `Codec` objects: a representation module registers one and `save` /
 `load` find it, by the representation's type and by the manifest's ``kind``. Writing is
-atomic (temp file in the same folder, fsync, ``os.replace``). Reading validates everything it
-can from the manifest and the ``.npy`` headers *before* allocating any array, then verifies
-checksums and finiteness. Every problem raises `FormatError`. See ``docs/format.md``.
+atomic (temp file in the same folder, fsync, ``os.replace``) and deterministic (fixed dates,
+order and deflate level). Reading validates everything it can from the zip directory, the
+manifest and the ``.npy`` headers *before* allocating any array, then streams each member
+through its own bounded reader (never more bytes than declared, stream length exact) while
+verifying checksums, then finiteness. Every problem raises `FormatError`. See
+``docs/format.md``.
 """
 
 from __future__ import annotations
@@ -18,11 +22,15 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import io
+import itertools
 import json
 import math
+import os
 import re
+import struct
 import zipfile
-from collections.abc import Callable, Iterable, Mapping
+import zlib
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,6 +57,16 @@ _HEADER_PEEK = _MAX_NPY_HEADER + 16    # magic + version (8) + length field (<= 
 _CHUNK = 1 << 20
 _FORCE_ZIP64 = 1 << 30                 # members this large get zip64 headers up front
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)      # fixed, so equal inputs give byte-identical files
+_DEFLATE_LEVEL = 1                     # fixed (determinism); see docs/format.md for the choice
+_MAX_DEFLATE_RATIO = 1032              # deflate's most output per input byte (258 B per 2 bits)
+_METHODS = (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED)  # what is read; deflated is written
+_OTHER_METHODS = {zipfile.ZIP_BZIP2: "bzip2", zipfile.ZIP_LZMA: "lzma", 9: "deflate64",
+                  93: "zstandard", 95: "xz", 98: "ppmd"}
+_LOCAL_HEADER = struct.Struct("<4s5H3L2H")  # the 30 fixed bytes of a zip local file header
+_LOCAL_MAGIC = b"PK\x03\x04"
+_FLAG_ENCRYPTED = 0x1 | 0x40               # traditional or strong encryption
+_FLAG_PATCHED = 0x20                       # "compressed patched data"
+_FLAG_UTF8 = 0x800
 _KIND_RE = re.compile(r"[a-z][a-z0-9_.-]*\Z")
 _NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _SHA_RE = re.compile(r"[0-9a-f]{64}\Z")
@@ -200,7 +218,7 @@ def _codec_for_object(rep) -> Codec:
         if cls in _BY_CLASS:
             return _BY_CLASS[cls]
     raise FormatError(f"cannot save a {type(rep).__qualname__}: no .rk kind is registered for "
-                      "it; register a Codec with reliefkit.formats.register")
+                      "it; register a Codec with reliefkit.io.rk.register")
 
 
 # --------------------------------------------------------------------- shared checks
@@ -277,7 +295,7 @@ def _check_json(value, where: str = "params") -> None:
 def _check_source_hash(value) -> None:
     if value is not None and not (isinstance(value, str) and _SHA_RE.match(value)):
         raise FormatError(f"source_hash must be None or 64 lower-case hex digits, got {value!r}"
-                          "; use reliefkit.formats.file_sha256")
+                          "; use reliefkit.io.rk.file_sha256")
 
 
 # --------------------------------------------------------------------------- writing
@@ -359,14 +377,21 @@ class _HashingWriter:
 
 def _zipinfo(name: str) -> zipfile.ZipInfo:
     info = zipfile.ZipInfo(name, date_time=_ZIP_DATE)
-    info.compress_type = zipfile.ZIP_STORED
+    info.compress_type = zipfile.ZIP_DEFLATED
+    # ZipFile.open(info, "w") and writestr(info) take the level from the ZipInfo: the
+    # attribute is public `compress_level` from Python 3.13, `_compresslevel` before.
+    if hasattr(zipfile.ZipInfo, "compress_level"):
+        info.compress_level = _DEFLATE_LEVEL
+    else:
+        info._compresslevel = _DEFLATE_LEVEL
+    info.create_system = 3  # "Unix" on every platform (zipfile says 0 on Windows)
     info.external_attr = 0o644 << 16
     return info
 
 
 def _write_zip(fh, head: dict, arrays: dict[str, np.ndarray]) -> None:
     entries = {}
-    with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+    with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as zf:
         for name, arr in arrays.items():
             big = arr.nbytes > _FORCE_ZIP64
             with zf.open(_zipinfo(f"{name}.npy"), "w", force_zip64=big) as raw:
@@ -382,10 +407,31 @@ def _write_zip(fh, head: dict, arrays: dict[str, np.ndarray]) -> None:
 
 
 @dataclass(frozen=True)
+class _Archive:
+    """An open .rk: its zip directory, the file it was read from and that file's size."""
+
+    zf: zipfile.ZipFile
+    fh: io.BufferedReader
+    size: int
+
+
+@dataclass(frozen=True)
+class _Span:
+    """Where one member's raw (stored or deflated) bytes lie, checked to fit in the file."""
+
+    info: zipfile.ZipInfo
+    start: int  # the first data byte, just after the local header
+
+    @property
+    def end(self) -> int:
+        return self.start + self.info.compress_size
+
+
+@dataclass(frozen=True)
 class _Member:
     """One .npy member whose header passed every check; nothing read yet."""
 
-    info: zipfile.ZipInfo
+    span: _Span
     dtype: np.dtype
     shape: tuple[int, ...]
     fortran: bool
@@ -403,7 +449,8 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
     Parameters
     ----------
     path : the .rk file.
-    max_bytes : refuse files whose arrays declare more bytes than this in total.
+    max_bytes : refuse files whose arrays declare more bytes than this in total
+        (uncompressed, as the arrays will be in memory).
 
     Raises
     ------
@@ -425,24 +472,26 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
 def read_manifest(path) -> dict:
     """The manifest of an .rk file, after every check that needs no array data.
 
-    The manifest, the member list and every ``.npy`` header are validated; array data and
-    checksums are not read, so this is cheap for any file size.
+    The manifest, the zip directory and every ``.npy`` header are validated; array data and
+    checksums are not read (beyond the first few KiB of each member), so this is cheap for
+    any file size.
     """
-    with _open_rk(path) as (zf, size):
-        manifest, _, _ = _inspect(zf, size, None)
+    with _open_rk(path) as archive:
+        manifest, _, _ = _inspect(archive, None)
     return manifest
 
 
 def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> RkFile:
     """Validate an .rk file completely and return its arrays without building the object.
 
-    Checks run before any array is allocated: manifest, kind, member set, ``.npy`` headers,
-    declared sizes against stored sizes and `max_bytes`. Then each member is read with its
-    SHA-256 verified, and finite-required arrays are checked.
+    Checks run before any array is allocated: zip directory and local headers, manifest,
+    kind, member set, compression method, ``.npy`` headers, declared sizes against the zip
+    directory's sizes and `max_bytes`. Then each member is streamed into its array with its
+    SHA-256 and CRC-32 verified and its length exact, and finite-required arrays are checked.
     """
-    with _open_rk(path) as (zf, size):
-        manifest, codec, members = _inspect(zf, size, max_bytes)
-        arrays = {name: _read_member(zf, name, m) for name, m in members.items()}
+    with _open_rk(path) as archive:
+        manifest, codec, members = _inspect(archive, max_bytes)
+        arrays = {name: _read_member(archive, name, m) for name, m in members.items()}
         for name, arr in arrays.items():
             if codec.arrays[name].finite:
                 _check_finite(name, arr)
@@ -451,18 +500,25 @@ def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> RkFile:
 
 @contextlib.contextmanager
 def _open_rk(path):
-    """Open the zip; prefix every FormatError with the path and map zip/IO errors."""
+    """Open the file and its zip directory; prefix every FormatError with the path and map
+    zip/IO errors. Members are read from the same open file as the directory."""
     path = Path(path)
     if not path.is_file():
         why = "is not a file" if path.exists() else "no such file"
         raise FormatError(f"{path}: {why}; check the path")
-    if not zipfile.is_zipfile(path):
-        raise FormatError(f"{path}: not a .rk file (not a zip archive, or truncated); "
-                          "re-create it with reliefkit")
     try:
-        size = path.stat().st_size
-        with zipfile.ZipFile(path) as zf:
-            yield zf, size
+        fh = open(path, "rb")  # noqa: SIM115 - closed below, after the yield
+    except OSError as exc:
+        raise FormatError(f"{path}: cannot read ({exc.strerror or exc}); check the path and "
+                          "its permissions") from None
+    try:
+        with fh:
+            if not zipfile.is_zipfile(fh):
+                raise FormatError("not a .rk file (not a zip archive, or truncated); "
+                                  "re-create it with reliefkit")
+            size = os.fstat(fh.fileno()).st_size
+            with zipfile.ZipFile(fh) as zf:
+                yield _Archive(zf, fh, size)
     except FormatError as exc:
         raise FormatError(f"{path}: {exc}") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError,
@@ -471,16 +527,16 @@ def _open_rk(path):
                           "with reliefkit") from exc
 
 
-def _inspect(zf: zipfile.ZipFile, archive_size: int, max_bytes: int | None):
+def _inspect(archive: _Archive, max_bytes: int | None):
     """All checks that need no array data; returns (manifest, codec, members)."""
-    infos = _member_table(zf)
-    manifest = _read_manifest_json(zf, infos)
+    infos = _member_table(archive.zf)
+    manifest = _read_manifest_json(archive, infos)
     codec = _check_manifest(manifest)
     entries = manifest["arrays"]
     _check_array_set(codec, entries)
     _check_member_set(entries, infos)
-    members = {name: _inspect_member(zf, codec, name, entry, infos[f"{name}.npy"],
-                                     archive_size)
+    spans = _layout(archive, infos.values())
+    members = {name: _inspect_member(archive, codec, name, entry, spans[f"{name}.npy"])
                for name, entry in entries.items()}
     total = sum(m.nbytes for m in members.values())
     if max_bytes is not None and total > max_bytes:
@@ -495,24 +551,171 @@ def _member_table(zf: zipfile.ZipFile) -> dict[str, zipfile.ZipInfo]:
     table = {info.filename: info for info in infos}
     if len(table) != len(infos):
         raise FormatError("the zip has duplicate member names; the file is corrupt or forged")
-    encrypted = [info.filename for info in infos if info.flag_bits & 0x1]
-    if encrypted:
-        raise FormatError(f"zip member {encrypted[0]!r} is encrypted; .rk files never are")
+    for info in infos:
+        if info.flag_bits & _FLAG_ENCRYPTED:
+            raise FormatError(f"zip member {info.filename!r} is encrypted; .rk files never "
+                              "are")
+        if info.flag_bits & _FLAG_PATCHED:
+            raise FormatError(f"zip member {info.filename!r} is compressed patched data, "
+                              "which .rk files never use; the file is corrupt or forged")
     return table
 
 
-def _read_manifest_json(zf: zipfile.ZipFile, infos: dict) -> dict:
+def _locate(archive: _Archive, info: zipfile.ZipInfo) -> _Span:
+    """Find a member's data after its local header; it must lie inside the file."""
+    what = f"zip member {info.filename!r}"
+    fixed = b""
+    if 0 <= info.header_offset <= archive.size:
+        archive.fh.seek(info.header_offset)
+        fixed = archive.fh.read(_LOCAL_HEADER.size)
+    if len(fixed) != _LOCAL_HEADER.size or fixed[:4] != _LOCAL_MAGIC:
+        raise FormatError(f"{what} has no local header at offset {info.header_offset}; the "
+                          "file is truncated or corrupt")
+    flags, name_len, extra_len = (_LOCAL_HEADER.unpack(fixed)[i] for i in (2, 9, 10))
+    name = archive.fh.read(name_len).decode("utf-8" if flags & _FLAG_UTF8 else "cp437",
+                                            errors="replace")
+    if name != info.orig_filename:
+        raise FormatError(f"{what} has the name {name!r} in its local header; the file is "
+                          "corrupt or forged")
+    span = _Span(info, info.header_offset + _LOCAL_HEADER.size + name_len + extra_len)
+    if span.end > archive.size:
+        raise FormatError(f"{what} claims {info.compress_size} bytes of data at offset "
+                          f"{span.start}, more than the zip holds; the file is truncated or "
+                          "forged")
+    return span
+
+
+def _layout(archive: _Archive, infos: Iterable[zipfile.ZipInfo]) -> dict[str, _Span]:
+    """Every member located; no two may overlap (shared data is a zip-bomb trick)."""
+    spans = {info.filename: _locate(archive, info) for info in infos}
+    ordered = sorted(spans.values(), key=lambda span: span.info.header_offset)
+    for a, b in itertools.pairwise(ordered):
+        if a.end > b.info.header_offset:
+            raise FormatError(f"zip members {a.info.filename!r} and {b.info.filename!r} "
+                              "overlap; the file is corrupt or forged")
+    return spans
+
+
+def _member_chunks(archive: _Archive, span: _Span, what: str,
+                   chunk: int | None = None) -> Iterator[bytes]:
+    """A member's uncompressed bytes in pieces of at most `chunk`, exactly its declared
+    ``file_size`` of them in all (stored or deflated members only); `chunk` defaults to
+    1 MiB and also bounds each read of compressed bytes.
+
+    The method and sizes are checked now; the stream as it is read. It never yields more than
+    declared and never inflates more than one byte past it: a stream that ends early, runs on
+    past the declared size or leaves compressed bytes over is refused, and so is a CRC-32
+    mismatch once the whole member is read.
+    """
+    info = span.info
+    method = info.compress_type
+    if method not in _METHODS:
+        label = _OTHER_METHODS.get(method, "unknown")
+        raise FormatError(f"{what} uses zip compression method {method} ({label}); .rk "
+                          "members are stored or deflated: re-create the file with "
+                          "reliefkit.save")
+    if method == zipfile.ZIP_STORED and info.compress_size != info.file_size:
+        raise FormatError(f"{what} is stored in {info.compress_size} bytes but claims "
+                          f"{info.file_size}; the file is truncated or forged")
+    if method == zipfile.ZIP_DEFLATED and \
+            info.file_size > _MAX_DEFLATE_RATIO * info.compress_size + _MAX_DEFLATE_RATIO:
+        raise FormatError(f"{what} claims {info.file_size} bytes from {info.compress_size} "
+                          "deflated bytes, more than deflate can expand; the file is forged")
+    chunk = max(1, chunk or _CHUNK)
+    raw = _RawReader(archive.fh, span, what, chunk)
+    if method == zipfile.ZIP_STORED:
+        return _checked_crc(raw, info, what)
+    return _checked_crc(_inflate(raw, info.file_size, what, chunk), info, what)
+
+
+class _RawReader:
+    """A member's raw bytes, `chunk` at a time; it seeks before every read (the one open
+    file is shared) and refuses to read past the member or to come back short."""
+
+    def __init__(self, fh, span: _Span, what: str, chunk: int) -> None:
+        self.fh, self.what, self.chunk = fh, what, chunk
+        self.pos, self.left = span.start, span.info.compress_size
+
+    def __iter__(self) -> Iterator[bytes]:
+        while self.left:
+            n = min(self.chunk, self.left)
+            self.fh.seek(self.pos)
+            data = self.fh.read(n)
+            if len(data) != n:
+                raise FormatError(f"{self.what} ends early; the file is truncated")
+            self.pos += n
+            self.left -= n
+            yield data
+
+
+def _inflate(raw: _RawReader, size: int, what: str, chunk: int) -> Iterator[bytes]:
+    """Inflate a raw deflate stream that must hold exactly `size` bytes and end with the
+    member's compressed bytes; output comes at most `chunk` bytes at a time."""
+    inflater = zlib.decompressobj(-zlib.MAX_WBITS)
+    pieces = iter(raw)
+    pending = b""
+    left = size
+    try:
+        while left or not inflater.eof:
+            if inflater.eof:
+                raise FormatError(f"{what} inflates to {size - left} bytes, fewer than its "
+                                  f"declared {size}; the file is truncated, corrupt or forged")
+            if not pending:
+                pending = next(pieces, b"")
+                if not pending:
+                    raise FormatError(f"{what}: its deflate stream ends early; the file is "
+                                      "truncated or corrupt")
+            out = inflater.decompress(pending, min(chunk, left) if left else 1)
+            if out and not left:
+                raise FormatError(f"{what} inflates to more than its declared {size} bytes; "
+                                  "the file is corrupt or forged")
+            if not out and not inflater.eof and len(inflater.unconsumed_tail) == len(pending):
+                raise FormatError(f"{what}: its deflate stream does not progress; the file is "
+                                  "corrupt")
+            pending = inflater.unconsumed_tail
+            if out:
+                left -= len(out)
+                yield out
+    except zlib.error as exc:
+        raise FormatError(f"{what}: its deflate stream is corrupt ({exc}); the file is "
+                          "corrupt") from None
+    if inflater.unused_data or pending or raw.left:
+        raise FormatError(f"{what} has compressed bytes after the end of its deflate stream; "
+                          "the file is corrupt or forged")
+
+
+def _checked_crc(pieces: Iterable[bytes], info: zipfile.ZipInfo, what: str) -> Iterator[bytes]:
+    crc = 0
+    for piece in pieces:
+        crc = zlib.crc32(piece, crc)
+        yield piece
+    if crc != info.CRC:
+        raise FormatError(f"checksum mismatch for {what} (zip CRC-32): the file is corrupt")
+
+
+def _peek(archive: _Archive, span: _Span, what: str, n: int) -> bytes:
+    """The first (at most) `n` uncompressed bytes of a member; reads about that much."""
+    head = bytearray()
+    pieces = _member_chunks(archive, span, what, chunk=n)
+    try:
+        for piece in pieces:
+            head += piece
+            if len(head) >= n:
+                break
+    finally:
+        pieces.close()
+    return bytes(head[:n])
+
+
+def _read_manifest_json(archive: _Archive, infos: dict) -> dict:
     info = infos.get(MANIFEST_NAME)
     if info is None:
         raise FormatError(f"no {MANIFEST_NAME} in the zip; this is not a .rk file (a plain "
-                          ".npz?) — write it with reliefkit.formats.save")
+                          ".npz?) — write it with reliefkit.save")
     if info.file_size > MAX_MANIFEST_BYTES:
         raise FormatError(f"{MANIFEST_NAME} is {info.file_size} bytes, over the 1 MiB limit; "
                           "the file is corrupt or forged")
-    with zf.open(info) as fp:
-        raw = fp.read(MAX_MANIFEST_BYTES + 1)
-    if len(raw) > MAX_MANIFEST_BYTES:
-        raise FormatError(f"{MANIFEST_NAME} is over the 1 MiB limit; the file is corrupt")
+    raw = b"".join(_member_chunks(archive, _locate(archive, info), MANIFEST_NAME))
     try:
         manifest = json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, ValueError, RecursionError) as exc:
@@ -577,45 +780,24 @@ def _check_member_set(entries: dict, infos: dict) -> None:
                           "corrupt or forged")
 
 
-def _inspect_member(zf, codec: Codec, name: str, entry: dict, info: zipfile.ZipInfo,
-                    archive_size: int) -> _Member:
+def _inspect_member(archive: _Archive, codec: Codec, name: str, entry: dict,
+                    span: _Span) -> _Member:
     """Check one member's zip entry and .npy header; read at most a few KiB."""
-    if info.compress_type != zipfile.ZIP_STORED:
-        raise FormatError(f"array '{name}' is compressed; .rk members must be stored "
-                          "uncompressed (write the file with reliefkit.formats.save)")
-    if info.compress_size != info.file_size or \
-            info.header_offset + info.compress_size > archive_size:
-        raise FormatError(f"array '{name}' claims {info.file_size} bytes, more than the zip "
-                          "holds; the file is truncated or forged")
-    with _member_stream(zf, info, name) as fp:
-        head = fp.read(min(info.file_size, _HEADER_PEEK))
+    info = span.info
+    head = _peek(archive, span, f"array '{name}'", _HEADER_PEEK)
     dtype, shape, fortran, header_len = _parse_npy_header(name, head)
     _check_array(codec.kind, name, codec.arrays[name], dtype, shape)
     if dtype.str != entry["dtype"] or list(shape) != entry["shape"]:
         raise FormatError(f"array '{name}': the .npy header says {dtype.str} {shape} but the "
                           f"manifest says {entry['dtype']} {tuple(entry['shape'])}; the file is "
                           "corrupt")
-    member = _Member(info, dtype, shape, fortran, header_len, entry["sha256"])
+    member = _Member(span, dtype, shape, fortran, header_len, entry["sha256"])
     if header_len + member.nbytes != info.file_size:
         raise FormatError(f"array '{name}' declares shape {shape} {dtype.str} "
                           f"({member.nbytes} bytes) but its member holds "
                           f"{info.file_size - header_len} bytes of data; the file is truncated "
                           "or forged")
     return member
-
-
-@contextlib.contextmanager
-def _member_stream(zf: zipfile.ZipFile, info: zipfile.ZipInfo, name: str):
-    """Open a member for reading; a failed zip CRC-32 becomes a checksum error.
-
-    zipfile reads small members whole on the first read, so the CRC can fail at any read.
-    """
-    try:
-        with zf.open(info) as fp:
-            yield fp
-    except zipfile.BadZipFile:
-        raise FormatError(f"checksum mismatch for array '{name}' (zip CRC-32): the file is "
-                          "corrupt") from None
 
 
 def _parse_npy_header(name: str, head: bytes) -> tuple[np.dtype, tuple, bool, int]:
@@ -638,21 +820,25 @@ def _parse_npy_header(name: str, head: bytes) -> tuple[np.dtype, tuple, bool, in
     return dtype, shape, fortran, fp.tell()
 
 
-def _read_member(zf: zipfile.ZipFile, name: str, member: _Member) -> np.ndarray:
-    """Read one validated member into a fresh array, hashing the bytes on the way."""
+def _read_member(archive: _Archive, name: str, member: _Member) -> np.ndarray:
+    """Stream one validated member into a fresh array, hashing the bytes on the way."""
     arr = np.empty(member.shape, member.dtype, order="F" if member.fortran else "C")
     flat = arr.ravel(order="K").view(np.uint8)
     sha = hashlib.sha256()
-    with _member_stream(zf, member.info, name) as fp:
-        sha.update(fp.read(member.header_len))
-        pos = 0
-        while pos < flat.size:
-            chunk = fp.read(min(_CHUNK, flat.size - pos))
-            if not chunk:
-                raise FormatError(f"array '{name}' ends early; the file is truncated")
-            sha.update(chunk)
-            flat[pos:pos + len(chunk)] = np.frombuffer(chunk, np.uint8)
-            pos += len(chunk)
+    skip, pos = member.header_len, 0
+    for piece in _member_chunks(archive, member.span, f"array '{name}'"):
+        sha.update(piece)
+        data = memoryview(piece)
+        if skip:
+            cut = min(skip, len(data))
+            data, skip = data[cut:], skip - cut
+        if pos + len(data) > flat.size:  # unreachable: the size was checked against the header
+            raise FormatError(f"array '{name}' holds more data than declared; the file is "
+                              "forged")
+        flat[pos:pos + len(data)] = np.frombuffer(data, np.uint8)
+        pos += len(data)
+    if pos != flat.size:
+        raise FormatError(f"array '{name}' ends early; the file is truncated")
     if sha.hexdigest() != member.sha256:
         raise FormatError(f"checksum mismatch for array '{name}': the file is corrupt")
     return np.ascontiguousarray(arr) if member.fortran else arr

@@ -69,11 +69,12 @@ class Frame:
         return {name: np.asarray(getattr(self, name)) for name in AOV_NAMES}
 
     def save_aovs(self, path) -> None:
-        """Write every AOV and matrix to an .npz (plain arrays, loadable without pickle)."""
+        """Write every AOV and matrix to a compressed .npz (plain arrays, deflated; loadable
+        with ``numpy.load(path, allow_pickle=False)``), atomically."""
         if not str(path).endswith(".npz"):
             raise UsageError(f"AOV file must end in .npz, got {path}")
         with atomic_path(path) as tmp, open(tmp, "wb") as handle:
-            np.savez(handle, **self.aovs())
+            np.savez_compressed(handle, **self.aovs())
 
 
 def frame_from_passes(camera, images) -> Frame:
