@@ -167,3 +167,26 @@ def test_heightmaps_read_like_a_map_from_above(gl, tmp_path):
     frame = render(relief, camera, method="exact")
     high = frame.position[..., 1] > 0.3
     np.testing.assert_array_equal(high, image > 0)
+
+
+@pytest.mark.parametrize("kind", ["relief", "relief-frustum", "relief-cube"])
+def test_a_mesh_and_its_bakes_share_one_camera(gl, tmp_path, kind):
+    """Every .rk keeps its source mesh's bounds, so the same --view gives the same camera
+    (the AOV file's view and projection matrices) for the mesh and for the bake."""
+    from reliefkit import cli
+    from reliefkit.io import rk
+
+    assert cli.main(["bake", "demo:blob", "--as", kind, "--depth-res", "64", "--no-safety",
+                     "-o", str(tmp_path / "b.rk")]) == 0
+    rep = rk.load(tmp_path / "b.rk")
+    np.testing.assert_allclose(rep.source_bounds, make_asset("blob").bounds)
+    cameras = []
+    for name, options in (("demo:blob", []), (str(tmp_path / "b.rk"), ["--method", "exact"])):
+        args = ["render", name, "--view", "30,25", "--size", "96x96", *options,
+                "-o", str(tmp_path / "x.png"), "--aovs", str(tmp_path / "x.npz")]
+        assert cli.main(args) == 0
+        with np.load(tmp_path / "x.npz", allow_pickle=False) as aovs:
+            cameras.append((aovs["view"], aovs["proj"]))
+            assert aovs["mask"].sum() > 500
+    np.testing.assert_array_equal(cameras[0][0], cameras[1][0])
+    np.testing.assert_array_equal(cameras[0][1], cameras[1][1])

@@ -100,7 +100,7 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
     relief = ReliefTexture(height=height, color=to_rgba8(color),
                            normal=_orient_normals(normal, box_to_world),
                            box_to_world=box_to_world, clip_bounds=clip_bounds,
-                           params=dict(params or {}))
+                           source_bounds=mesh.bounds, params=dict(params or {}))
     if safety:
         from .safety import safety_radii
 

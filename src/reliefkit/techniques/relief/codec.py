@@ -21,7 +21,10 @@ RELIEF_ARRAYS = {
     "safety": ArraySpec(("uint8", "uint16"), ndim=2, required=False),
     "box_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
     "clip_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False, finite=True),
+    "source_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False,
+                               finite=True),
 }
+PART_ARRAYS = {name: spec for name, spec in RELIEF_ARRAYS.items() if name != "source_bounds"}
 
 
 def _relief_arrays(relief: ReliefTexture, prefix: str = "") -> dict[str, np.ndarray]:
@@ -29,23 +32,40 @@ def _relief_arrays(relief: ReliefTexture, prefix: str = "") -> dict[str, np.ndar
               "box_to_world": relief.box_to_world}
     if relief.safety is not None:
         arrays["safety"] = relief.safety
-    if relief.clip_bounds is not None:
-        arrays["clip_bounds"] = relief.clip_bounds
+    for name in ("clip_bounds", "source_bounds"):
+        if getattr(relief, name) is not None:
+            arrays[name] = getattr(relief, name)
     return {prefix + name: a for name, a in arrays.items()}
 
 
 def _relief_from(arrays: dict, params: dict, prefix: str = "") -> ReliefTexture:
-    get = {name: arrays.get(prefix + name) for name in RELIEF_ARRAYS}
+    get = {name: arrays.get(prefix + name) for name in (PART_ARRAYS if prefix else RELIEF_ARRAYS)}
+    params = dict(params)
+    if get["clip_bounds"] is None and "clip_bounds" in params:  # files before it was an array
+        get["clip_bounds"] = _old_clip_bounds(params.pop("clip_bounds"))
     try:
-        return ReliefTexture(params=dict(params), **get)
+        return ReliefTexture(params=params, **get)
     except (UsageError, TypeError, ValueError) as exc:  # the representation refuses it
         raise FormatError(f"invalid relief texture: {exc}") from None
 
 
+def _old_clip_bounds(value) -> np.ndarray:
+    """``clip_bounds`` of an older file's params: two lists of three numbers."""
+    try:
+        box = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        box = None
+    if box is None or box.shape != (2, 3):
+        raise FormatError(f"params clip_bounds must be [[x, y, z], [x, y, z]], got {value!r}")
+    return box
+
+
 def _object_arrays(obj: ReliefObject):
-    arrays = {}
+    arrays = {"source_bounds": obj.source_bounds}
     for k, part in enumerate(obj.parts):
-        arrays |= _relief_arrays(part, f"p{k}_")
+        part_arrays = _relief_arrays(part, f"p{k}_")
+        part_arrays.pop(f"p{k}_source_bounds", None)  # the object's, stored once
+        arrays |= part_arrays
     params = dict(obj.params) | {"parts": len(obj.parts),
                                  "part_params": [p.params for p in obj.parts]}
     return arrays, params
@@ -55,14 +75,21 @@ def _object_from(arrays: dict, params: dict) -> ReliefObject:
     count = params.get("parts")
     if not isinstance(count, int) or not 1 <= count <= MAX_PARTS:
         raise FormatError(f"relief-object needs 1..{MAX_PARTS} parts, manifest says {count!r}")
-    part_params = params.get("part_params") or [{}] * count
+    part_params = params.get("part_params", [{}] * count)
+    if not (isinstance(part_params, list) and len(part_params) == count
+            and all(isinstance(p, dict) for p in part_params)):
+        raise FormatError(f"relief-object part_params must be a list of {count} JSON objects "
+                          "(one per part)")
     parts = []
     for k in range(count):
         if f"p{k}_height" not in arrays:
             raise FormatError(f"relief-object part {k} is missing its arrays")
         parts.append(_relief_from(arrays, part_params[k], f"p{k}_"))
     rest = {key: v for key, v in params.items() if key not in ("parts", "part_params")}
-    return ReliefObject(parts=parts, params=rest)
+    try:
+        return ReliefObject(parts=parts, params=rest, source_bounds=arrays.get("source_bounds"))
+    except UsageError as exc:
+        raise FormatError(f"invalid relief object: {exc}") from None
 
 
 RELIEF = Codec(kind="relief", cls=ReliefTexture, arrays=RELIEF_ARRAYS,
@@ -70,8 +97,9 @@ RELIEF = Codec(kind="relief", cls=ReliefTexture, arrays=RELIEF_ARRAYS,
                from_arrays=_relief_from)
 RELIEF_OBJECT = Codec(
     kind="relief-object", cls=ReliefObject,
-    arrays={f"p{k}_{name}": ArraySpec(spec.dtypes, spec.ndim, required=False,
-                                      finite=spec.finite, trailing=spec.trailing)
-            for k in range(MAX_PARTS) for name, spec in RELIEF_ARRAYS.items()},
+    arrays={"source_bounds": RELIEF_ARRAYS["source_bounds"]} | {
+        f"p{k}_{name}": ArraySpec(spec.dtypes, spec.ndim, required=False, finite=spec.finite,
+                                  trailing=spec.trailing)
+        for k in range(MAX_PARTS) for name, spec in PART_ARRAYS.items()},
     to_arrays=_object_arrays, from_arrays=_object_from)
 CODECS = (RELIEF, RELIEF_OBJECT)

@@ -121,4 +121,5 @@ def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int |
         parts.append(bake_through(mesh, box_to_world, size, color_size, safety=safety,
                                   tolerance=tolerance, progress=part_progress, params=params,
                                   zero_border=False, ctx=ctx))
-    return ReliefObject(parts=parts, params={"projection": "cube", "source": mesh.name})
+    return ReliefObject(parts=parts, params={"projection": "cube", "source": mesh.name},
+                        source_bounds=mesh.bounds)

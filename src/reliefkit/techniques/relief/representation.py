@@ -31,6 +31,8 @@ class ReliefTexture:
         exact methods can render it).
     clip_bounds : (2, 3) float64 world box (min, max corner) that the drawn proxy is cut to
         (§4.1: fewer fragments for a frustum), or None to draw the whole box.
+    source_bounds : (2, 3) float64 world bounding box of the mesh it was baked from, or None;
+        views frame a representation by it, so a mesh and its bakes share one camera.
     params : bake parameters (JSON), kept in the .rk manifest.
     """
 
@@ -40,6 +42,7 @@ class ReliefTexture:
     box_to_world: np.ndarray
     safety: np.ndarray | None = None
     clip_bounds: np.ndarray | None = None
+    source_bounds: np.ndarray | None = None
     params: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -64,11 +67,15 @@ class ReliefTexture:
             if self.safety.shape != self.height.shape or self.safety.dtype not in (
                     np.uint8, np.uint16):
                 raise UsageError("safety must be uint8/uint16 with the height's shape")
+        self.clip_bounds = _box_or_none(self.clip_bounds, "clip_bounds")
+        self.source_bounds = _box_or_none(self.source_bounds, "source_bounds")
         if self.clip_bounds is not None:
-            self.clip_bounds = np.asarray(self.clip_bounds, dtype=np.float64)
-            if self.clip_bounds.shape != (2, 3) or not np.isfinite(self.clip_bounds).all() \
-                    or (self.clip_bounds[0] >= self.clip_bounds[1]).any():
-                raise UsageError("clip_bounds must be finite (min, max) corners with min < max")
+            corners = self.corners
+            lo = np.maximum(corners.min(axis=0), self.clip_bounds[0])
+            hi = np.minimum(corners.max(axis=0), self.clip_bounds[1])
+            if (lo >= hi).any():
+                raise UsageError("clip_bounds do not overlap the relief's box: nothing would "
+                                 "be drawn")
 
     @property
     def depth_resolution(self) -> tuple[int, int]:
@@ -122,12 +129,28 @@ class ReliefTexture:
                 "bytes": self.memory_bytes(), "params": self.params}
 
 
+def _box_or_none(value, name: str) -> np.ndarray | None:
+    """A (2, 3) world box (min, max corner, min <= max: flat meshes have flat boxes), or None."""
+    if value is None:
+        return None
+    box = np.asarray(value, dtype=np.float64)
+    if box.shape != (2, 3) or not np.isfinite(box).all() or (box[0] > box[1]).any():
+        raise UsageError(f"{name} must be finite (min, max) corners with min <= max")
+    return box
+
+
 @dataclass(eq=False)
 class ReliefObject:
     """Several relief textures drawn together (the six frusta of a cube, §4.2)."""
 
     parts: list[ReliefTexture]
     params: dict = field(default_factory=dict)
+    source_bounds: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if not self.parts or not all(isinstance(p, ReliefTexture) for p in self.parts):
+            raise UsageError("a relief object needs one or more ReliefTexture parts")
+        self.source_bounds = _box_or_none(self.source_bounds, "source_bounds")
 
     @property
     def bounds(self) -> np.ndarray:
