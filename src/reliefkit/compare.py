@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .io.atomic import atomic_path
+from .units import format_bytes
 from .pictures import TILE_BACKGROUND
 
 CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
@@ -23,11 +24,13 @@ def compare(mesh, representation, camera, *, light=None) -> dict:
     """Render ``mesh`` and every variant of ``representation``; metrics, frames, error masks.
 
     Returns ``{"metrics": {variant: row}, "frames": {"mesh": Frame, variant: Frame},
-    "errors": {variant: mask or None}, "columns": table columns}``.
+    "errors": {variant: mask or None}, "columns": table columns, "bytes": {"mesh": n,
+    "representation": n}}`` (bytes as the .rk files store them, uncompressed).
     """
     from . import metrics
     from .core.technique import technique_of
     from .errors import UsageError
+    from .io.rk import array_bytes
     from .render import render
 
     tech = technique_of(representation)
@@ -56,7 +59,10 @@ def compare(mesh, representation, camera, *, light=None) -> dict:
         frames[variant.name] = plain
         errors[variant.name] = error_mask
     columns = tuple(c for m in tech.compare_metrics for c in m.columns) + CORE_COLUMNS
-    return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns}
+    sizes = {"mesh": sum(array_bytes(mesh).values()),
+             "representation": sum(array_bytes(representation).values())}
+    return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns,
+            "bytes": sizes}
 
 
 def comparison_sheet(result: dict, title: str):
@@ -88,7 +94,10 @@ def _rgba(rgb: np.ndarray) -> np.ndarray:
 
 def metrics_markdown(result: dict, heading: str) -> str:
     cols = result["columns"]
-    lines = [f"### {heading}", "", "| variant | " + " | ".join(cols) + " |",
+    sizes = result["bytes"]
+    lines = [f"### {heading}", "", f"Memory: representation {format_bytes(sizes['representation'])}"
+             f", mesh {format_bytes(sizes['mesh'])}.", "",
+             "| variant | " + " | ".join(cols) + " |",
              "|---" * (len(cols) + 1) + "|"]
     for name, row in result["metrics"].items():
         cells = [f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, ""))
@@ -108,5 +117,6 @@ def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]
     with atomic_path(paths["markdown"]) as tmp:
         tmp.write_text(metrics_markdown(result, title))
     with atomic_path(paths["json"]) as tmp:
-        tmp.write_text(json.dumps({"title": title, "variants": result["metrics"]}, indent=2))
+        tmp.write_text(json.dumps({"title": title, "bytes": result["bytes"],
+                                   "variants": result["metrics"]}, indent=2))
     return paths

@@ -58,6 +58,9 @@ def test_compare_uses_the_toys_variants_and_metric(gl, toy):
     assert set(result["metrics"]) == {"flat", "checker"}
     assert result["metrics"]["flat"]["mean_alpha"] == pytest.approx(1.0)
     assert "mean_alpha" in result["columns"]
+    # memory as stored: 4 x 3 float64 corners and 4 float32 colour channels
+    assert result["bytes"]["representation"] == 4 * 3 * 8 + 4 * 4
+    assert result["bytes"]["mesh"] >= mesh.positions.nbytes + mesh.indices.nbytes
 
 
 def test_demo_lists_the_toys_tile(toy):

@@ -42,7 +42,7 @@ from .atomic import atomic_path
 
 __all__ = [
     "ArraySpec", "Codec", "RkFile", "register", "unregister", "registered_kinds",
-    "save", "load", "read_manifest", "write_rk", "read_rk", "file_sha256",
+    "save", "load", "read_manifest", "write_rk", "read_rk", "file_sha256", "array_bytes",
     "FORMAT_NAME", "FORMAT_VERSION", "DEFAULT_MAX_BYTES",
 ]
 
@@ -299,6 +299,12 @@ def _check_source_hash(value) -> None:
 
 
 # --------------------------------------------------------------------------- writing
+
+
+def array_bytes(representation) -> dict[str, int]:
+    """Bytes of each array a representation stores (its memory, uncompressed), by name."""
+    arrays, _ = _codec_for_object(representation).to_arrays(representation)
+    return {name: int(np.asarray(a).nbytes) for name, a in arrays.items() if a is not None}
 
 
 def save(path, representation, *, source_hash: str | None = None) -> Path:
