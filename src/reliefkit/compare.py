@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from .io.atomic import atomic_path
-from .units import format_bytes
 from .pictures import TILE_BACKGROUND
+from .units import format_bytes
 
 CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
                 "iterations_max")
