@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ...io.atomic import atomic_path
+from ...units import format_bytes
 from .bake import DEFAULT_TOLERANCE
 from .render import METHODS
 
@@ -61,6 +62,7 @@ def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
 def table1(cfg: BenchConfig, log) -> list[dict]:
     """Frame time per method and for the mesh, iterations per covered pixel (Table 1)."""
     from ...bench.timing import time_render
+    from ...io.rk import array_bytes
     from ...render import render
     from ...scene.assets import make_asset
     from .bake import bake_relief
@@ -79,7 +81,9 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
             row = {"model": name, "res": res, "mesh_ms": mesh_ms,
                    "triangles": mesh.triangle_count,
                    "safety_s": time.perf_counter() - start,
-                   "mean_radius": float(relief.safety.mean())}
+                   "mean_radius": float(relief.safety.mean()),
+                   "bytes": sum(array_bytes(relief).values()),
+                   "mesh_bytes": sum(array_bytes(mesh).values())}
             for method in METHODS:
                 row[f"{method}_ms"] = time_render(relief, camera, method=method,
                                                   repeats=cfg.repeats)["wall_ms"]
@@ -225,6 +229,11 @@ def markdown(results: dict) -> str:
     for r in results["table1"]:
         lines.append(f"| {r['model']} | {r['res']}² | {r['safety_s']:.2f} | "
                      f"{r['mean_radius']:.2f} |")
+    lines += ["", "#### Memory (arrays as stored, uncompressed)", "",
+              "| model | resolution | relief texture | its mesh |", "|---" * 4 + "|"]
+    for r in results["table1"]:
+        lines.append(f"| {r['model']} | {r['res']}² | {format_bytes(r['bytes'])} | "
+                     f"{format_bytes(r['mesh_bytes'])} |")
     lines += ["", "#### Targets", "", "| target | value | met |", "|---|---|---|"]
     for t in results["targets"]:
         lines.append(f"| {t['target']} | {t['value']:.4g} | {'yes' if t['met'] else 'no'} |")
