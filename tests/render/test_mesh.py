@@ -151,3 +151,161 @@ def test_textured_glb_renders_its_texture_the_right_way_up(gl, tmp_path):
     np.testing.assert_allclose(rgb[7:9, 23:25].mean(axis=(0, 1)), [0, 1, 0], atol=0.1)
     np.testing.assert_allclose(rgb[23:25, 7:9].mean(axis=(0, 1)), [0, 0, 1], atol=0.1)
     np.testing.assert_allclose(rgb[23:25, 23:25].mean(axis=(0, 1)), [1, 1, 1], atol=0.1)
+
+
+# --------------------------------------------------------------------------- materials
+
+def _flat_light():
+    """A light under which a pixel shows its base colour."""
+    from reliefkit.scene.light import DirectionalLight
+
+    return DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)
+
+
+def _srgb_to_linear(byte):
+    c = np.asarray(byte, float) / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+# two 2x2 images, as PIL stores them (row 0 is the top), every texel different
+IMAGE_A = np.array([[[230, 20, 20, 255], [20, 230, 20, 255]],
+                    [[20, 20, 230, 255], [230, 230, 230, 255]]], np.uint8)
+IMAGE_B = np.array([[[250, 200, 0, 255], [0, 200, 250, 255]],
+                    [[120, 0, 120, 255], [40, 40, 40, 255]]], np.uint8)
+
+
+def _two_textured_quads(tmp_path):
+    """A GLB of two unit quads in z = 0, at x in [0, 1] (IMAGE_A) and [2, 3] (IMAGE_B)."""
+    from PIL import Image
+
+    quads = []
+    for x, image in ((0.0, IMAGE_A), (2.0, IMAGE_B)):
+        blocks = np.repeat(np.repeat(image, 4, axis=0), 4, axis=1)  # bilinear-proof blocks
+        material = trimesh.visual.material.PBRMaterial(
+            baseColorTexture=Image.fromarray(blocks, "RGBA"), baseColorFactor=[255] * 4)
+        quads.append(trimesh.Trimesh(
+            np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float) + [x, 0, 0],
+            [[0, 1, 2], [0, 2, 3]], process=False,
+            visual=trimesh.visual.TextureVisuals(
+                uv=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]), material=material)))
+    path = tmp_path / "two_materials.glb"
+    trimesh.Scene(quads).export(str(path))
+    return path
+
+
+def _assert_texels_shown(rgb, image, col0, top_row, step):
+    """Each 4x4-texel block of a 2x2 `image` (32 pixels wide) at its centre in `rgb`.
+
+    The quad's left edge is column `col0`; picture rows go down from `top_row` (step -1 for
+    images with row 0 at v = 0). Inside a uniform block bilinear filtering is exact.
+    """
+    for r in range(2):
+        for c in range(2):
+            rows = top_row + step * (8 + 16 * r) + np.arange(-4, 4)
+            cols = col0 + 8 + 16 * c + np.arange(-4, 4)
+            got = rgb[np.ix_(rows, cols)].reshape(-1, 3)
+            np.testing.assert_allclose(got, np.tile(_srgb_to_linear(image[r, c, :3]), (64, 1)),
+                                       atol=3e-3, err_msg=f"texel ({r}, {c})")
+
+
+def test_two_materials_render_each_its_own_texture(gl, tmp_path):
+    from reliefkit.scene.loader import load_mesh
+
+    mesh = load_mesh(_two_textured_quads(tmp_path))
+    camera = Camera(eye=(1.5, 0.5, 3), target=(1.5, 0.5, 0), size=(96, 32), ortho_height=0.5)
+    frame = render(mesh, camera, light=_flat_light())
+    rgb = frame.color[..., :3]
+    _assert_texels_shown(rgb, IMAGE_A, col0=0, top_row=0, step=1)
+    _assert_texels_shown(rgb, IMAGE_B, col0=64, top_row=0, step=1)
+
+
+def test_projected_bake_colour_shows_both_textures(gl, tmp_path):
+    from reliefkit.bake.project import project_mesh
+    from reliefkit.scene.loader import load_mesh
+
+    mesh = load_mesh(_two_textured_quads(tmp_path))
+    box_to_world = np.array([[3.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.5], [0, 0, 0, 1]])
+    projection = project_mesh(mesh, box_to_world, (96, 32))
+    assert projection.mask[:, :32].all() and projection.mask[:, 64:].all()
+    rgb = projection.color[..., :3]  # row 0 at v = 0: the picture's bottom row
+    _assert_texels_shown(rgb, IMAGE_A, col0=0, top_row=31, step=-1)
+    _assert_texels_shown(rgb, IMAGE_B, col0=64, top_row=31, step=-1)
+
+
+def _unit_quad(**mesh_kwargs) -> RenderMesh:
+    positions = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float32)
+    return RenderMesh(positions, [[0, 1, 2], [0, 2, 3]], np.tile([0, 0, 1.0], (4, 1)),
+                      mesh_kwargs.pop("colors", np.ones((4, 4))),
+                      uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]), **mesh_kwargs)
+
+
+def test_material_colour_texture_and_vertex_colour_multiply(gl):
+    from reliefkit.scene.mesh import Material
+
+    white = np.full((2, 2, 4), 255, np.uint8)
+    colors = np.tile([0.5, 1.0, 1.0, 1.0], (4, 1))
+    mesh = _unit_quad(colors=colors,
+                      materials=[Material(color=(1.0, 0.5, 0.25, 1.0), texture=white)])
+    frame = render(mesh, Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(16, 16),
+                                ortho_height=1.0), light=_flat_light())
+    np.testing.assert_allclose(frame.color[4:12, 4:12, :3].reshape(-1, 3),
+                               np.tile([0.5, 0.5, 0.25], (64, 1)), atol=1e-3)
+
+
+def test_uv_transform_moves_the_lookup(gl):
+    from reliefkit.scene.mesh import Material
+
+    texture = IMAGE_A[::-1].copy()  # row 0 at v = 0
+    to_one_texel = [[0, 0, 0.75], [0, 0, 0.75], [0, 0, 1]]  # every uv -> (0.75, 0.75)
+    mesh = _unit_quad(materials=[Material(texture=texture, uv_transform=to_one_texel)])
+    frame = render(mesh, Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(16, 16),
+                                ortho_height=1.0), light=_flat_light())
+    expected = _srgb_to_linear(IMAGE_A[0, 1, :3])  # the top-right texel
+    np.testing.assert_allclose(frame.color[2:14, 2:14, :3].reshape(-1, 3),
+                               np.tile(expected, (144, 1)), atol=3e-3)
+
+
+def test_uvs_without_an_image_render_the_default_colour(gl, tmp_path):
+    from reliefkit.scene.loader import DEFAULT_COLOR, load_mesh
+
+    path = tmp_path / "uv_only.obj"
+    path.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                    "f 1/1 2/2 3/3 4/4\n")
+    frame = render(load_mesh(path), Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(16, 16),
+                                           ortho_height=1.0), light=_flat_light())
+    np.testing.assert_allclose(frame.color[4:12, 4:12, :3].reshape(-1, 3),
+                               np.tile(DEFAULT_COLOR[:3], (64, 1)), atol=1e-3)
+
+
+def test_rotated_textured_boxes_are_lit_from_the_front(gl, tmp_path):
+    """Boxes under rotated glTF nodes: on every visible pixel the normal faces the camera."""
+    from PIL import Image
+    from scipy.spatial.transform import Rotation
+
+    from reliefkit.scene.loader import load_mesh
+
+    box = trimesh.creation.box(extents=(1.0, 1.5, 2.0))
+    corners = box.vertices[box.faces].reshape(-1, 3)
+    faces = np.arange(len(corners)).reshape(-1, 3)
+    material = trimesh.visual.material.PBRMaterial(
+        baseColorTexture=Image.fromarray(IMAGE_A, "RGBA"), baseColorFactor=[255] * 4)
+    textured = trimesh.Trimesh(
+        corners, faces, vertex_normals=np.repeat(box.face_normals, 3, axis=0), process=False,
+        visual=trimesh.visual.TextureVisuals(uv=corners[:, :2] + 0.5, material=material))
+    scene = trimesh.Scene()
+    for k, rotvec in enumerate(([1.2, 0, 0], [0, 0.8, 0.5], [-0.4, 2.0, 1.1])):
+        node = np.eye(4)
+        node[:3, :3] = Rotation.from_rotvec(rotvec).as_matrix()
+        node[:3, 3] = [3.0 * k, 0, 0]
+        scene.add_geometry(textured, node_name=f"box{k}", geom_name="box", transform=node)
+    path = tmp_path / "boxes.glb"
+    scene.export(str(path))
+    mesh = load_mesh(path)
+    for azimuth, elevation in ((0, 20), (140, -35), (260, 60)):
+        camera = Camera.orbit(tuple(mesh.center), azimuth, elevation, 9.0, size=(128, 64))
+        frame = render(mesh, camera)
+        m = frame.mask
+        assert m.sum() > 400
+        to_eye = np.asarray(camera.eye) - frame.position[m]
+        facing = (frame.normal[m] * to_eye).sum(axis=1)
+        assert (facing > 0).all(), f"{(facing <= 0).mean():.0%} of the pixels face away"

@@ -248,14 +248,17 @@ def test_obj_material_diffuse_is_decoded_from_srgb(tmp_path):
     mesh_out = load_mesh(path)
     c = 0.5, 0.25
     expected = [((x + 0.055) / 1.055) ** 2.4 for x in c] + [1.0, 1.0]
-    np.testing.assert_allclose(mesh_out.colors, np.tile(expected, (3, 1)), rtol=1e-6)
+    assert [m.name for m in mesh_out.materials] == ["paint"]
+    np.testing.assert_allclose(mesh_out.materials[0].color, expected, rtol=1e-6)
+    np.testing.assert_array_equal(mesh_out.colors, 1.0)  # the file has no vertex colours
 
 
 def test_gltf_base_color_factor_is_linear_already(tmp_path):
     material = trimesh.visual.material.PBRMaterial(baseColorFactor=[0.5, 0.25, 1.0, 1.0])
     shape = quad(visual=trimesh.visual.TextureVisuals(material=material))
     mesh_out = load_mesh(write_export(shape, tmp_path / "factor.glb"))
-    np.testing.assert_allclose(mesh_out.colors, np.tile([0.5, 0.25, 1, 1], (4, 1)), atol=1 / 255)
+    np.testing.assert_allclose(mesh_out.materials[0].color, [0.5, 0.25, 1, 1], atol=1 / 255)
+    np.testing.assert_array_equal(mesh_out.colors, 1.0)
 
 
 # the 2x2 texture as PIL stores it (row 0 is the top of the picture, v = 1)
@@ -303,30 +306,32 @@ def test_gltf_image_given_by_uri_is_loaded(tmp_path):
     np.testing.assert_array_equal(sample_nearest(mesh_out.texture, mesh_out.uvs), CORNER_COLORS)
 
 
-def test_different_textures_are_baked_into_vertex_colours(tmp_path):
+def test_different_textures_are_kept_one_material_each(tmp_path):
     red = np.tile(np.array([255, 0, 0, 255], np.uint8), (2, 2, 1))
     blue = np.tile(np.array([0, 0, 255, 255], np.uint8), (2, 2, 1))
     scene = trimesh.Scene([textured_quad(red), textured_quad(blue, offset=(2.0, 0.0, 0.0))])
     mesh_out = load_mesh(write_export(scene, tmp_path / "two.glb"))
 
-    assert mesh_out.texture is None and mesh_out.uvs is None
-    is_red = mesh_out.positions[:, 0] < 1.5
-    np.testing.assert_allclose(mesh_out.colors[is_red], np.tile([1, 0, 0, 1], (4, 1)))
-    np.testing.assert_allclose(mesh_out.colors[~is_red], np.tile([0, 0, 1, 1], (4, 1)))
+    assert mesh_out.textured and mesh_out.texture is None  # no single texture
+    assert len(mesh_out.materials) == 2
+    triangle_x = mesh_out.positions[mesh_out.indices][:, :, 0].mean(axis=1)
+    for is_red, image in ((triangle_x < 1.5, red), (triangle_x > 1.5, blue)):
+        (used,) = set(mesh_out.material[is_red])
+        np.testing.assert_array_equal(mesh_out.materials[used].texture, image)
+    np.testing.assert_array_equal(mesh_out.colors, 1.0)
 
 
-def test_textured_and_untextured_parts_are_baked(tmp_path):
+def test_textured_and_untextured_parts_keep_their_materials(tmp_path):
     scene = trimesh.Scene([textured_quad(), quad(offset=(2.0, 0.0, 0.0))])
     mesh_out = load_mesh(write_export(scene, tmp_path / "mixed.glb"))
 
-    assert mesh_out.texture is None
-    textured = mesh_out.positions[:, 0] < 1.5
-    # vertices sit on the texture's outer corners: bilinear with wrap-around mixes all four
-    # texels, so compare with the mean of the linearised texture
-    linear = np.array([[srgb_byte_to_linear(int(b)) for b in t[:3]] for t in CORNER_COLORS])
-    mean = np.append(linear.mean(axis=0), CORNER_COLORS[:, 3].mean() / 255)
-    np.testing.assert_allclose(mesh_out.colors[textured], np.tile(mean, (4, 1)), atol=1e-6)
-    np.testing.assert_allclose(mesh_out.colors[~textured], np.tile([0.8, 0.8, 0.8, 1], (4, 1)))
+    triangle_x = mesh_out.positions[mesh_out.indices][:, :, 0].mean(axis=1)
+    textured = mesh_out.materials[mesh_out.material[triangle_x < 1.5][0]]
+    plain = mesh_out.materials[mesh_out.material[triangle_x > 1.5][0]]
+    np.testing.assert_array_equal(sample_nearest(textured.texture, QUAD_UV), CORNER_COLORS)
+    assert plain.texture is None
+    untextured_vertices = mesh_out.positions[:, 0] > 1.5
+    np.testing.assert_allclose(mesh_out.colors[untextured_vertices], [[0.8, 0.8, 0.8, 1]] * 4)
 
 
 # --------------------------------------------------------------------------------------
@@ -586,3 +591,10 @@ def test_reference_outside_the_folder(tmp_path):
     path = folder / "m.obj"
     path.write_text("mtllib ../m.mtl\nusemtl paint\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     expect_error(path, "outside its folder")
+
+
+@pytest.mark.parametrize("suffix", SUPPORTED_EXTENSIONS)
+def test_empty_file_says_it_is_empty(tmp_path, suffix):
+    path = tmp_path / f"empty{suffix}"
+    path.write_bytes(b"")
+    expect_error(path, "is empty")

@@ -30,6 +30,7 @@ def describe(obj) -> dict:
         lo, hi = obj.bounds
         return {"kind": "mesh", "name": obj.name, "vertices": len(obj.positions),
                 "triangles": obj.triangle_count, "bounds_min": lo.tolist(),
-                "bounds_max": hi.tolist(), "textured": obj.texture is not None}
+                "bounds_max": hi.tolist(), "materials": len(obj.materials),
+                "textured": obj.textured}
     summary = getattr(obj, "summary", None)
     return summary() if callable(summary) else {"kind": type(obj).__name__}

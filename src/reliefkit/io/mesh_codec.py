@@ -1,31 +1,90 @@
-"""The core's own .rk kind, ``mesh``: a RenderMesh stored as plain arrays."""
+"""The core's own .rk kind, ``mesh``: a RenderMesh stored as plain arrays, every material kept.
+
+Version 2 added materials to the arrays of version 1, which describe a one-material mesh
+with at most one texture (``texture``). Arrays that would only repeat the defaults are left
+out, so a version 1 file is a valid version 2 file and one reader reads both:
+
+- ``material`` (F,) uint16 per-triangle material index (absent: every triangle uses 0);
+- ``material_colors`` (M, 4) float32 linear colour factors (absent: one white material);
+- ``texture`` material 0's texture, ``texture_K`` material K's (K < `MAX_TEXTURED`);
+- ``uv_transforms`` (M, 3, 3) float32 (absent: none); param ``materials``: their names.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import FormatError
-from ..scene.mesh import RenderMesh
+from ..scene.mesh import Material, RenderMesh
 from .rk import ArraySpec, Codec, register
+
+#: Materials 0 .. MAX_TEXTURED - 1 can keep a texture in a .rk file.
+MAX_TEXTURED = 64
+
+_WHITE = np.ones(4, np.float32)
+
+
+def texture_array_name(k: int) -> str:
+    """The array holding material k's texture (``texture`` for material 0, as in version 1)."""
+    return "texture" if k == 0 else f"texture_{k}"
 
 
 def _mesh_to_arrays(mesh: RenderMesh) -> tuple[dict[str, np.ndarray], dict]:
+    materials = mesh.materials
     arrays = {"positions": mesh.positions, "indices": mesh.indices, "normals": mesh.normals,
-              "colors": mesh.colors, "uvs": mesh.uvs, "texture": mesh.texture}
-    return arrays, {"name": mesh.name}
+              "colors": mesh.colors, "uvs": mesh.uvs}
+    params = {"name": mesh.name}
+    if len(materials) > 1:
+        arrays["material"] = mesh.material
+    if len(materials) > 1 or not np.array_equal(materials[0].color, _WHITE):
+        arrays["material_colors"] = np.stack([m.color for m in materials])
+    if any(m.uv_transform is not None for m in materials):
+        arrays["uv_transforms"] = np.stack(
+            [np.eye(3, dtype=np.float32) if m.uv_transform is None else m.uv_transform
+             for m in materials])
+    if any(m.name for m in materials):
+        params["materials"] = [m.name for m in materials]
+    for k, m in enumerate(materials):
+        if m.texture is None:
+            continue
+        if k >= MAX_TEXTURED:
+            raise FormatError(f"{mesh.name}: material {k} has a texture; a mesh .rk keeps the "
+                              f"textures of its first {MAX_TEXTURED} materials only")
+        arrays[texture_array_name(k)] = m.texture
+    return arrays, params
 
 
 def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh:
     name = params.get("name", "mesh")
     if not isinstance(name, str):
         raise FormatError(f"mesh param 'name' must be a string, got {type(name).__name__}")
-    return RenderMesh(name=name, **arrays)
+    colors = arrays.get("material_colors", _WHITE[None])
+    count = len(colors)
+    names = params.get("materials", [""] * count)
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise FormatError("mesh param 'materials' must be a list of material names")
+    transforms = arrays.get("uv_transforms")
+    for what, n in (("names in param 'materials'", len(names)),
+                    ("uv_transforms", count if transforms is None else len(transforms))):
+        if n != count:
+            raise FormatError(f"mesh has {count} material colours but {n} {what}")
+    textured = [k for k in range(MAX_TEXTURED) if texture_array_name(k) in arrays]
+    if textured and textured[-1] >= count:
+        raise FormatError(f"array '{texture_array_name(textured[-1])}' belongs to material "
+                          f"{textured[-1]}, but the mesh has {count} materials")
+    materials = [Material(names[k], colors[k], arrays.get(texture_array_name(k)),
+                          None if transforms is None else transforms[k]) for k in range(count)]
+    return RenderMesh(arrays["positions"], arrays["indices"], arrays["normals"],
+                      arrays["colors"], arrays.get("uvs"), name=name, materials=materials,
+                      material=arrays.get("material"))
 
 
 def _rows(dtype: str, cols: int, **options) -> ArraySpec:
     """Spec of an (N, cols) per-vertex or per-triangle table."""
     return ArraySpec((dtype,), ndim=2, trailing=(cols,), **options)
 
+
+_TEXTURE = ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False)
 
 register(Codec(
     kind="mesh",
@@ -36,8 +95,13 @@ register(Codec(
         "normals": _rows("float32", 3, finite=True),
         "colors": _rows("float32", 4, finite=True),
         "uvs": _rows("float32", 2, finite=True, required=False),
-        "texture": ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False),
+        "material": ArraySpec(("uint16",), ndim=1, required=False),
+        "material_colors": _rows("float32", 4, finite=True, required=False),
+        "uv_transforms": ArraySpec(("float32",), ndim=3, trailing=(3, 3), finite=True,
+                                   required=False),
+        **{texture_array_name(k): _TEXTURE for k in range(MAX_TEXTURED)},
     },
     to_arrays=_mesh_to_arrays,
     from_arrays=_mesh_from_arrays,
+    version=2,
 ))

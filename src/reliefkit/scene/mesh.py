@@ -1,20 +1,78 @@
-"""`RenderMesh`: the triangle mesh every renderer and baker consumes, validated on creation.
+"""`RenderMesh` and its `Material`s: what every renderer and baker consumes, validated.
 
 Loading from files (`load_mesh`) lives in :mod:`reliefkit.scene.loader`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import MeshError
 
+#: Most materials one mesh may have (per-triangle material indices are uint16).
+MAX_MATERIALS = 1 << 16
+
 
 @dataclass(frozen=True, eq=False)
+class Material:
+    """One surface's base colour: ``color`` times ``texture`` (times the vertex colours).
+
+    Materials compare equal by value, so a loader can merge the same material met twice.
+
+    Attributes
+    ----------
+    name : the file's material name ("" when it has none).
+    color : (4,) float32 linear RGBA factor, in [0, 1].
+    texture : (h, w, 4) uint8 sRGB-encoded base-colour image, row 0 at v = 0, or None.
+    uv_transform : (3, 3) float32 affine map of (u, v, 1) applied before the lookup (glTF's
+        KHR_texture_transform, in this mesh's UV convention), or None for the identity.
+    """
+
+    name: str = ""
+    color: np.ndarray = (1.0, 1.0, 1.0, 1.0)
+    texture: np.ndarray | None = None
+    uv_transform: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        where = f"material '{self.name}'"
+        if not isinstance(self.name, str):
+            raise MeshError(f"a material name must be a string, got {type(self.name).__name__}")
+        color = _array(np.atleast_2d(self.color), np.float32, 4, "color", where)
+        if len(color) != 1 or color.min() < 0 or color.max() > 1:
+            raise MeshError(f"{where}: color must be 4 values in [0, 1], got {color.tolist()}")
+        set_(self, "color", color[0])
+        if self.texture is not None:
+            tex = np.ascontiguousarray(self.texture)
+            if tex.dtype != np.uint8 or tex.ndim != 3 or tex.shape[2] != 4 or tex.size == 0:
+                raise MeshError(f"{where}: texture must be a non-empty (h, w, 4) uint8 array")
+            set_(self, "texture", tex)
+        if self.uv_transform is not None:
+            matrix = _array(self.uv_transform, np.float32, 3, "uv_transform", where)
+            if matrix.shape != (3, 3) or not np.array_equal(matrix[2], [0, 0, 1]):
+                raise MeshError(f"{where}: uv_transform must be a 3x3 affine matrix "
+                                "(last row 0, 0, 1)")
+            set_(self, "uv_transform", None if np.array_equal(matrix, np.eye(3)) else matrix)
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, Material):
+            return NotImplemented
+        return (self.name == other.name and np.array_equal(self.color, other.color)
+                and _same_or_none(self.texture, other.texture)
+                and _same_or_none(self.uv_transform, other.uv_transform))
+
+    __hash__ = None
+
+
+@dataclass(frozen=True, eq=False, init=False)
 class RenderMesh:
-    """An indexed triangle mesh in its file's own world coordinates.
+    """An indexed triangle mesh in its file's own world coordinates, with its materials.
+
+    A triangle's base colour is its vertex colour times its material's colour and texture.
+    Every material keeps its own texture; the renderer draws each material's triangles with
+    it (`material_groups`).
 
     Attributes
     ----------
@@ -22,41 +80,74 @@ class RenderMesh:
     indices : (F, 3) uint32 triangle corners (counter-clockwise is the front face).
     normals : (V, 3) float32 unit vertex normals.
     colors : (V, 4) float32 linear RGBA base colour per vertex, in [0, 1].
-    uvs : (V, 2) float32 texture coordinates (GL convention, v up) or None.
-    texture : (h, w, 4) uint8 sRGB-encoded base-colour texture, row 0 at v = 0, or None.
+    uvs : (V, 2) float32 texture coordinates (GL convention, v up) or None; shared by all
+        materials, required when one has a texture.
+    materials : tuple of at least one `Material`.
+    material : (F,) uint16 index into `materials` per triangle.
     name : a label for pictures and messages.
+    extra : free-form provenance (source path, asset parts), never stored in .rk files.
+
+    The constructor also takes the single-texture form of older callers:
+    ``RenderMesh(positions, indices, normals, colors, uvs, texture)`` is one material with
+    that texture (and a white colour); ``materials=`` with ``material=`` gives several.
     """
 
     positions: np.ndarray
     indices: np.ndarray
     normals: np.ndarray
     colors: np.ndarray
-    uvs: np.ndarray | None = None
-    texture: np.ndarray | None = None
-    name: str = "mesh"
-    extra: dict = field(default_factory=dict)
+    uvs: np.ndarray | None
+    materials: tuple[Material, ...]
+    material: np.ndarray
+    name: str
+    extra: dict
 
-    def __post_init__(self) -> None:
+    def __init__(self, positions, indices, normals, colors, uvs=None, texture=None,
+                 name: str = "mesh", extra: dict | None = None, *, materials=None,
+                 material=None) -> None:
         set_ = object.__setattr__
-        set_(self, "positions", _array(self.positions, np.float32, 3, "positions", self.name))
-        set_(self, "indices", _indices(self.indices, len(self.positions), self.name))
-        set_(self, "normals", _array(self.normals, np.float32, 3, "normals", self.name))
-        set_(self, "colors", _array(self.colors, np.float32, 4, "colors", self.name))
+        set_(self, "name", name)
+        set_(self, "extra", {} if extra is None else extra)
+        set_(self, "positions", _array(positions, np.float32, 3, "positions", name))
+        set_(self, "indices", _indices(indices, len(self.positions), name))
+        set_(self, "normals", _array(normals, np.float32, 3, "normals", name))
+        set_(self, "colors", _array(colors, np.float32, 4, "colors", name))
         v = len(self.positions)
         for label, arr in (("normals", self.normals), ("colors", self.colors)):
             if len(arr) != v:
-                raise MeshError(f"{self.name}: {label} has {len(arr)} rows, expected {v}")
-        if self.uvs is not None:
-            set_(self, "uvs", _array(self.uvs, np.float32, 2, "uvs", self.name))
-            if len(self.uvs) != v:
-                raise MeshError(f"{self.name}: uvs has {len(self.uvs)} rows, expected {v}")
-        if self.texture is not None:
-            tex = np.ascontiguousarray(self.texture)
-            if tex.dtype != np.uint8 or tex.ndim != 3 or tex.shape[2] != 4 or tex.size == 0:
-                raise MeshError(f"{self.name}: texture must be a non-empty (h, w, 4) uint8 array")
-            if self.uvs is None:
-                raise MeshError(f"{self.name}: a texture needs texture coordinates (uvs)")
-            set_(self, "texture", tex)
+                raise MeshError(f"{name}: {label} has {len(arr)} rows, expected {v}")
+        if uvs is not None:
+            uvs = _array(uvs, np.float32, 2, "uvs", name)
+            if len(uvs) != v:
+                raise MeshError(f"{name}: uvs has {len(uvs)} rows, expected {v}")
+        set_(self, "uvs", uvs)
+        set_(self, "materials", _materials(materials, texture, name))
+        set_(self, "material", _material_indices(material, self, name))
+        if self.textured and uvs is None:
+            raise MeshError(f"{name}: a texture needs texture coordinates (uvs)")
+
+    @property
+    def texture(self) -> np.ndarray | None:
+        """The texture of a one-material mesh (None with several materials, or none)."""
+        return self.materials[0].texture if len(self.materials) == 1 else None
+
+    @property
+    def textured(self) -> bool:
+        """Whether any material has a real image."""
+        return any(m.texture is not None for m in self.materials)
+
+    def material_groups(self) -> list[tuple[Material, np.ndarray]]:
+        """(material, (G, 3) uint32 corners of its triangles) for each material that has some.
+
+        The triangles of one material keep their order; one draw per group renders the mesh.
+        """
+        if len(self.materials) == 1:
+            return [(self.materials[0], self.indices)]
+        order = np.argsort(self.material, kind="stable")
+        counts = np.bincount(self.material, minlength=len(self.materials))
+        starts = np.concatenate([[0], np.cumsum(counts)])
+        return [(m, self.indices[order[starts[k]:starts[k + 1]]])
+                for k, m in enumerate(self.materials) if counts[k]]
 
     @property
     def bounds(self) -> np.ndarray:
@@ -90,6 +181,42 @@ def _array(a, dtype, cols: int, label: str, name: str) -> np.ndarray:
         bad = int((~np.isfinite(arr)).any(axis=1).sum())
         raise MeshError(f"{name}: {label} has {bad} rows with NaN or Inf values")
     return arr
+
+
+def _materials(materials, texture, name: str) -> tuple[Material, ...]:
+    if materials is None:
+        return (Material(texture=texture),) if texture is not None else (Material(),)
+    if texture is not None:
+        raise MeshError(f"{name}: give texture= (one material) or materials=, not both")
+    materials = tuple(materials)
+    if not materials or not all(isinstance(m, Material) for m in materials):
+        raise MeshError(f"{name}: materials must be a non-empty sequence of Material")
+    if len(materials) > MAX_MATERIALS:
+        raise MeshError(f"{name}: {len(materials)} materials, more than {MAX_MATERIALS}")
+    return materials
+
+
+def _material_indices(material, mesh: RenderMesh, name: str) -> np.ndarray:
+    """Per-triangle material indices, checked against the materials (all 0 for one)."""
+    count, triangles = len(mesh.materials), len(mesh.indices)
+    if material is None:
+        if count > 1:
+            raise MeshError(f"{name}: {count} materials need per-triangle material indices")
+        return np.zeros(triangles, np.uint16)
+    arr = np.asarray(material)
+    if arr.shape != (triangles,) or not np.issubdtype(arr.dtype, np.integer):
+        raise MeshError(f"{name}: material must be {triangles} integers (one per triangle), "
+                        f"got {arr.dtype} {arr.shape}")
+    if arr.size and (arr.min() < 0 or arr.max() >= count):
+        bad = int(arr.min() if arr.min() < 0 else arr.max())
+        raise MeshError(f"{name}: material index {bad} out of range for {count} materials")
+    return np.ascontiguousarray(arr, dtype=np.uint16)
+
+
+def _same_or_none(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    if a is None or b is None:
+        return a is b
+    return a is b or (a.shape == b.shape and np.array_equal(a, b))
 
 
 def _indices(a, vertex_count: int, name: str) -> np.ndarray:

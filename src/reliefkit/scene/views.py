@@ -1,4 +1,4 @@
-"""Placing cameras around anything with ``bounds``: the CLI's --view and --size.
+"""Placing cameras around anything with ``bounds``: the CLI's --view, --size and --light.
 
 A mesh and every representation baked from it are framed by the same box: a baked
 representation keeps its source mesh's bounds (``source_bounds``), so one ``--view`` gives one
@@ -34,6 +34,26 @@ def parse_view(text: str) -> tuple[float, float, float | None]:
     if abs(el) >= 90:
         raise UsageError(f"--view elevation must be strictly between -90 and 90, got {el}")
     return az, el, dist
+
+
+def parse_light(text: str) -> tuple[float, float]:
+    """'AZ,EL' -> the light's (azimuth, elevation) in degrees, the conventions of --view."""
+    try:
+        az, el = (float(part) for part in text.split(","))
+    except ValueError:
+        raise UsageError(f"--light must be AZ,EL in degrees (e.g. -60,30), got {text!r}") \
+            from None
+    if not np.isfinite((az, el)).all() or abs(el) > 90:
+        raise UsageError(f"--light needs finite angles and an elevation within [-90, 90], got "
+                         f"{text!r}")
+    return az, el
+
+
+def check_fov(fov_deg: float) -> float:
+    """The vertical field of view in degrees, strictly between 0 and 180."""
+    if not 0 < fov_deg < 180:
+        raise UsageError(f"--fov must be strictly between 0 and 180 degrees, got {fov_deg:g}")
+    return fov_deg
 
 
 def parse_size(text: str) -> tuple[int, int]:

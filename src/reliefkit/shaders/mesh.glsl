@@ -1,4 +1,5 @@
 // Ground truth: rasterize a triangle mesh with Phong shading and write every AOV.
+// One draw per material: its colour factor, and with HAS_TEXTURE its texture and UV transform.
 //! defines: HAS_TEXTURE
 
 #if defined VERTEX_SHADER
@@ -6,17 +7,22 @@
 in vec3 in_position;
 in vec3 in_normal;
 in vec4 in_color;
-in vec2 in_uv;
 out vec3 v_world;
 out vec3 v_normal;
 out vec4 v_color;
+#if defined HAS_TEXTURE
+uniform mat3 u_uv_transform;  // the material's affine map of (u, v, 1)
+in vec2 in_uv;
 out vec2 v_uv;
+#endif
 
 void main() {
     v_world = in_position;
     v_normal = in_normal;
     v_color = in_color;
-    v_uv = in_uv;
+#if defined HAS_TEXTURE
+    v_uv = (u_uv_transform * vec3(in_uv, 1.0)).xy;
+#endif
     gl_Position = u_proj * u_view * vec4(in_position, 1.0);
 }
 #endif
@@ -26,16 +32,17 @@ void main() {
 #include "include/shading.glsl"
 #include "include/frame_outputs.glsl"
 #include "include/iterations.glsl"
+uniform vec4 u_base_color;  // the material's linear colour factor
 #if defined HAS_TEXTURE
 uniform sampler2D u_texture;  // sRGB texture: sampling returns linear colour
+in vec2 v_uv;
 #endif
 in vec3 v_world;
 in vec3 v_normal;
 in vec4 v_color;
-in vec2 v_uv;
 
 void main() {
-    vec4 base = v_color;
+    vec4 base = v_color * u_base_color;
 #if defined HAS_TEXTURE
     base *= texture(u_texture, v_uv);
 #endif

@@ -1,10 +1,11 @@
 """`load_mesh`: read OBJ, PLY, STL, OFF, glTF and GLB files into one `RenderMesh`.
 
-Parsing is trimesh's (:mod:`.parse`); this package adds what a renderer needs on top of it:
-a structural check per format before parsing (:mod:`.obj`, :mod:`.ply`, :mod:`.stl`,
-:mod:`.off`, :mod:`.gltf`), the scene flattened with its transforms applied (:mod:`.scene`),
-linear colours and one kept or baked texture (:mod:`.materials`, :mod:`.merge`), usable
-normals (:mod:`.normals`), and one `MeshError` naming the file for any bad input.
+Parsing is trimesh's, quietly (:mod:`.parse`); this package adds what a renderer needs on top
+of it: a structural check per format before parsing (:mod:`.obj`, which also triangulates
+concave polygons with :mod:`.polygons`, :mod:`.ply`, :mod:`.stl`, :mod:`.off`, :mod:`.gltf`),
+the scene flattened with its transforms applied (:mod:`.scene`), linear colours and every
+material with its texture (:mod:`.materials`, :mod:`.texture_transform`, :mod:`.merge`),
+usable normals (:mod:`.normals`), and one `MeshError` naming the file for any bad input.
 """
 
 from __future__ import annotations
@@ -24,13 +25,14 @@ from .parse import parse_file
 from .ply import check_ply
 from .scene import scene_parts
 from .stl import check_stl
+from .texture_transform import uv_transforms
 
 __all__ = ["SUPPORTED_EXTENSIONS", "load_mesh"]
 
 #: File name extensions `load_mesh` reads (lower case, with the dot).
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".gltf", ".glb")
 
-_LINEAR_COLOR_FORMATS = ("gltf", "glb")  # glTF stores vertex colours and factors linear
+_GLTF_FORMATS = ("gltf", "glb")  # linear vertex colours and factors, KHR_texture_transform
 
 _PRECHECKS = {
     "obj": check_obj,
@@ -57,15 +59,17 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
     -------
     RenderMesh
         Every triangle of the file in world space (scene-graph transforms applied, no
-        rescaling or recentring), with unit normals, linear RGBA colours and, when the whole
-        mesh uses one base-colour texture, its UVs and the (h, w, 4) uint8 sRGB texture.
+        rescaling or recentring), with unit normals, linear RGBA vertex colours, UVs, and
+        each distinct material of the file (colour factor, texture, UV transform) with the
+        triangles that use it.
 
     Raises
     ------
     MeshError
-        The file is missing, unsupported, unreadable, truncated, empty, has NaN/Inf
-        coordinates or out-of-range face indices, or references a missing file. The message
-        is one line that starts with the path.
+        The file is missing, unsupported (glTF 1.0, a required glTF extension that cannot be
+        read), unreadable, truncated, empty, has NaN/Inf coordinates or out-of-range face
+        indices, or references a missing file. The message is one line that starts with the
+        path; nothing the parsing libraries log or warn reaches stderr.
     """
     path = Path(path)
     try:
@@ -77,9 +81,12 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
 def _load(path: Path, label: str) -> RenderMesh:
     file_type = _file_type(path)
     data = _read_bytes(path)
+    if not data:
+        raise BadFile("is empty (0 bytes)")
     data = _PRECHECKS[file_type](data)
     scene = parse_file(data, file_type, path)
-    parts = scene_parts(scene, srgb=file_type not in _LINEAR_COLOR_FORMATS)
+    transforms = uv_transforms(data, file_type, scene) if file_type in _GLTF_FORMATS else {}
+    parts = scene_parts(scene, srgb=file_type not in _GLTF_FORMATS, uv_transforms=transforms)
     if not parts:
         raise BadFile("contains no triangles (only points, lines or nothing); nothing to render")
     return render_mesh(parts, label, path)

@@ -1,14 +1,17 @@
-"""Colours, materials and textures of trimesh visuals, as linear RGBA and sRGB texture bytes.
+"""Colours and materials of trimesh visuals: linear RGBA, `Material`s with sRGB textures.
 
 sRGB-encoded 8-bit colours are decoded; glTF colours are linear by specification and kept.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import trimesh
 
 from ...colorspace import srgb_decode
+from ..mesh import Material
 from .badfile import BadFile
 
 #: Linear base colour of a surface whose file gives none.
@@ -38,47 +41,80 @@ def decode_colors(colors, srgb: bool) -> np.ndarray:
     return unit
 
 
-def base_color(
-    visual, count: int, srgb: bool
-) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
-    """Linear colours, UVs and base-colour texture of the `count` vertices of a visual."""
-    if isinstance(visual, trimesh.visual.ColorVisuals):
-        if visual.kind == "vertex":
-            return decode_colors(visual.vertex_colors, srgb), None, None
-        return np.tile(DEFAULT_COLOR, (count, 1)), None, None
-    if not isinstance(visual, trimesh.visual.TextureVisuals):
-        return np.tile(DEFAULT_COLOR, (count, 1)), None, None
-    factor, image = _material(visual.material)
-    colors = np.tile(factor, (count, 1))
-    vertex_colors = visual.vertex_attributes.get("color")
-    if vertex_colors is not None and len(vertex_colors) == count:
-        colors = colors * decode_colors(vertex_colors, srgb)
-    uvs = visual.uv
-    if uvs is None or len(uvs) != count:
-        return colors, None, None
-    uvs = np.asarray(uvs, dtype=np.float64)
-    bad = int((~np.isfinite(uvs)).any(axis=1).sum())
-    if bad:
-        raise BadFile(f"{bad} texture coordinates are NaN or Inf")
-    texture = None if image is None else _texture_array(image)
-    return colors, uvs, texture
+class SurfaceReader:
+    """Colours, UVs and `Material`s of trimesh visuals, each material and image read once.
+
+    Parts of one file share trimesh materials and images; converting each once keeps equal
+    materials identical objects, so merging them is cheap.
+    """
+
+    def __init__(self, srgb: bool):
+        self.srgb = srgb
+        # keyed by id(); each entry keeps its trimesh object alive so the id stays its own
+        self._materials: dict[int, tuple[object, Material]] = {}
+        self._images: dict[int, tuple[object, np.ndarray]] = {}
+
+    def surface(self, visual, count: int) -> tuple[np.ndarray, np.ndarray | None, Material]:
+        """Linear vertex colours, UVs and the material of the `count` vertices of a visual."""
+        if isinstance(visual, trimesh.visual.ColorVisuals) and visual.kind == "vertex":
+            return decode_colors(visual.vertex_colors, self.srgb), None, Material()
+        if not isinstance(visual, trimesh.visual.TextureVisuals):
+            return np.tile(DEFAULT_COLOR, (count, 1)), None, Material()
+        material = self.material(visual.material)
+        colors = np.ones((count, 4))
+        vertex_colors = visual.vertex_attributes.get("color")
+        if vertex_colors is not None and len(vertex_colors) == count:
+            colors = decode_colors(vertex_colors, self.srgb)
+        uvs = visual.uv
+        if uvs is None or len(uvs) != count:
+            untextured = material if material.texture is None else replace(material, texture=None)
+            return colors, None, untextured
+        uvs = np.asarray(uvs, dtype=np.float64)
+        bad = int((~np.isfinite(uvs)).any(axis=1).sum())
+        if bad:
+            raise BadFile(f"{bad} texture coordinates are NaN or Inf")
+        return colors, uvs, material
+
+    def material(self, material) -> Material:
+        """A trimesh material as a `Material` (linear factor, sRGB texture)."""
+        kept = self._materials.get(id(material))
+        if kept is None:
+            kept = self._materials[id(material)] = (material, self._convert(material))
+        return kept[1]
+
+    def _convert(self, material) -> Material:
+        name = getattr(material, "name", None) or ""
+        if isinstance(material, trimesh.visual.material.PBRMaterial):
+            factor = material.baseColorFactor  # linear by the glTF specification
+            factor = np.ones(4) if factor is None else np.asarray(factor) / 255.0
+            return Material(name, factor, self._texture(material.baseColorTexture))
+        if isinstance(material, trimesh.visual.material.SimpleMaterial):
+            image = None if _is_placeholder(material.image) else material.image
+            kd = material.kwargs.get("kd")  # present only when the .mtl file gave Kd
+            if kd is None:
+                return Material(name, DEFAULT_COLOR if image is None else (1.0, 1.0, 1.0, 1.0),
+                                self._texture(image))
+            kd = np.atleast_1d(np.asarray(kd, dtype=np.float64))
+            rgb = kd[:3] if kd.size >= 3 else np.full(3, kd[0])
+            return Material(name, np.append(srgb_decode(rgb), 1.0), self._texture(image))
+        return Material(name, DEFAULT_COLOR)
+
+    def _texture(self, image) -> np.ndarray | None:
+        if image is None:
+            return None
+        kept = self._images.get(id(image))
+        if kept is None:
+            kept = self._images[id(image)] = (image, _texture_array(image))
+        return kept[1]
 
 
-def _material(material) -> tuple[np.ndarray, object]:
-    """(linear RGBA factor, PIL image or None) of a trimesh material."""
-    if isinstance(material, trimesh.visual.material.PBRMaterial):
-        factor = material.baseColorFactor  # linear by the glTF specification
-        factor = np.ones(4) if factor is None else np.asarray(factor) / 255.0
-        return factor, material.baseColorTexture
-    if isinstance(material, trimesh.visual.material.SimpleMaterial):
-        image = material.image
-        kd = material.kwargs.get("kd")  # present only when the .mtl file gave Kd
-        if kd is None:
-            return np.array(DEFAULT_COLOR if image is None else (1.0, 1.0, 1.0, 1.0)), image
-        kd = np.atleast_1d(np.asarray(kd, dtype=np.float64))
-        rgb = kd[:3] if kd.size >= 3 else np.full(3, kd[0])
-        return np.append(srgb_decode(rgb), 1.0), image
-    return np.array(DEFAULT_COLOR), None
+def _is_placeholder(image) -> bool:
+    """Whether `image` is the grey 2x2 trimesh invents for UVs without a material."""
+    if image is None or getattr(image, "format", None) is not None:  # read from a file
+        return False
+    placeholder = trimesh.visual.material.color_image()
+    return image.size == placeholder.size and np.array_equal(np.asarray(image),
+                                                             np.asarray(placeholder))
 
 
 def _texture_array(image) -> np.ndarray:
@@ -88,20 +124,3 @@ def _texture_array(image) -> np.ndarray:
     except Exception as exc:  # noqa: BLE001 - PIL decodes lazily, so errors surface here
         raise BadFile(f"its texture image could not be decoded ({exc})") from None
     return np.ascontiguousarray(rgba[::-1])
-
-
-def sample_linear(texture: np.ndarray, uvs: np.ndarray) -> np.ndarray:
-    """Bilinear, repeating lookup of an sRGB texture at UVs, returning linear RGBA."""
-    h, w = texture.shape[:2]
-    linear = np.concatenate(
-        [_SRGB_BYTE_TO_LINEAR[texture[..., :3]], texture[..., 3:] / 255.0], axis=-1
-    )
-    x = uvs[:, 0] * w - 0.5
-    y = uvs[:, 1] * h - 0.5
-    x0, y0 = np.floor(x), np.floor(y)
-    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
-    i0, j0 = x0.astype(np.int64) % w, y0.astype(np.int64) % h  # UVs are finite here
-    i1, j1 = (i0 + 1) % w, (j0 + 1) % h
-    top = linear[j0, i0] * (1 - fx) + linear[j0, i1] * fx
-    bottom = linear[j1, i0] * (1 - fx) + linear[j1, i1] * fx
-    return top * (1 - fy) + bottom * fy

@@ -1,4 +1,9 @@
-"""The structural check of OBJ files: every face corner against the v/vt/vn it refers to."""
+"""OBJ text before trimesh parses it: face corners checked, concave polygons triangulated.
+
+Every face corner is checked against the v/vt/vn it refers to. trimesh splits polygons into
+fans (quads along the diagonal from their first corner), which is wrong for concave ones, so
+those faces are rewritten as the triangles of an ear clipping, corners kept verbatim.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +12,7 @@ import re
 import numpy as np
 
 from .badfile import BadFile, decode_text
+from .polygons import triangulate_polygon
 
 # OBJ records that define or use indices: (keyword, rest of the line without its comment)
 _OBJ_RECORD = re.compile(r"(?m)^[ \t]*(vt|vn|v|f)[ \t]+([^\n#]*)")
@@ -22,7 +28,8 @@ _OBJ_SLOTS = {
 def check_obj(data: bytes) -> bytes:
     """Check every face corner of an OBJ against the v/vt/vn it defines."""
     text = decode_text(data, "OBJ").replace("\\\n", "")
-    records = _OBJ_RECORD.findall(text)
+    matches = list(_OBJ_RECORD.finditer(text))
+    records = [m.groups() for m in matches]
     kinds = [kind for kind, _ in records]
     totals = {slot: kinds.count(slot) for slot in _OBJ_SLOTS}
     fields = _obj_face_fields(" ".join(rest for kind, rest in records if kind == "f"))
@@ -34,7 +41,7 @@ def check_obj(data: bytes) -> bytes:
         bad = indices[(indices < 1) | (indices > totals[slot])]
         if bad.size:
             _check_obj_index(str(bad[0]), slot, totals[slot], totals[slot])
-    return text.encode("utf-8")
+    return _triangulated(text, matches, totals["v"]).encode("utf-8")
 
 
 def _obj_face_fields(faces: str) -> dict[str, list[str]]:
@@ -87,3 +94,50 @@ def _check_obj_index(field: str, slot: str, seen: int, total: int) -> None:
             f"uses relative (negative) indices before all {noun} are defined, which the "
             "reader (trimesh) resolves wrongly; re-export it with absolute indices"
         )
+
+
+def _triangulated(text: str, matches: list[re.Match], vertex_count: int) -> str:
+    """`text` with each face that a fan would get wrong replaced by ear-clipped triangles."""
+    faces = [(m, m.group(2).split()) for m in matches if m.group(1) == "f"]
+    faces = [(m, corners) for m, corners in faces if len(corners) > 3]
+    if not faces:
+        return text
+    try:
+        positions = np.array(
+            [m.group(2).split()[:3] for m in matches if m.group(1) == "v"], dtype=np.float64)
+        corner_vertices = [[_vertex_index(c, vertex_count) for c in corners]
+                           for _, corners in faces]
+    except ValueError:  # ragged or odd vertex records: leave them to trimesh
+        return text
+    quads = [k for k, (_, corners) in enumerate(faces) if len(corners) == 4]
+    fan_ok = np.zeros(len(faces), bool)
+    if quads:
+        fan_ok[quads] = _first_diagonal_inside(positions[[corner_vertices[k] for k in quads]])
+    pieces, end = [], 0
+    for (match, corners), vertices, ok in zip(faces, corner_vertices, fan_ok, strict=True):
+        if ok:
+            continue
+        triangles = triangulate_polygon(positions[vertices])
+        pieces += [text[end:match.start()],
+                   "\n".join("f " + " ".join(corners[i] for i in t) for t in triangles)]
+        end = match.end()
+    return "".join(pieces) + text[end:]
+
+
+def _vertex_index(corner: str, count: int) -> int:
+    """The 0-based vertex of a face corner 'v', 'v/vt', 'v//vn' or 'v/vt/vn' (checked before)."""
+    index = int(corner.split("/")[0])
+    return index - 1 if index > 0 else count + index
+
+
+def _first_diagonal_inside(quads: np.ndarray) -> np.ndarray:
+    """Per (Q, 4, 3) quad: is the diagonal 0-2, which trimesh splits along, inside it?
+
+    It is unless corners 1 and 3 lie on the same side of it (a concave quad whose reflex
+    corner is 1 or 3). Polygons of five or more corners are always ear clipped.
+    """
+    p0, p1, p2, p3 = (quads[:, i] for i in range(4))
+    normal = np.cross(p2 - p0, p3 - p1)  # the quad's vector area, doubled
+    side1 = np.einsum("ij,ij->i", np.cross(p2 - p0, p1 - p0), normal)
+    side3 = np.einsum("ij,ij->i", np.cross(p2 - p0, p3 - p0), normal)
+    return side1 * side3 <= 0

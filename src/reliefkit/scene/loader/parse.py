@@ -1,10 +1,14 @@
-"""Parsing with trimesh: referenced files come from the mesh's folder; failures raise `BadFile`."""
+"""Parsing with trimesh, quietly: referenced files come from the mesh's folder (found as other
+importers find them), and failures, also ones trimesh only logs, raise `BadFile`."""
 
 from __future__ import annotations
 
+import contextlib
 import io
+import logging
 import urllib.parse
-from pathlib import Path
+import warnings
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 import trimesh
@@ -16,8 +20,10 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
     """Find referenced files next to the mesh and remember the ones that are missing.
 
     trimesh skips a missing .mtl, texture or image silently, so `parse_file` asks this resolver
-    afterwards. Names are also tried URL-decoded (glTF URIs escape spaces as %20), and .mtl
-    files are handed over as UTF-8 like the OBJ itself.
+    afterwards. Names are looked up as other importers do: also URL-decoded (glTF URIs escape
+    spaces as %20), with `\\` as a separator (files written on Windows), and at last with
+    any case, in the named subfolder or the mesh's own folder. Names that lead out of the
+    folder are refused. .mtl files are handed over as UTF-8 like the OBJ itself.
     """
 
     def __init__(self, source: Path):
@@ -26,7 +32,9 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         self.outside: list[str] = []
 
     def get(self, name: str) -> bytes:
-        for candidate in dict.fromkeys((name, urllib.parse.unquote(name))):
+        unquoted = urllib.parse.unquote(name)
+        spellings = (name, unquoted, name.replace("\\", "/"), unquoted.replace("\\", "/"))
+        for candidate in dict.fromkeys(spellings):
             try:
                 data = super().get(candidate)
             except FileNotFoundError:
@@ -34,9 +42,16 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
             except ValueError:  # the name leads out of the mesh's folder
                 self.outside.append(name)
                 raise
-            return as_utf8(data, "MTL") if name.lower().endswith(".mtl") else data
-        self.missing.append(name)
-        raise FileNotFoundError(name)
+            return self._decoded(name, data)
+        found = _any_case(Path(self.parent), PurePosixPath(spellings[-1].strip()))
+        if found is None:
+            self.missing.append(name)
+            raise FileNotFoundError(name)
+        return self._decoded(name, found.read_bytes())
+
+    @staticmethod
+    def _decoded(name: str, data: bytes) -> bytes:
+        return as_utf8(data, "MTL") if name.lower().endswith(".mtl") else data
 
     def problem(self) -> str | None:
         """A message for the first unusable reference, or None."""
@@ -50,20 +65,87 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         return None
 
 
+def _any_case(folder: Path, name: PurePosixPath) -> Path | None:
+    """The file `name` inside `folder` matched with any case: its own path, else its file name.
+
+    Only relative names without '..' are followed into subfolders (the others were refused or
+    not found above); an absolute name from another machine is tried by its file name alone.
+    """
+    parts = [p for p in name.parts if p not in (".", "/")]
+    if not parts:
+        return None
+    relative = not name.is_absolute() and ".." not in parts and ":" not in parts[0]
+    for candidate in ([parts] if relative else []) + [parts[-1:]]:
+        path = folder
+        for part in candidate:
+            path = _child_any_case(path, part)
+            if path is None:
+                break
+        else:
+            if path.is_file():
+                return path
+    return None
+
+
+def _child_any_case(folder: Path, name: str) -> Path | None:
+    if not folder.is_dir():
+        return None
+    return min((p for p in folder.iterdir() if p.name.lower() == name.lower()), default=None)
+
+
 def parse_file(data: bytes, file_type: str, path: Path) -> trimesh.Scene:
-    """Parse with trimesh, converting everything it raises into `BadFile`."""
+    """Parse with trimesh quietly; what it raises, or logs as lost, becomes `BadFile`."""
     resolver = _RecordingResolver(path)
     try:
-        with np.errstate(all="ignore"):  # trimesh's own arithmetic on odd but valid data
+        with _quiet() as logged:
             scene = trimesh.load_scene(
                 io.BytesIO(data), file_type=file_type, resolver=resolver, process=False
             )
     except Exception as exc:  # noqa: BLE001 - any parser failure is a bad file
         raise BadFile(resolver.problem() or _parse_failure(file_type, exc)) from None
-    problem = resolver.problem()
+    problem = resolver.problem() or _data_lost(logged)
     if problem:
         raise BadFile(problem)
     return scene if isinstance(scene, trimesh.Scene) else trimesh.Scene(scene)
+
+
+class _Collect(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage())
+
+
+@contextlib.contextmanager
+def _quiet():
+    """Keep what trimesh logs and any library warns off the caller's handlers and stderr.
+
+    Yields the messages trimesh logged at WARNING and above, for `_data_lost` to judge. Python
+    warnings (Pillow's, numpy's) are dropped, and so is trimesh's arithmetic on odd but valid
+    data (`np.errstate`).
+    """
+    log = logging.getLogger("trimesh")
+    collect, propagate = _Collect(), log.propagate
+    log.addHandler(collect)
+    log.propagate = False
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            yield collect.messages
+    finally:
+        log.removeHandler(collect)
+        log.propagate = propagate
+
+
+def _data_lost(messages: list[str]) -> str | None:
+    """A message when trimesh said it left geometry undecoded (it only logs that)."""
+    if not any("placeholder zeros" in m for m in messages):
+        return None
+    failed = [m for m in messages if m.startswith("failed to process extension")]
+    detail = " ".join((failed or messages)[0].split())[:200]
+    return f"could not be decoded ({detail}); is it corrupt?"
 
 
 def _parse_failure(file_type: str, exc: Exception) -> str:

@@ -6,13 +6,14 @@ recentred).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import trimesh
 
+from ..mesh import Material
 from .badfile import BadFile, check_range
-from .materials import base_color, decode_colors, is_face_colored
+from .materials import SurfaceReader, decode_colors, is_face_colored
 from .normals import file_normals
 
 
@@ -23,29 +24,39 @@ class Part:
     positions: np.ndarray  # (V, 3) float64
     faces: np.ndarray  # (F, 3) int64, indices into this part
     normals: np.ndarray  # (V, 3) float64 from the file; NaN rows where there are none
-    colors: np.ndarray  # (V, 4) float64 linear RGBA
+    colors: np.ndarray  # (V, 4) float64 linear RGBA vertex colours
     uvs: np.ndarray | None = None  # (V, 2) float64
-    texture: np.ndarray | None = None  # (h, w, 4) uint8 sRGB, row 0 at v = 0
+    material: Material = field(default_factory=Material)
 
 
-def scene_parts(scene: trimesh.Scene, srgb: bool) -> list[Part]:
-    """Every instance of every triangle geometry, placed in world space."""
+def scene_parts(scene: trimesh.Scene, srgb: bool,
+                uv_transforms: dict[str, np.ndarray] | None = None) -> list[Part]:
+    """Every instance of every triangle geometry, placed in world space.
+
+    ``uv_transforms`` gives the texture transform of geometries (by name) whose material has
+    one that trimesh does not read.
+    """
     local: dict[str, Part | None] = {}
     parts = []
     several = len(scene.geometry) > 1
+    surfaces = SurfaceReader(srgb)
     for node in scene.graph.nodes_geometry:
         matrix, geometry_name = scene.graph[node]
         if geometry_name not in local:
             geometry = scene.geometry[geometry_name]
             where = f" in mesh '{geometry_name}'" if several else ""
-            local[geometry_name] = _local_part(geometry, srgb, where)
+            part = _local_part(geometry, surfaces, where)
+            transform = (uv_transforms or {}).get(geometry_name)
+            if part is not None and transform is not None:
+                part = replace(part, material=replace(part.material, uv_transform=transform))
+            local[geometry_name] = part
         part = local[geometry_name]
         if part is not None:
             parts.append(_placed(part, np.asarray(matrix, dtype=np.float64)))
     return parts
 
 
-def _local_part(geometry, srgb: bool, where: str) -> Part | None:
+def _local_part(geometry, surfaces: SurfaceReader, where: str) -> Part | None:
     """A trimesh geometry as a `Part`; None for points, lines and meshes without faces."""
     if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
         return None
@@ -55,10 +66,11 @@ def _local_part(geometry, srgb: bool, where: str) -> Part | None:
     bad = int((~np.isfinite(positions)).any(axis=1).sum())
     if bad:
         raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates{where}")
-    surface = base_color(geometry.visual, len(positions), srgb)
+    surface = surfaces.surface(geometry.visual, len(positions))
     part = Part(positions, faces, file_normals(geometry), *surface)
     if is_face_colored(geometry.visual):
-        corner_colors = np.repeat(decode_colors(geometry.visual.face_colors, srgb), 3, axis=0)
+        face_colors = decode_colors(geometry.visual.face_colors, surfaces.srgb)
+        corner_colors = np.repeat(face_colors, 3, axis=0)
         part = replace(_unshared(part), colors=corner_colors)
     return part
 
@@ -76,7 +88,7 @@ def _unshared(part: Part) -> Part:
         normals=part.normals[corners],
         colors=part.colors[corners],
         uvs=None if part.uvs is None else part.uvs[corners],
-        texture=part.texture,
+        material=part.material,
     )
 
 
@@ -88,12 +100,19 @@ def _placed(part: Part, matrix: np.ndarray) -> Part:
     det = np.linalg.det(linear)
     with np.errstate(all="ignore"):
         positions = part.positions @ linear.T + matrix[:3, 3]
-        # the cofactor matrix is det * inverse-transpose (and defined for singular matrices):
-        # times sign(det) it maps normals to the side the transformed winding faces
-        cofactor = np.cross(linear.T[[1, 2, 0]], linear.T[[2, 0, 1]])
-        normals = part.normals @ (np.sign(det) * cofactor).T
+        normals = part.normals @ (np.sign(det) * _cofactor(linear)).T
     bad = int((~np.isfinite(positions)).any(axis=1).sum())
     if bad:
         raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates after the scene transforms")
     faces = part.faces[:, ::-1] if det < 0 else part.faces
     return replace(part, positions=positions, faces=np.ascontiguousarray(faces), normals=normals)
+
+
+def _cofactor(linear: np.ndarray) -> np.ndarray:
+    """det * inverse-transpose of a 3x3 matrix, defined for singular matrices too.
+
+    It maps a triangle's normal to the normal of the transformed triangle (times sign(det), to
+    the side the transformed winding faces). Its columns are the cross products of the
+    matrix's columns: column i is linear[:, i+1] x linear[:, i+2].
+    """
+    return np.cross(linear[:, [1, 2, 0]].T, linear[:, [2, 0, 1]].T).T
