@@ -14,8 +14,9 @@ def run_cli(*args, cwd=None):
                           capture_output=True, text=True, timeout=300, cwd=cwd)
 
 
-def assert_one_line_error(result, *words):
+def assert_one_line_error(result, *words, code=None):
     assert result.returncode != 0
+    assert code is None or result.returncode == code, (result.returncode, result.stderr)
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
     assert "Traceback" not in result.stderr
@@ -102,7 +103,7 @@ def test_bake_render_info_relief(gl, tmp_path):
 @pytest.mark.parametrize("args, words", [
     (["render", "missing.obj", "-o", "x.png"], ["missing.obj", "no such file"]),
     (["render", "demo:nope", "-o", "x.png"], ["nope"]),
-    (["render", "demo:tree", "--view", "1,2", "-o", "x.png"], ["--view"]),
+    (["render", "demo:tree", "--view", "1,2,3,4", "-o", "x.png"], ["--view"]),
     (["render", "demo:tree", "--size", "0x5", "-o", "x.png"], ["--size"]),
     (["render", "demo:tree", "-o", "x.jpg"], [".png"]),
     (["render", "demo:tree", "--turntable", "3", "-o", "x.png"], [".gif"]),
@@ -146,10 +147,215 @@ def test_bake_heightmap_png16_and_npy(gl, tmp_path):
 
 def test_compare_writes_picture_and_metrics(gl, tmp_path):
     out = run_cli("compare", "demo:terrain", "--as", "relief", "--depth-res", "32",
-                  "--size", "64x64", "--out", tmp_path / "cmp")
+                  "--size", "64x64", "--light", "-40,30", "--out", tmp_path / "cmp")
     assert out.returncode == 0, out.stderr
+    progress = [line for line in out.stderr.splitlines() if line.startswith("compare: ")]
+    assert progress and "done in" in progress[-1], out.stderr
     report = json.loads((tmp_path / "cmp" / "metrics.json").read_text())
     assert set(report["variants"]) == {"binary", "exact", "robust"}
     assert report["variants"]["exact"]["wrong_hit_fraction"] <= 0.001
     assert (tmp_path / "cmp" / "compare.png").stat().st_size > 1000
     assert "| robust |" in (tmp_path / "cmp" / "metrics.md").read_text()
+
+
+@pytest.fixture(scope="module")
+def small_rk(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rk") / "small.rk"
+    out = run_cli("bake", "demo:terrain", "--as", "relief", "--depth-res", "16", "-o", path)
+    assert out.returncode == 0, out.stderr
+    return path
+
+
+def test_values_starting_with_a_dash_parse(gl, tmp_path):
+    rk = tmp_path / "down.rk"
+    out = run_cli("bake", "demo:terrain", "--as", "relief", "--axis", "-y", "--depth-res", "16",
+                  "-o", rk)
+    assert out.returncode == 0, out.stderr
+    from reliefkit.io.rk import read_manifest
+
+    assert read_manifest(rk)["params"]["axis"] == "-y"
+    out = run_cli("render", "demo:tree", "--view", "-30,20", "--light", "-40,30", "--size",
+                  "24x24", "-o", tmp_path / "t.png")
+    assert out.returncode == 0, out.stderr
+    # a real option after a flag is still an option, not its value
+    assert_one_line_error(run_cli("bake", "demo:terrain", "--axis", "-o", "x.rk", cwd=tmp_path),
+                          "--axis", code=2)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["bake", "demo:terrain", "--as", "relief", "--depth-res", "0", "-o", "x.rk"],
+     ["--depth-res", "[8, 8192]", "got 0"]),
+    (["bake", "demo:terrain", "--as", "relief", "--color-res", "0", "-o", "x.rk"],
+     ["--color-res", "got 0"]),
+    (["bake", "demo:terrain", "--as", "relief", "--depth-res", "many", "-o", "x.rk"],
+     ["--depth-res", "'many'"]),
+    (["bake", "demo:tree", "--as", "relief-cube", "--spread", "9", "-o", "x.rk"],
+     ["--spread does not apply to --as relief-cube"]),
+    (["render", "demo:tree", "--turntable", "3", "--aovs", "a.npz", "-o", "x.gif"],
+     ["--aovs", "--turntable"]),
+    (["render", "demo:tree", "--turntable", "3", "--stats", "s.json", "-o", "x.gif"],
+     ["--stats", "--turntable"]),
+    (["render", "demo:tree", "--background", "2", "-o", "x.png"], ["--background", "[0, 1]"]),
+    (["render", "demo:tree", "--background", "grey", "-o", "x.png"], ["--background"]),
+    (["render", "demo:tree", "--method", "exact", "-o", "x.png"],
+     ["--method does not apply", "RenderMesh"]),
+    (["render", "demo:tree", "--light", "1", "-o", "x.png"], ["--light", "AZ,EL"]),
+    (["render", "demo:tree", "--light", "10,95", "-o", "x.png"], ["--light", "[-90, 90]"]),
+    (["render", "demo:tree", "--fov", "0", "-o", "x.png"], ["--fov"]),
+    (["render", "demo:tree", "--msaa", "3", "-o", "x.png"], ["--msaa"]),
+    (["compare", "demo:tree", "--light", "x,y", "--out", "c"], ["--light"]),
+    (["render", "demo:tree", "--view", "1,2,3,4", "-o", "x.png"], ["--view"]),
+    (["bench", "nope"], ["invalid choice"]),
+])
+def test_usage_errors_exit_2_naming_the_flag(tmp_path, args, words):
+    result = run_cli(*args, cwd=tmp_path)
+    assert_one_line_error(result, *words, code=2)
+    assert not list(tmp_path.iterdir()), "a refused command wrote nothing"
+
+
+def test_render_options_name_the_typed_flag(gl, small_rk, tmp_path):
+    result = run_cli("render", small_rk, "--linear-steps", "0", "-o", tmp_path / "x.png")
+    assert_one_line_error(result, "--linear-steps must be within", code=2)
+    assert "linear_steps" not in result.stderr
+
+
+def test_bake_refuses_an_rk_input(gl, small_rk, tmp_path):
+    for command in (["bake", small_rk, "-o", tmp_path / "x.rk"],
+                    ["compare", small_rk, "--out", tmp_path / "c"]):
+        assert_one_line_error(run_cli(*command), "needs a mesh or heightmap, not an .rk file",
+                              code=2)
+
+
+@pytest.mark.parametrize("name, command", [
+    ("zero.obj", ["render", "{}", "-o", "x.png"]),
+    ("zero.glb", ["render", "{}", "-o", "x.png"]),
+    ("zero.rk", ["render", "{}", "-o", "x.png"]),
+    ("zero.rk", ["info", "{}"]),
+    ("zero.png", ["bake", "{}", "--as", "relief", "-o", "x.rk"]),
+    ("zero.ply", ["compare", "{}", "--out", "c"]),
+])
+def test_an_empty_file_says_it_is_empty(tmp_path, name, command):
+    (tmp_path / name).write_bytes(b"")
+    result = run_cli(*[c.replace("{}", name) for c in command], cwd=tmp_path)
+    assert_one_line_error(result, name, "empty", code=1)
+
+
+def test_bad_input_files_exit_1(tmp_path):
+    bad = tmp_path / "nan.obj"
+    bad.write_text("v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n")
+    assert_one_line_error(run_cli("render", bad, "-o", tmp_path / "x.png"), code=1)
+    assert_one_line_error(run_cli("render", tmp_path / "missing.obj", "-o", tmp_path / "x.png"),
+                          code=1)
+
+
+def flip_a_byte_inside(path, member: str):
+    """Flip one bit in the middle of an array's stored bytes (the zip member's data)."""
+    import struct
+    import zipfile
+
+    with zipfile.ZipFile(path) as zf:
+        info = zf.getinfo(member)
+    data = bytearray(path.read_bytes())
+    name_len, extra_len = struct.unpack("<HH", data[info.header_offset + 26:
+                                                    info.header_offset + 30])
+    start = info.header_offset + 30 + name_len + extra_len
+    data[start + info.compress_size // 2] ^= 0x10
+    path.write_bytes(bytes(data))
+
+
+def test_info_verifies_checksums(gl, small_rk, tmp_path):
+    out = run_cli("info", small_rk)
+    assert out.returncode == 0, out.stderr
+    assert any(line.split() == ["checksums:", "ok"] for line in out.stdout.splitlines())
+    assert json.loads(run_cli("info", "--json", small_rk).stdout)["file"]["checksums"] == "ok"
+    import shutil
+
+    for member in ("height.npy", "color.npy"):
+        bad = tmp_path / f"bad-{member}.rk"
+        shutil.copy(small_rk, bad)
+        flip_a_byte_inside(bad, member)
+        for args in (["info", bad], ["info", "--json", bad]):
+            result = run_cli(*args)
+            assert_one_line_error(result, bad.name, code=1)
+            assert "ok" not in result.stdout
+
+
+def test_a_closed_stdout_is_no_error(gl, small_rk):
+    """``reliefkit info --json x.rk | head -1``: the reader leaves before reliefkit writes."""
+    proc = subprocess.Popen([sys.executable, "-m", "reliefkit.cli", "info", "--json", "--gl",
+                             str(small_rk)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    proc.wait(timeout=300)
+    assert proc.returncode in (0, 141), err
+    assert err == ""
+
+
+@pytest.fixture(scope="module")
+def edge_on(tmp_path_factory):
+    """A flat triangle in the xz plane: seen at elevation 0 it covers no pixel at all."""
+    path = tmp_path_factory.mktemp("flat") / "flat.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n")
+    return path
+
+
+def test_a_render_of_nothing_warns(gl, edge_on, tmp_path):
+    out = run_cli("render", edge_on, "--view", "20,0", "--size", "32x32", "-o", tmp_path / "f.png")
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "f.png").is_file()
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: "), out.stderr
+    assert "nothing visible" in lines[0] and "0 pixels" in lines[0]
+    out = run_cli("render", edge_on, "--view", "20,0", "--turntable", "4", "--size", "16x16",
+                  "-o", tmp_path / "f.gif")
+    assert out.returncode == 0, out.stderr
+    warnings = [line for line in out.stderr.splitlines() if line.startswith("warning: ")]
+    assert len(warnings) == 1 and "views 1, 2, 3, 4 of 4" in warnings[0], out.stderr
+    assert "nothing visible" in warnings[0]
+    visible = run_cli("render", edge_on, "--view", "20,30", "--size", "32x32", "-o",
+                      tmp_path / "v.png")
+    assert visible.returncode == 0 and "warning" not in visible.stderr
+
+
+def test_light_flag_moves_the_light(gl, box_obj, tmp_path):
+    """The box's +x face is brighter than its +z face under light from +x, and the reverse."""
+    brightness = {}
+    for light in ("90,0", "0,0"):
+        out = run_cli("render", box_obj, "--view", "45,20", "--size", "48x48", "--light", light,
+                      "-o", tmp_path / "b.png", "--aovs", tmp_path / "b.npz")
+        assert out.returncode == 0, out.stderr
+        with np.load(tmp_path / "b.npz") as aovs:
+            lum = aovs["color"][..., :3].mean(axis=-1)
+            p = aovs["position"]
+            faces = (np.isclose(p[..., 0], 1.0, atol=1e-4), np.isclose(p[..., 2], 0.25, atol=1e-4))
+            assert all(face.sum() > 20 for face in faces)
+            brightness[light] = [lum[face].mean() for face in faces]
+    assert brightness["90,0"][0] > brightness["90,0"][1] + 0.2
+    assert brightness["0,0"][1] > brightness["0,0"][0] + 0.2
+
+
+def test_msaa_flag_smooths_edges_only(gl, box_obj, tmp_path):
+    aovs = {}
+    for n in (1, 4):
+        out = run_cli("render", box_obj, "--size", "48x48", "--msaa", n, "-o",
+                      tmp_path / f"m{n}.png", "--aovs", tmp_path / f"m{n}.npz")
+        assert out.returncode == 0, out.stderr
+        with np.load(tmp_path / f"m{n}.npz") as data:
+            aovs[n] = {name: data[name] for name in data.files}
+    def fractional(alpha):
+        return int(((alpha > 0.05) & (alpha < 0.95)).sum())
+
+    assert fractional(aovs[4]["color"][..., 3]) > 20
+    assert fractional(aovs[1]["color"][..., 3]) == 0
+    for name in ("mask", "depth", "normal"):
+        np.testing.assert_array_equal(aovs[4][name], aovs[1][name])
+
+
+def test_bake_progress_is_plain_lines_off_a_terminal(gl, tmp_path):
+    out = run_cli("bake", "demo:terrain", "--as", "relief", "--depth-res", "16", "-o",
+                  tmp_path / "p.rk")
+    assert out.returncode == 0, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert lines and lines[-1].startswith("baking relief: ") and "done in" in lines[-1], lines
+    assert all(line.startswith("baking relief: ") for line in lines), lines
+    assert "\x1b" not in out.stderr and "\r" not in out.stderr

@@ -1,6 +1,8 @@
 """The `reliefkit` command line: parses arguments, calls the library, prints results.
 
-Every failure is one line ``error: ...`` on stderr and a non-zero exit status.
+Every failure is one line ``error: ...`` on stderr and a non-zero exit status: 2 for a usage
+error (argparse's or a `UsageError`), 1 for bad input (a mesh, an .rk file, the GPU), 3 for
+an internal error (docs/cli.md).
 """
 
 from __future__ import annotations
@@ -11,13 +13,18 @@ import os
 import sys
 from pathlib import Path
 
-from .errors import ReliefkitError, UsageError
+from .errors import FormatError, ReliefkitError, UsageError
+from .scene.light import DEFAULT_LIGHT_ANGLES
 from .scene.views import DEFAULT_SIZE, DEFAULT_VIEW
+
+EXIT_INPUT, EXIT_USAGE, EXIT_INTERNAL = 1, 2, 3
+EXIT_BROKEN_PIPE = 141  # what a shell reports for a process stopped by SIGPIPE
+MSAA_CHOICES = (1, 2, 4, 8)
 
 CORE_EXAMPLES = {
     "demo": ["reliefkit demo --out out                          contact sheet of every demo"],
     "render": ["reliefkit render bunny.ply -o bunny.png           one view (default --view "
-               "30,25,2.6)",
+               "30,25)",
                "reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs "
                "side.npz",
                "reliefkit render demo:tree --turntable 36 -o spin.gif"],
@@ -55,21 +62,64 @@ def _epilog() -> str:
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse that reports errors as one `error:` line (exit status 2)."""
+    """argparse that reports errors as one `error:` line (exit status 2), and lets the flags
+    in ``dash_values`` take a value that starts with '-' (``--axis -y``, ``--view -30,20``),
+    which argparse alone would read as another option."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.dash_values: set[str] = set()
 
     def error(self, message: str):  # noqa: D102
-        self.exit(2, f"error: {message} (see {self.prog} --help)\n")
+        self.exit(EXIT_USAGE, f"error: {message} (see {self.prog} --help)\n")
+
+    def parse_known_args(self, args=None, namespace=None):  # noqa: D102
+        args = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(self._join_dash_values(args), namespace)
+
+    def _join_dash_values(self, args: list[str]) -> list[str]:
+        """``--flag -value`` -> ``--flag=-value`` for those flags, unless -value is an option."""
+        out, k = [], 0
+        while k < len(args):
+            arg = args[k]
+            following = args[k + 1] if k + 1 < len(args) else None
+            if (arg in self.dash_values and following is not None and following.startswith("-")
+                    and following not in self._option_string_actions):
+                out.append(f"{arg}={following}")
+                k += 2
+            else:
+                out.append(arg)
+                k += 1
+            if arg == "--":
+                return out + args[k:]
+        return out
 
 
-def _add_view_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--view", default=",".join(f"{x:g}" for x in DEFAULT_VIEW[:2]),
-                   metavar="AZ,EL[,DIST]",
-                   help="orbit the bounding-box centre (of the source mesh for a baked .rk): "
-                        "azimuth and elevation in degrees, distance in bounding-sphere radii "
-                        "(default: %(default)s, at the distance that fits the sphere in view)")
+def _add_flag(parser: _Parser, *args, within=None, dash_value: bool = False, **kwargs):
+    """``add_argument`` (to ``within``, a group of ``parser``, if given); with ``dash_value``
+    the flag's value may start with '-' (see `_Parser`)."""
+    action = (within or parser).add_argument(*args, **kwargs)
+    if dash_value:
+        parser.dash_values.update(s for s in action.option_strings if s.startswith("--"))
+    return action
+
+
+def _add_view_args(p: _Parser) -> None:
+    """--view, --size, --fov and --light: the camera and light of every render."""
+    _add_flag(p, "--view", dash_value=True, metavar="AZ,EL[,DIST]",
+              default=",".join(f"{x:g}" for x in DEFAULT_VIEW[:2]),
+              help="orbit the bounding-box centre (of the source mesh for a baked .rk): "
+                   "azimuth about +y from +z towards +x and elevation in degrees, distance in "
+                   "bounding-sphere radii (default: %(default)s, at the distance that fits the "
+                   "sphere in view)")
     p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
                    help="image size in pixels (default: %(default)s)")
-    p.add_argument("--fov", type=float, default=40.0, help="vertical field of view in degrees")
+    _add_flag(p, "--fov", dash_value=True, type=float, default=40.0, metavar="DEG",
+              help="vertical field of view in degrees (default: %(default)g)")
+    _add_flag(p, "--light", dash_value=True, metavar="AZ,EL",
+              default=",".join(f"{x:g}" for x in DEFAULT_LIGHT_ANGLES),
+              help="where the light comes from: azimuth and elevation in degrees, as in "
+                   "--view (default: %(default)s, a low sun from the side)")
 
 
 def _command(sub, name: str, summary: str, description: str):
@@ -100,8 +150,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write the frame's counters: covered pixels, fragments and loop "
                         "iterations per pixel (mean, max) where the renderer counts them")
     p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
-    p.add_argument("--background", default="transparent",
-                   help="'transparent' or a grey level 0..1 to composite over")
+    p.add_argument("--background", default="transparent", metavar="transparent|LEVEL",
+                   help="'transparent' or a grey level 0..1 to composite over (default: "
+                        "%(default)s)")
+    p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
+                   help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
+                        "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
     _add_options(p, [(t.name, spec.option_list) for t in techniques() for spec in t.drawables],
                  "render options")
     p.set_defaults(run=cmd_render)
@@ -170,8 +224,16 @@ def _add_options(p: argparse.ArgumentParser, owners: list[tuple[str, tuple]], ti
             continue
         metavar = "|".join(map(str, first.choices)) if first.choices else (
             ",".join(["X"] * (first.count or 2)) if first.kind == "floats" else first.kind.upper())
-        group.add_argument(flag, dest=OPTION_PREFIX + name, default=None, metavar=metavar,
-                           help=_option_help(decls))
+        _add_flag(p, flag, within=group, dest=OPTION_PREFIX + name, default=None,
+                  metavar=metavar, help=_option_help(decls),
+                  dash_value=any(_takes_dash(opt) for _, opt in decls))
+
+
+def _takes_dash(opt) -> bool:
+    """Whether a value of ``opt`` may start with '-': a number, or a choice such as '-y'."""
+    if opt.choices:
+        return any(str(choice).startswith("-") for choice in opt.choices)
+    return opt.kind in ("int", "float", "floats")
 
 
 def _option_help(decls: list) -> str:
@@ -202,14 +264,26 @@ def _given_options(args) -> dict:
 
 
 def _applicable(given: dict, options, what: str) -> dict:
-    """``given`` restricted to ``options``; a flag that does not apply is an error."""
-    names = {opt.name for opt in options}
-    wrong = [k for k in given if k not in names]
+    """``given`` restricted to ``options`` and checked by their declarations; a flag that
+    does not apply, or a bad value, is a UsageError naming the flag as the user typed it."""
+    by_name = {opt.name: opt for opt in options}
+    wrong = [k for k in given if k not in by_name]
     if wrong:
         flags = ", ".join("--" + k.replace("_", "-") for k in wrong)
         has = ", ".join("--" + opt.flag for opt in options) or "none"
         raise UsageError(f"{flags} does not apply to {what} (its options: {has})")
-    return given
+    return {name: _checked(by_name[name], value, what) for name, value in given.items()}
+
+
+def _checked(opt, value, what: str):
+    """``opt.check`` with the message saying ``--flag`` (the declaration says ``flag``)."""
+    try:
+        return opt.check(value, what)
+    except UsageError as exc:
+        message, bare = str(exc), f"{what}: {opt.flag} "
+        if message.startswith(bare):
+            message = f"--{opt.flag} {message[len(bare):]} ({what})"
+        raise UsageError(message) from None
 
 
 def _add_bake_args(p: argparse.ArgumentParser, table: dict) -> None:
@@ -220,20 +294,35 @@ def _add_bake_args(p: argparse.ArgumentParser, table: dict) -> None:
     _add_options(p, [(name, b.options) for name, (_, b) in table.items()], "bake options")
 
 
-def _bake_input(args):
+def _check_not_empty(spec: str) -> None:
+    """A zero-byte input file is refused as such (before a loader guesses why it fails)."""
+    path = Path(spec)
+    if path.is_file() and path.stat().st_size == 0:
+        raise FormatError(f"{spec}: the file is empty (0 bytes)")
+
+
+def _bake_source(spec: str, command: str = "bake"):
+    """The mesh or heightmap ``bake`` and ``compare`` start from."""
+    from .scene.heightmap import is_heightmap, load_heightmap
+
+    _check_not_empty(spec)
+    if Path(spec).suffix.lower() == ".rk":
+        raise UsageError(f"{command} needs a mesh or heightmap, not an .rk file ({spec})")
+    if is_heightmap(spec):
+        return load_heightmap(spec)
+    from .io.inputs import load_input
+
+    return load_input(spec)
+
+
+def _bake_input(args, source=None):
     from .bake import bake
     from .core.technique import baker
     from .progress import progress_bar
-    from .scene.heightmap import is_heightmap, load_heightmap
 
     _, chosen = baker(args.kind)
     params = _applicable(_given_options(args), chosen.options, f"--as {args.kind}")
-    if is_heightmap(args.input):
-        source = load_heightmap(args.input)
-    else:
-        from .io.inputs import load_input
-
-        source = load_input(args.input)
+    source = _bake_source(args.input) if source is None else source
     with progress_bar(f"baking {args.kind}", 1) as advance:
         return bake(source, args.kind, progress=advance, **params)
 
@@ -257,56 +346,107 @@ def _version() -> str:
 
 
 def _background(text: str):
+    """--background: None (transparent) or a linear grey (level, level, level) in 0..1."""
     if text == "transparent":
         return None
     try:
         level = float(text)
     except ValueError:
-        raise UsageError(f"--background must be 'transparent' or a number, got {text!r}") from None
+        level = float("nan")
+    if not 0.0 <= level <= 1.0:
+        raise UsageError(f"--background must be 'transparent' or a grey level within [0, 1], "
+                         f"got {text!r}")
     return (level, level, level)
+
+
+def _light(args):
+    from .scene.light import DirectionalLight
+    from .scene.views import parse_light
+
+    return DirectionalLight.from_angles(*parse_light(args.light))
+
+
+def _warn_nothing_visible(what: str) -> None:
+    """A picture with nothing in it is written, but never silently (exit status 0 still)."""
+    print(f"warning: {what} 0 pixels: nothing visible (check --view, --fov and the input's "
+          "bounds)", file=sys.stderr)
 
 
 def cmd_render(args) -> int:
     from .io.inputs import load_input
-    from .pictures import TILE_BACKGROUND, save_gif
     from .render import render, render_options
-    from .scene.views import framing_bounds, orbit_bounds, parse_size, parse_view, turntable
+    from .scene.views import check_fov, framing_bounds, orbit_bounds, parse_size, parse_view
 
     az, el, dist = parse_view(args.view)
     size = parse_size(args.size)
+    check_fov(args.fov)
     background = _background(args.background)
-    suffix = Path(args.output).suffix.lower()
-    if args.turntable is not None and suffix != ".gif":
-        raise UsageError("--turntable writes an animated .gif: name the output *.gif")
-    if args.turntable is None and suffix != ".png":
-        raise UsageError(f"output must be a .png file, got {args.output}")
-    if args.stats and Path(args.stats).suffix.lower() != ".json":
-        raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
+    light = _light(args)
+    _check_render_outputs(args)
+    _check_not_empty(args.input)
     obj = load_input(args.input)
     options = _applicable(_given_options(args), render_options(obj),
-                          f"a {type(obj).__name__} ({args.input})")
-    if args.turntable is not None:
-        from .progress import progress_bar
+                          f"{args.input}, a {type(obj).__name__}")
 
-        cameras = turntable(framing_bounds(obj), args.turntable, el, dist, size, args.fov)
-        frames = []
-        with progress_bar("turntable", len(cameras)) as advance:
-            for k, camera in enumerate(cameras):
-                frames.append(render(obj, camera, **options).rgba8(
-                    background or TILE_BACKGROUND))
-                advance(k + 1)
-        save_gif(frames, args.output)
-        print(f"wrote {args.output} ({len(frames)} views)")
-        return 0
+    def draw(camera, msaa=args.msaa, **core):
+        return render(obj, camera, light=light, msaa=msaa, **core, **options)
+
+    if args.turntable is not None:
+        return _render_turntable(args, framing_bounds(obj), draw, el, dist, size, background)
     camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
-    frame = render(obj, camera, **options)
+    frame = draw(camera)
     frame.save(args.output, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
+    if frame.stats["covered"] == 0:
+        _warn_nothing_visible("the render covers")
     if args.aovs:
         frame.save_aovs(args.aovs)
         print(f"wrote {args.aovs}")
     if args.stats:
-        _write_stats(args, frame, render(obj, camera, count_iterations=True, **options))
+        counted = draw(camera, msaa=1, count_iterations=True)  # counters are single-sample
+        _write_stats(args, frame, counted)
+    return 0
+
+
+def _check_render_outputs(args) -> None:
+    """The output names fit what is written; per-frame outputs do not go with --turntable."""
+    suffix = Path(args.output).suffix.lower()
+    if args.turntable is not None:
+        if suffix != ".gif":
+            raise UsageError("--turntable writes an animated .gif: name the output *.gif")
+        given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
+                 if value]
+        if given:
+            raise UsageError(f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not "
+                             "apply to --turntable (one frame's arrays and counters): render "
+                             "a single --view for them")
+    elif suffix != ".png":
+        raise UsageError(f"output must be a .png file, got {args.output}")
+    if args.stats and Path(args.stats).suffix.lower() != ".json":
+        raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
+
+
+def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
+    """``args.turntable`` views of ``draw(camera)`` into a GIF, warning about empty views."""
+    from .pictures import TILE_BACKGROUND, save_gif
+    from .progress import progress_bar
+    from .scene.views import turntable
+
+    cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
+    frames, empty = [], []
+    with progress_bar("turntable", len(cameras)) as advance:
+        for k, camera in enumerate(cameras):
+            frame = draw(camera)
+            if frame.stats["covered"] == 0:
+                empty.append(str(k + 1))
+            frames.append(frame.rgba8(background or TILE_BACKGROUND))
+            advance(k + 1)
+    save_gif(frames, args.output)
+    print(f"wrote {args.output} ({len(frames)} views)")
+    if empty:
+        many = len(empty) > 1
+        _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
+                              f"cover{'' if many else 's'}")
     return 0
 
 
@@ -322,22 +462,36 @@ def _write_stats(args, frame, counted) -> None:
 
 
 def cmd_compare(args) -> int:
-    from .compare import compare, metrics_markdown, write_comparison
-    from .io.inputs import load_input
-    from .scene.views import orbit_bounds, parse_size, parse_view
+    from .compare import metrics_markdown, write_comparison
+    from .scene.views import check_fov, orbit_bounds, parse_size, parse_view
 
     az, el, dist = parse_view(args.view)
     size = parse_size(args.size)
-    mesh = load_input(args.input)
+    check_fov(args.fov)
+    light = _light(args)
+    mesh = _bake_source(args.input, "compare")
     if not hasattr(mesh, "triangle_count"):
-        raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not an .rk file")
-    rep = _bake_input(args)
-    result = compare(mesh, rep, orbit_bounds(mesh.bounds, az, el, dist, size, args.fov))
+        raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not a heightmap")
+    rep = _bake_input(args, mesh)
+    camera = orbit_bounds(mesh.bounds, az, el, dist, size, args.fov)
+    result = _compare_with_progress(mesh, rep, camera, light)
     title = f"{mesh.name} as {args.kind}, view {args.view}"
     paths = write_comparison(result, Path(args.out), title)
     print(metrics_markdown(result, title))
     print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0
+
+
+def _compare_with_progress(mesh, rep, camera, light) -> dict:
+    """`compare` with a progress line per variant (the mesh, then each available variant)."""
+    from .compare import compare
+    from .core.technique import technique_of
+    from .progress import progress_bar
+
+    tech = technique_of(rep)
+    variants = [v for v in (tech.compare_variants if tech else ()) if v.available(rep)]
+    with progress_bar("compare", len(variants) + 1) as advance:
+        return compare(mesh, rep, camera, light=light, progress=advance)
 
 
 def cmd_bench(args) -> int:
@@ -358,14 +512,7 @@ def cmd_info(args) -> int:
 
         report["gl"] = gl_info()
     if args.file:
-        if Path(args.file).suffix.lower() == ".rk":
-            from .io.rk import read_manifest
-
-            report["file"] = read_manifest(args.file)
-        else:
-            from .io.inputs import describe, load_input
-
-            report["file"] = describe(load_input(args.file))
+        report["file"] = _describe_file(args.file)
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -374,6 +521,19 @@ def cmd_info(args) -> int:
                 shown = json.dumps(value) if isinstance(value, dict | list) else value
                 print(f"{key:>24}: {shown}")
     return 0
+
+
+def _describe_file(spec: str) -> dict:
+    """A mesh's counts and bounds, or an .rk file's manifest once every array is read and its
+    checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
+    _check_not_empty(spec)
+    if Path(spec).suffix.lower() == ".rk":
+        from .io.rk import read_rk
+
+        return {**read_rk(spec).manifest, "checksums": "ok"}
+    from .io.inputs import describe, load_input
+
+    return describe(load_input(spec))
 
 
 def cmd_demo(args) -> int:
@@ -390,20 +550,24 @@ def main(argv: list[str] | None = None) -> int:
         parser = build_parser()
     except ReliefkitError as exc:  # a technique failed to register
         print(f"error: {exc}", file=sys.stderr)
-        return 1
+        return EXIT_INPUT
     args = parser.parse_args(argv)
     if not getattr(args, "run", None):
         parser.print_help()
-        return 2
+        return EXIT_USAGE
     try:
-        return args.run(args)
+        status = args.run(args)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
+        return status
+    except BrokenPipeError:
+        return _broken_pipe()
     except ReliefkitError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 1
+        return EXIT_USAGE if isinstance(exc, UsageError) else EXIT_INPUT
     except OSError as exc:
         name = f" {exc.filename}" if getattr(exc, "filename", None) else ""
         print(f"error: cannot access{name}: {exc.strerror or exc}", file=sys.stderr)
-        return 1
+        return EXIT_INPUT
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130
@@ -412,7 +576,18 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"error: internal error ({type(exc).__name__}: {exc}); "
               "rerun with RELIEFKIT_DEBUG=1 for a traceback", file=sys.stderr)
-        return 3
+        return EXIT_INTERNAL
+
+
+def _broken_pipe() -> int:
+    """The reader of stdout went away (``... | head``): stop quietly, as `cat` would.
+
+    stdout is pointed at /dev/null so the interpreter's final flush cannot fail again.
+    """
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return EXIT_BROKEN_PIPE
 
 
 if __name__ == "__main__":

@@ -20,8 +20,10 @@ CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
                 "iterations_max")
 
 
-def compare(mesh, representation, camera, *, light=None) -> dict:
+def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     """Render ``mesh`` and every variant of ``representation``; metrics, frames, error masks.
+
+    ``progress(done, total)`` is called after the mesh and after each variant.
 
     Returns ``{"metrics": {variant: row}, "frames": {"mesh": Frame, variant: Frame},
     "errors": {variant: mask or None}, "columns": table columns, "bytes": {"mesh": n,
@@ -37,11 +39,12 @@ def compare(mesh, representation, camera, *, light=None) -> dict:
     if tech is None or not tech.compare_variants:
         raise UsageError(f"nothing to compare: {type(representation).__name__} declares no "
                          "compare variants")
+    variants = [v for v in tech.compare_variants if v.available(representation)]
+    advance = progress or (lambda done, total: None)
     truth = render(mesh, camera, light=light)
+    advance(1, len(variants) + 1)
     rows, frames, errors = {}, {"mesh": truth}, {}
-    for variant in tech.compare_variants:
-        if not variant.available(representation):
-            continue
+    for k, variant in enumerate(variants):
         plain = render(representation, camera, light=light, **variant.options)
         counted = render(representation, camera, light=light, count_iterations=True,
                          **variant.options)
@@ -58,6 +61,7 @@ def compare(mesh, representation, camera, *, light=None) -> dict:
         rows[variant.name] = row
         frames[variant.name] = plain
         errors[variant.name] = error_mask
+        advance(k + 2, len(variants) + 1)
     columns = tuple(c for m in tech.compare_metrics for c in m.columns) + CORE_COLUMNS
     sizes = {"mesh": sum(array_bytes(mesh).values()),
              "representation": sum(array_bytes(representation).values())}

@@ -49,7 +49,7 @@ def build_demo(out_dir: Path, tile_size=(256, 256), columns: int = 4) -> Path:
     from .pictures import contact_sheet, save_image
     from .progress import progress_bar
     from .render import render
-    from .scene.views import orbit_bounds
+    from .scene.views import framing_bounds, orbit_bounds
 
     out_dir.mkdir(parents=True, exist_ok=True)
     tiles = demo_tiles()
@@ -57,7 +57,7 @@ def build_demo(out_dir: Path, tile_size=(256, 256), columns: int = 4) -> Path:
     with progress_bar("demo", len(tiles)) as advance:
         for k, tile in enumerate(tiles):
             obj = tile.make()
-            camera = orbit_bounds(obj.bounds, *tile.view, size=tile_size)
+            camera = orbit_bounds(framing_bounds(obj), *tile.view, size=tile_size)
             rgba = render(obj, camera, **(tile.options or {})).rgba8(TILE_BACKGROUND)
             with atomic_path(out_dir / f"{tile.slug}.png") as tmp:
                 Image.fromarray(rgba, "RGBA").save(tmp, format="PNG")

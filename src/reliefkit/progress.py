@@ -1,27 +1,100 @@
-"""Progress bars for long work (on stderr, so stdout stays clean for tables and JSON)."""
+"""Progress of long work, on stderr so that stdout stays clean for tables and JSON.
+
+On a terminal this draws a rich bar. Anywhere else (a log file, a pipe, CI) a bar would be
+noise or nothing at all, so progress becomes plain lines such as ``demo: 3/8``: at most one
+every `PLAIN_INTERVAL` seconds, plus a final ``demo: 8/8, done in 12.3 s``. This module is the one
+place that decides; commands only call `progress_bar` or `activity`.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import sys
+import time
+
+PLAIN_INTERVAL = 5.0  # seconds between two plain progress lines
+
+
+def _is_terminal(stream) -> bool:
+    isatty = getattr(stream, "isatty", None)
+    return bool(isatty and isatty())
 
 
 @contextlib.contextmanager
-def progress_bar(description: str, total: int, *, enabled: bool = True):
-    """Yield ``advance(done, total)``, a callback for baking loops; draws with rich."""
+def progress_bar(description: str, total: int, *, enabled: bool = True, stream=None,
+                 interval: float = PLAIN_INTERVAL):
+    """Yield ``advance(done, total=None)``, the callback long loops (and bakers) call."""
+    stream = stream if stream is not None else sys.stderr
     if not enabled:
         yield lambda done, total_=None: None
-        return
-    from rich.console import Console
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    elif _is_terminal(stream):
+        with _rich_bar(description, total, stream) as advance:
+            yield advance
+    else:
+        lines = _PlainLines(description, total, stream, interval)
+        yield lines.advance
+        lines.finish()
 
-    console = Console(file=sys.stderr)
-    columns = (TextColumn("{task.description}"), BarColumn(),
-               TextColumn("{task.percentage:>3.0f}%"), TimeElapsedColumn())
-    with Progress(*columns, console=console, transient=not console.is_terminal) as bar:
+
+@contextlib.contextmanager
+def activity(description: str, *, stream=None):
+    """Yield ``log(message)`` for work that reports steps rather than counts (benchmarks):
+    each message is a line prefixed with ``description``; a terminal also shows a spinner
+    with the elapsed time."""
+    stream = stream if stream is not None else sys.stderr
+    start = time.monotonic()
+    if _is_terminal(stream):
+        from rich.console import Console
+
+        console = Console(file=stream)
+        with console.status(description) as status:
+            def log(message: str) -> None:
+                console.print(f"{description}: {message}", highlight=False, markup=False)
+                status.update(f"{description}: {message}")
+
+            yield log
+    else:
+        def log(message: str) -> None:
+            print(f"{description}: {message}", file=stream, flush=True)
+
+        yield log
+    print(f"{description}: done in {time.monotonic() - start:.1f} s", file=stream, flush=True)
+
+
+@contextlib.contextmanager
+def _rich_bar(description: str, total: int, stream):
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+               TimeElapsedColumn())
+    with Progress(*columns, console=Console(file=stream)) as bar:
         task = bar.add_task(description, total=total)
 
         def advance(done: int, total_: int | None = None) -> None:
             bar.update(task, completed=done, total=total_ if total_ is not None else total)
 
         yield advance
+        bar.update(task, completed=bar.tasks[0].total)  # done, also where nothing reported
+
+
+class _PlainLines:
+    """``description: done/total`` lines, rate-limited, and one final line on success."""
+
+    def __init__(self, description: str, total: int, stream, interval: float):
+        self.description, self.total, self.stream = description, total, stream
+        self.interval = interval
+        self.start = self.last = time.monotonic()
+
+    def advance(self, done: int, total: int | None = None) -> None:
+        self.total = total if total is not None else self.total
+        now = time.monotonic()
+        if now - self.last >= self.interval and done < self.total:
+            self.last = now
+            self._line(f"{done}/{self.total}")
+
+    def finish(self) -> None:
+        self._line(f"{self.total}/{self.total}, done in {time.monotonic() - self.start:.1f} s")
+
+    def _line(self, text: str) -> None:
+        print(f"{self.description}: {text}", file=self.stream, flush=True)

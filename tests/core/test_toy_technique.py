@@ -77,10 +77,10 @@ def test_cli_derives_everything_from_the_registry(gl, toy, tmp_path, capsys):
     stats = json.loads((tmp_path / "s.json").read_text())
     assert stats["covered"] > 0 and stats["toy_quads"] == 1
     assert cli.main(["render", str(out), "--method", "exact", "-o",
-                     str(tmp_path / "bad.png")]) == 1
+                     str(tmp_path / "bad.png")]) == 2  # a usage error
     assert "method must be one of flat, checker" in capsys.readouterr().err
     assert cli.main(["bake", "demo:blob", "--as", "toy-quad", "--spread", "20", "-o",
-                     str(tmp_path / "x.rk")]) == 1
+                     str(tmp_path / "x.rk")]) == 2
     assert "--spread does not apply to --as toy-quad" in capsys.readouterr().err
     assert cli.main(["bench", "toy", "--out", str(tmp_path / "bench")]) == 0
     assert "toy bench" in capsys.readouterr().out

@@ -6,18 +6,24 @@ Suites measure side by side in one run (ratios) and report device-independent co
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
               log=None) -> tuple[str, list[Path]]:
-    """Run the suite ``name``; returns its markdown report and the files it wrote."""
+    """Run the suite ``name``; returns its markdown report and the files it wrote.
+
+    Without ``log`` the suite's step messages are its progress (`reliefkit.progress.activity`:
+    ``bench NAME: ...`` lines on stderr, a spinner on a terminal).
+    """
     from ..core.technique import bench_suite
+    from ..progress import activity
 
     suite = bench_suite(name)
-    log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
-    return suite.run(quick, Path(out), log)
+    if log is not None:
+        return suite.run(quick, Path(out), log)
+    with activity(f"bench {name}") as progress_log:
+        return suite.run(quick, Path(out), progress_log)
 
 
 def suite_names() -> tuple[str, ...]:

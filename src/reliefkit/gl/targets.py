@@ -13,6 +13,12 @@ gated write is ``(value * g, g)`` with ``g`` 0 or 1, turns the AOV attachments i
 "first gated write wins": no AOV is ever blended. Between transparent drawables the
 accumulated opacity is copied to a texture the next one samples (shaders/include/
 transparency.glsl), so the 0.5 point is exact across drawables.
+
+Multisampled colour (``msaa`` > 1): the opaque draw runs once more into multisampled colour
+and position + coverage renderbuffers with their own multisampled depth, resolved (blitted)
+into single-sample textures: straight colour whose alpha is the covered fraction of each
+pixel (times the surface's own alpha). The AOVs never come from it (a resolved position or
+depth would average two surfaces), and transparent drawables are drawn single-sample only.
 """
 
 from __future__ import annotations
@@ -22,10 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import GPUError, UsageError
 from .context import bind_home_framebuffer, check_gl_error
-from .textures import read_depth, read_rgba, render_target
+from .textures import MAX_TARGET_BYTES, read_depth, read_rgba, render_target
 
 FRAME_ATTACHMENTS = 3  # colour, position + coverage, normal
+MSAA_CHOICES = (1, 2, 4, 8)  # samples per pixel of the multisampled colour
 FRONT_OPACITY_UNIT = 15  # texture unit of u_front_opacity (drawables use the low units)
 
 
@@ -39,11 +47,13 @@ class PassImages:
     depth: np.ndarray       # (H, W)
     extra: list             # extra attachments of the opaque pass
     transparent: tuple | None = None  # (premultiplied colour, position + gate, normal + gate)
+    msaa_color: np.ndarray | None = None  # (H, W, 4) straight multisampled opaque colour
 
 
 def draw_passes(ctx, size, opaque: Callable[[], None], transparent: list[Callable[[], None]],
-                *, extra_attachments: int = 0) -> PassImages:
-    """Clear fresh targets, run the opaque draw, then each transparent draw front to back.
+                *, extra_attachments: int = 0, msaa: int = 1) -> PassImages:
+    """Clear fresh targets, run the opaque draw, then each transparent draw front to back;
+    with ``msaa`` > 1 the opaque draw runs once more, multisampled (`PassImages.msaa_color`).
 
     While a transparent draw runs, the opacity accumulated in front of it is bound to texture
     unit ``FRONT_OPACITY_UNIT`` (``u_front_opacity`` of shaders/include/transparency.glsl).
@@ -66,6 +76,8 @@ def draw_passes(ctx, size, opaque: Callable[[], None], transparent: list[Callabl
                             depth=read_depth(fbo),
                             extra=[read_rgba(fbo, FRAME_ATTACHMENTS + i)
                                    for i in range(extra_attachments)])
+        if msaa > 1:
+            images.msaa_color = _multisampled_color(ctx, size, opaque, msaa)
         if transparent:
             images.transparent = _transparent_pass(ctx, fbo, transparent, made)
         return images
@@ -77,6 +89,59 @@ def draw_passes(ctx, size, opaque: Callable[[], None], transparent: list[Callabl
                 attachment.release()
             target.release()
         depth.release()
+
+
+def check_msaa(ctx, samples: int) -> None:
+    """Refuse a sample count that is no power of two up to 8, or over GL_MAX_SAMPLES."""
+    if samples not in MSAA_CHOICES:
+        raise UsageError(f"msaa must be one of {', '.join(map(str, MSAA_CHOICES))}, got "
+                         f"{samples!r}")
+    limit = int(ctx.info["GL_MAX_SAMPLES"])
+    if samples > limit:
+        raise GPUError(f"msaa {samples} exceeds this GPU's limit of {limit} samples; use "
+                       f"--msaa {limit} or less")
+
+
+def _multisampled_color(ctx, size, opaque: Callable[[], None], samples: int) -> np.ndarray:
+    """Run the opaque draw into ``samples``-sample colour, position + coverage and depth;
+    resolve; return straight colour whose alpha includes the covered fraction."""
+    import moderngl
+
+    width, height = size
+    needed = width * height * 36 * samples  # two RGBA32F attachments + depth per sample
+    if needed > MAX_TARGET_BYTES:
+        raise GPUError(f"a {width}x{height} image with msaa {samples} needs "
+                       f"{needed / 2**30:.1f} GiB of multisampled buffers (limit "
+                       f"{MAX_TARGET_BYTES / 2**30:.0f} GiB); use fewer samples or a smaller size")
+    made = []
+    try:
+        buffers = [ctx.renderbuffer((width, height), 4, samples=samples, dtype="f4")
+                   for _ in range(2)]
+        made += buffers
+        made.append(ctx.depth_renderbuffer((width, height), samples=samples))
+        multisampled = ctx.framebuffer(color_attachments=buffers, depth_attachment=made[-1])
+        made.append(multisampled)
+        textures = [ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
+        made += textures
+        resolved = ctx.framebuffer(color_attachments=textures)
+        made.append(resolved)
+        multisampled.use()
+        multisampled.viewport = (0, 0, width, height)
+        multisampled.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        opaque()  # outputs past position + coverage (normal, counters) have no buffer: dropped
+        check_gl_error(ctx, f"drawing the opaque pass with {samples} samples")
+        ctx.copy_framebuffer(resolved, multisampled)  # resolves every attachment (a blit)
+        check_gl_error(ctx, "resolving the multisampled colour")
+        mean, coverage = read_rgba(resolved, 0), read_rgba(resolved, 1)[..., 3:4]
+    finally:
+        for obj in reversed(made):
+            obj.release()
+    # samples not covered are cleared to 0: the mean colour over the covered ones is mean /
+    # coverage, and the mean alpha is already coverage times the surface's own alpha
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rgb = np.where(coverage > 0, mean[..., :3] / np.where(coverage > 0, coverage, 1.0), 0.0)
+    return np.concatenate([rgb, mean[..., 3:4]], axis=-1).astype(np.float32)
 
 
 class _Owned:

@@ -81,14 +81,18 @@ def release_all(drawables) -> None:
             release()
 
 
-def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False, **options):
+def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
+           msaa: int = 1, **options):
     """Render a representation, a RenderMesh (ground truth), or a list of them, into a Frame.
 
     ``count_iterations`` draws the instrumented variants and fills ``frame.stats`` with
-    fragments and loop iterations per pixel (``frame.extra["iterations"]``).
+    fragments and loop iterations per pixel (``frame.extra["iterations"]``). ``msaa`` (1, 2,
+    4 or 8 samples) draws the opaque objects once more, multisampled, for the colour only:
+    edge pixels get the covered fraction as alpha, every AOV stays single-sample, and
+    transparent objects are composited single-sample over it.
     """
     from ..gl.context import get_context
-    from ..gl.targets import draw_passes
+    from ..gl.targets import check_msaa, draw_passes
     from ..scene.light import DirectionalLight
     from .frame import frame_from_passes
 
@@ -97,6 +101,7 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
         raise UsageError("nothing to render")
     ctx = ctx or get_context()
     light = light or DirectionalLight()
+    check_msaa(ctx, msaa)
     drawables = make_drawables(ctx, objects, options, instrument=count_iterations)
     try:
         opaque = [d for d in drawables if not getattr(d, "transparent", False)]
@@ -110,8 +115,10 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
 
         images = draw_passes(ctx, camera.size, draw_opaque,
                              [lambda d=d: d.draw(camera, light) for d in transparent],
-                             extra_attachments=extra)
+                             extra_attachments=extra, msaa=msaa)
         frame = frame_from_passes(camera, images)
+        if images.msaa_color is not None:
+            frame.color = _multisampled_frame_color(camera, images)
         frame.stats["covered"] = int(frame.mask.sum())
         if count_iterations and extra:
             _iteration_stats(frame, images.extra[0])
@@ -122,6 +129,20 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
         return frame
     finally:
         release_all(drawables)
+
+
+def _multisampled_frame_color(camera, images) -> np.ndarray:
+    """The Frame's colour with the multisampled opaque colour in place of the single-sample
+    one, transparent layers composited over it by `frame_from_passes` itself (one copy of the
+    compositing); only its colour is kept, the AOVs are the single-sample pass's."""
+    from dataclasses import replace
+
+    from .frame import frame_from_passes
+
+    color = images.msaa_color
+    position = images.position.copy()
+    position[..., 3] = np.where(color[..., 3] > 0, 1.0, 0.0)  # any covered sample counts
+    return frame_from_passes(camera, replace(images, color=color, position=position)).color
 
 
 def _front_distance(drawable, camera) -> float:

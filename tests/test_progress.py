@@ -1,0 +1,89 @@
+"""Progress: a rich bar on a terminal, plain rate-limited lines anywhere else."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from reliefkit.progress import activity, progress_bar
+
+
+class Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_plain_lines_every_interval_and_a_final_one():
+    stream = io.StringIO()
+    with progress_bar("demo", 3, stream=stream, interval=0.0) as advance:
+        for k in range(3):
+            advance(k + 1)
+    lines = stream.getvalue().splitlines()
+    assert lines[:2] == ["demo: 1/3", "demo: 2/3"]
+    assert lines[2].startswith("demo: 3/3, done in ") and len(lines) == 3
+
+
+def test_plain_lines_are_rate_limited():
+    stream = io.StringIO()
+    with progress_bar("bake", 10, stream=stream, interval=3600.0) as advance:
+        for k in range(10):
+            advance(k + 1)
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("bake: 10/10, done in ")
+
+
+def test_a_total_given_while_running_is_used():
+    stream = io.StringIO()
+    with progress_bar("baking", 1, stream=stream, interval=0.0) as advance:
+        advance(5, 40)
+    assert stream.getvalue().splitlines()[0] == "baking: 5/40"
+
+
+def test_no_final_line_when_the_work_fails():
+    stream = io.StringIO()
+    with pytest.raises(RuntimeError), progress_bar("demo", 2, stream=stream) as advance:
+        advance(1)
+        raise RuntimeError("boom")
+    assert "done" not in stream.getvalue()
+
+
+def test_disabled_writes_nothing():
+    stream = io.StringIO()
+    with progress_bar("demo", 2, stream=stream, enabled=False) as advance:
+        advance(2)
+    assert stream.getvalue() == ""
+
+
+def test_a_terminal_gets_a_bar():
+    stream = Terminal()
+    with progress_bar("demo", 4, stream=stream) as advance:
+        advance(4)
+    text = stream.getvalue()
+    assert "demo" in text and "4/4" in text and "done in" not in text
+
+
+def test_activity_lines_are_prefixed():
+    stream = io.StringIO()
+    with activity("bench toy", stream=stream) as log:
+        log("table 1: 4 ms")
+    lines = stream.getvalue().splitlines()
+    assert lines[0] == "bench toy: table 1: 4 ms"
+    assert lines[1].startswith("bench toy: done in ")
+
+
+def test_bench_reports_its_steps_as_progress(toy_bench, tmp_path, capsys):
+    from reliefkit.bench import run_suite
+
+    report, _ = run_suite("toy", out=tmp_path)
+    err = capsys.readouterr().err.splitlines()
+    assert "bench toy: toy bench ran" in err and err[-1].startswith("bench toy: done in ")
+    assert "toy bench" in report
+
+
+@pytest.fixture
+def toy_bench():
+    from helpers import toy_technique
+
+    with toy_technique():
+        yield
