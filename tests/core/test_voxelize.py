@@ -471,3 +471,24 @@ def test_mesh_outside_the_box_is_an_error_not_an_empty_grid(gl):
     far = render_mesh(sphere(0.5, (5.0, 0, 0), subdivisions=1))
     with pytest.raises(UsageError, match="no part of the mesh"):
         voxelize(far, CUBE, 8, mode="solid", ctx=gl)
+
+
+def test_every_material_lands_in_its_voxels(gl):
+    """Two quads at z = -0.5 and z = +0.5, each with its own material: a textured one (a
+    uniform blue image, a grey factor) and a plain red one."""
+    from reliefkit.colorspace import srgb_decode
+    from reliefkit.scene.mesh import Material
+
+    quad = np.array([[-0.8, -0.8], [0.8, -0.8], [0.8, 0.8], [-0.8, 0.8]])
+    pos = np.concatenate([np.c_[quad, np.full(4, z)] for z in (-0.5, 0.5)]).astype(np.float32)
+    faces = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    uvs = np.tile([[0, 0], [1, 0], [1, 1], [0, 1]], (2, 1)).astype(np.float32)
+    blue = np.zeros((4, 4, 4), np.uint8)
+    blue[..., 2] = blue[..., 3] = 255
+    materials = (Material("blue", (0.5, 0.5, 0.5, 1.0), blue), Material("red", (1, 0, 0, 1)))
+    mesh = RenderMesh(pos, faces, np.tile([0, 0, 1], (8, 1)), np.ones((8, 4)), uvs=uvs,
+                      materials=materials, material=np.array([0, 0, 1, 1]), name="two")
+    grid = voxelize(mesh, CUBE, 16, mode="surface", ctx=gl)
+    back, front = grid.color[4, 8, 8], grid.color[12, 8, 8]  # voxels at z = -0.5 and +0.5
+    np.testing.assert_allclose(back, [0, 0, 0.5 * srgb_decode(1.0), 1], atol=1e-3)
+    np.testing.assert_allclose(front, [1, 0, 0, 1], atol=1e-3)

@@ -32,6 +32,7 @@ import numpy as np
 from ..errors import GPUError, UsageError
 from ..gl.textures import read_rgba
 from ..gl.uniforms import set_uniforms
+from ..render.mesh import material_uniforms
 from ..scene.mesh import RenderMesh
 
 MODES = ("surface", "solid")
@@ -42,6 +43,7 @@ MAX_VOXELS = 1 << 24         # 256^3; the grid's float arrays take 40 bytes per 
 MAX_SLAB_ENTRIES = 1 << 24   # triangle-slab pairs bucketed; above this every slab draws all
 _FAR = 1e30                  # an unused threshold channel (never reached)
 _EDGE_EPS = 1e-4             # box units: widen a triangle's slab range against rounding
+WHITE_TEXEL = np.full((1, 1, 4), 255, np.uint8)  # the texture of a material without an image
 
 # For each sweep axis, the box axes that become the image's x', y' and the slab axis z'.
 # Cyclic permutations keep the frame right-handed, so facing means the same in every sweep.
@@ -249,7 +251,7 @@ class _Sweeps:
         acc = np.zeros((d, h, w, 9), np.float32)
         inside = np.zeros((d, h, w), np.float32) if self.solid else None
         buckets = {name: self._buckets(perm) for name, perm in SWEEPS.items()}
-        total = sum(len(b[1]) - 1 for b in buckets.values()) + (1 if self.solid else 0)
+        total = sum(len(b[2]) - 1 for b in buckets.values()) + (1 if self.solid else 0)
         self.done, self.total = 0, total
         try:
             self._upload()
@@ -270,7 +272,8 @@ class _Sweeps:
         return acc[..., 8], acc[..., :4], acc[..., 4:7], acc[..., 7], inside
 
     def _upload(self) -> None:
-        """Vertex buffer and texture, shared by all sweeps."""
+        """Vertex buffer and one texture per material, shared by all sweeps (a material
+        without an image gets a white texel when others have one: one program for all)."""
         from ..gl.context import check_gl_error
         from ..gl.textures import texture2d
 
@@ -279,21 +282,29 @@ class _Sweeps:
         data = np.hstack([self.box_pos, mesh.normals, mesh.colors, uvs]).astype(np.float32)
         self.vbo = ctx.buffer(data.tobytes())
         self.objects.append(self.vbo)
-        self.texture = None
-        if mesh.texture is not None:
-            self.texture = texture2d(ctx, mesh.texture, what=f"{mesh.name} texture", srgb=True,
-                                     mipmaps=True, repeat=True)
-            self.objects.append(self.texture)
+        self.textured = mesh.textured
+        self.textures = []
+        uploaded = {}
+        for material in mesh.materials:
+            image = material.texture if material.texture is not None else WHITE_TEXEL
+            if self.textured and id(image) not in uploaded:
+                uploaded[id(image)] = texture2d(ctx, image, what=f"{mesh.name} texture",
+                                                srgb=True, mipmaps=True, repeat=True)
+                self.objects.append(uploaded[id(image)])
+            self.textures.append(uploaded.get(id(image)))
         check_gl_error(ctx, f"uploading {mesh.name} for voxelization")
 
     def _buckets(self, perm):
-        """Triangle corners grouped by the slabs (along z' = box axis perm[2]) they reach.
+        """Triangle corners grouped by the slabs (along z' = box axis perm[2]) they reach,
+        and by material inside each slab.
 
-        Returns (indices, offsets, above): the corners of slab k are
-        ``indices[offsets[k]:offsets[k+1]]`` (in triangles), ``above`` the triangles that
-        reach z' >= 1 (only the winding count of the h sweep needs those).
+        Returns (indices, materials, offsets, above, above_materials): the corners of slab k
+        are ``indices[offsets[k]:offsets[k+1]]`` (in triangles), ``materials`` each entry's
+        material, ``above`` the triangles that reach z' >= 1 (only the winding count of the
+        h sweep needs those).
         """
         n = self.size[perm[2]]
+        material = self.mesh.material
         z = self.box_pos[:, perm[2]][self.mesh.indices.astype(np.int64)]  # (F, 3)
         zmin, zmax = z.min(axis=1), z.max(axis=1)
         kmin = np.clip(np.floor((zmin - _EDGE_EPS) * n), 0, n - 1).astype(np.int64)
@@ -301,16 +312,20 @@ class _Sweeps:
         hit = (zmax >= -_EDGE_EPS) & (zmin < 1 + _EDGE_EPS)
         tri = np.nonzero(hit)[0]
         span = kmax[tri] - kmin[tri] + 1
-        above = self.mesh.indices[zmax >= 1 - _EDGE_EPS]
+        above = np.nonzero(zmax >= 1 - _EDGE_EPS)[0]
+        above = above[np.argsort(material[above], kind="stable")]
+        above_part = (self.mesh.indices[above], material[above])
         if span.sum() > MAX_SLAB_ENTRIES:  # too many big triangles: draw all of them per slab
+            tri = tri[np.argsort(material[tri], kind="stable")]
             offsets = np.zeros(n + 1, np.int64)
-            return self.mesh.indices[tri], offsets, above
+            return self.mesh.indices[tri], material[tri], offsets, *above_part
         rep = np.repeat(tri, span)
         first = np.repeat(np.cumsum(span) - span, span)
         slab = np.repeat(kmin[tri], span) + (np.arange(len(rep)) - first)
-        order = np.argsort(slab, kind="stable")
+        order = np.lexsort((material[rep], slab))
         offsets = np.concatenate([[0], np.cumsum(np.bincount(slab, minlength=n))])
-        return self.mesh.indices[rep[order]], offsets, above
+        entries = rep[order]
+        return self.mesh.indices[entries], material[entries], offsets, *above_part
 
     def _sweep(self, perm, buckets, acc, inside):
         """Rasterize every slab along z' = box axis perm[2], adding to ``acc`` (a view
@@ -323,29 +338,31 @@ class _Sweeps:
         ctx, s = self.ctx, self.s
         winding = inside is not None
         nx, ny, nz = (self.size[a] for a in perm)
-        indices, offsets, above = buckets
+        indices, materials, offsets, above, above_materials = buckets
         draw_all = offsets[-1] == 0  # the bucketing cap was hit
-        defines = {"HAS_TEXTURE": self.texture is not None, "WINDING": winding}
+        defines = {"HAS_TEXTURE": self.textured, "WINDING": winding}
         prog = program(ctx, "voxelize.glsl", defines)
         to_slab = np.eye(4)[list(perm) + [3]]  # (u, v, h) -> (x', y', z')
-        set_uniforms(prog, {"u_box_to_slab": to_slab, "u_texture": 0, "u_signed": self.signed,
-                    "u_alpha_cutoff": self.alpha_cutoff})
-        if self.texture is not None:
-            self.texture.use(0)
+        set_uniforms(prog, {"u_box_to_slab": to_slab, "u_signed": self.signed,
+                            "u_alpha_cutoff": self.alpha_cutoff})
         vao, _ = self._vao(prog, indices)
         attachments = 4 if winding else 2
         fbo = self._target(nx * s, ny * s, attachments)
 
-        def draw(vao, lo, hi, clip, tris):
+        def draw(vao, lo, hi, clip, tris, mats):
             first, n = tris
             fbo.use()
             fbo.clear(0.0, 0.0, 0.0, 0.0)
             thresholds = [lo + (t + 0.5) * (hi - lo) / s for t in range(s)] + [lo]
             thresholds += [_FAR] * (8 - len(thresholds))
             set_uniforms(prog, {"u_slab": (lo, hi), "u_clip_z": clip,
-                        "u_threshold_a": tuple(thresholds[:4]),
-                        "u_threshold_b": tuple(thresholds[4:])})
-            vao.render(moderngl.TRIANGLES, vertices=3 * n, first=3 * first)
+                                "u_threshold_a": tuple(thresholds[:4]),
+                                "u_threshold_b": tuple(thresholds[4:])})
+            for start, count, m in _runs(mats[first:first + n]):  # one draw per material
+                set_uniforms(prog, material_uniforms(self.mesh.materials[m]))
+                if self.textures[m] is not None:
+                    self.textures[m].use(0)
+                vao.render(moderngl.TRIANGLES, vertices=3 * count, first=3 * (first + start))
             check_gl_error(ctx, "voxelizing a slab")
             return [read_rgba(fbo, i, top_row_first=False) for i in range(attachments)]
 
@@ -354,7 +371,7 @@ class _Sweeps:
             top = float(self.box_pos[np.unique(above), perm[2]].max())
             above_vao, _ = self._vao(prog, above)
             counts = draw(above_vao, 1.0, _FAR, (1.0 - 0.5 / nz, top + 0.5 / nz),
-                          (0, len(above)))
+                          (0, len(above)), above_materials)
             above_count = _channels(counts)[..., s]
         if winding:
             self._advance()
@@ -368,7 +385,7 @@ class _Sweeps:
                                         self.signed)
                 self._advance()
                 continue
-            images = draw(vao, lo, hi, (lo - margin, hi + margin), tris)
+            images = draw(vao, lo, hi, (lo - margin, hi + margin), tris, materials)
             hit = images[1][..., 3:4] > 0  # the line crosses the surface in this voxel
             sums = _voxel_sums(np.concatenate([images[0], images[1], hit], -1), s)
             acc[k, ..., :8] += sums[..., :8]
@@ -409,6 +426,16 @@ class _Sweeps:
         self.done += 1
         if self.progress is not None:
             self.progress(self.done, self.total)
+
+
+def _runs(values: np.ndarray):
+    """(start, length, value) of each run of equal values."""
+    if len(values) == 0:
+        return []
+    change = np.flatnonzero(np.diff(values)) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [len(values)]])
+    return [(int(a), int(b - a), int(values[a])) for a, b in zip(starts, ends, strict=True)]
 
 
 def _channels(images) -> np.ndarray:

@@ -78,7 +78,7 @@ class MeshDrawable:
                         mipmaps=True, repeat=True))
                 texture = textures[key]
             self.draws.append(_Draw(*vertex_arrays[textured], texture,
-                                    _material_uniforms(material), first, corners.size))
+                                    material_uniforms(material), first, corners.size))
             first += corners.size
         self.programs = [prog for prog, _ in vertex_arrays.values()]
         check_gl_error(ctx, f"uploading mesh {mesh.name}")
@@ -112,7 +112,8 @@ class MeshDrawable:
         self._objects.clear()
 
 
-def _material_uniforms(material: Material) -> dict:
+def material_uniforms(material: Material) -> dict:
+    """u_base_color, u_uv_transform and u_texture (unit 0) of shaders that draw a material."""
     uv_transform = np.eye(3) if material.uv_transform is None else material.uv_transform
     return {"u_base_color": tuple(float(c) for c in material.color),
             "u_uv_transform": tuple(float(x) for x in uv_transform.T.ravel()),  # column-major

@@ -7,6 +7,7 @@
 #if defined VERTEX_SHADER
 uniform mat4 u_box_to_slab;    // box (u, v, h) -> the sweep's (x', y', z'), z' = slab axis
 uniform vec2 u_clip_z;         // the z' range mapped to clip z in [-1, 1] (the slab + margin)
+uniform mat3 u_uv_transform;   // the material's affine map of (u, v, 1)
 in vec3 in_box;                // vertex position in box coordinates (not world)
 in vec3 in_normal;             // world-space normal
 in vec4 in_color;
@@ -21,7 +22,7 @@ void main() {
     v_box = b;
     v_normal = in_normal;
     v_color = in_color;
-    v_uv = in_uv;
+    v_uv = (u_uv_transform * vec3(in_uv, 1.0)).xy;
     // orthographic along z': x' and y' in [0, 1] fill the viewport; clipping keeps the slab
     float z = 2.0 * (b.z - u_clip_z.x) / (u_clip_z.y - u_clip_z.x) - 1.0;
     gl_Position = vec4(2.0 * b.x - 1.0, 2.0 * b.y - 1.0, z, 1.0);
@@ -31,6 +32,7 @@ void main() {
 #if defined FRAGMENT_SHADER
 uniform vec2 u_slab;           // keep crossings with u_slab.x <= z' < u_slab.y (half open)
 uniform float u_alpha_cutoff;  // base alpha <= this is a hole (cut-out leaves), not surface
+uniform vec4 u_base_color;     // the material's linear colour factor
 #if defined HAS_TEXTURE
 uniform sampler2D u_texture;   // sRGB texture: sampling returns linear colour
 #endif
@@ -52,7 +54,7 @@ layout(location = 3) out vec4 f_count_b; // channels 4-7
 
 void main() {
     if (v_box.z < u_slab.x || v_box.z >= u_slab.y) discard;  // each crossing in one slab
-    vec4 base = v_color;
+    vec4 base = v_color * u_base_color;
 #if defined HAS_TEXTURE
     base *= texture(u_texture, v_uv);
 #endif
