@@ -27,7 +27,7 @@ def mesh_tiles() -> list[DemoTile]:
         DemoTile("terrain (mesh)", "terrain-mesh", _asset("terrain"), (30.0, 35.0, 2.2)),
         DemoTile("blob (mesh)", "blob-mesh", _asset("blob"), (35.0, 25.0, 2.5)),
         DemoTile("tree (mesh)", "tree-mesh", _asset("tree"), (20.0, 10.0, 2.4)),
-        DemoTile("vehicle (mesh)", "vehicle-mesh", _asset("vehicle"), (40.0, 20.0, 2.2)),
+        DemoTile("vehicle (mesh)", "vehicle-mesh", _asset("vehicle"), (40.0, 20.0, None)),
     ]
 
 

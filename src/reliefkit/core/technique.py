@@ -109,7 +109,7 @@ class DemoTile:
     title: str
     slug: str
     make: Callable[[], object]
-    view: tuple[float, float, float] = (35.0, 30.0, 2.4)
+    view: tuple = (35.0, 30.0, 2.4)  # AZ, EL, DIST (DIST None: fit the bounding sphere)
     options: dict | None = None
 
 

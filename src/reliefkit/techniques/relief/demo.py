@@ -18,7 +18,7 @@ def _baked(asset: str, kind: str, **params):
 def demo_tiles() -> list[DemoTile]:
     from ...scene.light import DirectionalLight
 
-    terrain_view, vehicle_view, blob_view = (30.0, 35.0, 2.2), (40.0, 20.0, 2.2), (35, 25, 2.5)
+    terrain_view, vehicle_view, blob_view = (30.0, 35.0, 2.2), (40.0, 20.0, None), (35, 25, 2.5)
     low_sun = DirectionalLight(direction=(-0.85, 0.35, 0.25))
     return [
         DemoTile("terrain: relief 256, robust + shadows", "terrain-relief",
