@@ -80,6 +80,8 @@ def test_bake_render_info_relief(gl, tmp_path):
     rk = tmp_path / "t.rk"
     out = run_cli("bake", "demo:terrain", "--as", "relief", "--depth-res", "32", "-o", rk)
     assert out.returncode == 0, out.stderr
+    # sizes with units: 32 x 32 float32 heights are 4 KiB
+    assert "height 4.0 KiB" in out.stdout and "on disk" in out.stdout, out.stdout
     info = json.loads(run_cli("info", "--json", rk).stdout)
     assert info["file"]["kind"] == "relief" and "safety" in info["file"]["arrays"]
     out = run_cli("render", rk, "--method", "exact", "--shadows", "--size", "32x32", "-o",

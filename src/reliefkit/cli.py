@@ -328,14 +328,18 @@ def _bake_input(args, source=None):
 
 
 def cmd_bake(args) -> int:
-    from .io.rk import file_sha256, save
+    from .io.rk import array_bytes, file_sha256, save
+    from .units import format_bytes
 
     if Path(args.output).suffix.lower() != ".rk":
         raise UsageError(f"output must be an .rk file, got {args.output}")
     rep = _bake_input(args)
     source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
     save(args.output, rep, source_hash=source_hash)
-    print(f"wrote {args.output} ({json.dumps(rep.summary().get('bytes', {}))})")
+    sizes = array_bytes(rep)
+    parts = ", ".join(f"{name} {format_bytes(n)}" for name, n in sizes.items())
+    print(f"wrote {args.output}: {format_bytes(sum(sizes.values()))} of arrays ({parts}), "
+          f"{format_bytes(Path(args.output).stat().st_size)} on disk")
     return 0
 
 
