@@ -52,6 +52,9 @@ class ReliefTexture:
                              f"{self.height.shape}")
         if not np.isfinite(self.height).all() or self.height.min() < 0 or self.height.max() > 1:
             raise UsageError("height values must be finite and within [0, 1]")
+        if not self.height.any():
+            raise UsageError("the heightfield is empty (every height is 0): nothing visible "
+                             "to render")
         self.color = np.ascontiguousarray(self.color, dtype=np.uint8)
         if self.color.ndim != 3 or self.color.shape[2] != 4:
             raise UsageError(f"color must be (H, W, 4) uint8, got {self.color.shape}")
@@ -59,14 +62,18 @@ class ReliefTexture:
         if self.normal.shape != self.color.shape[:2] + (3,):
             raise UsageError(f"normal must be {self.color.shape[:2] + (3,)}, got "
                              f"{self.normal.shape}")
-        self.box_to_world = np.asarray(self.box_to_world, dtype=np.float64)
-        if self.box_to_world.shape != (4, 4) or abs(np.linalg.det(self.box_to_world)) < 1e-300:
-            raise UsageError("box_to_world must be an invertible 4x4 matrix")
+        self.box_to_world = _checked_box(self.box_to_world)
         if self.safety is not None:
             self.safety = np.ascontiguousarray(self.safety)
             if self.safety.shape != self.height.shape or self.safety.dtype not in (
                     np.uint8, np.uint16):
                 raise UsageError("safety must be uint8/uint16 with the height's shape")
+            # a jump of max(W, H) centrelines crosses the whole field: larger radii are noise
+            limit = max(MAX_UINT8_RADIUS, *self.height.shape)
+            if int(self.safety.max()) > limit:
+                raise UsageError(f"safety radii up to {int(self.safety.max())} texels on a "
+                                 f"{self.height.shape[1]}x{self.height.shape[0]} heightfield; "
+                                 f"at most {limit} make sense")
         self.clip_bounds = _box_or_none(self.clip_bounds, "clip_bounds")
         self.source_bounds = _box_or_none(self.source_bounds, "source_bounds")
         if self.clip_bounds is not None:
@@ -127,6 +134,41 @@ class ReliefTexture:
                 "color_resolution": f"{cw}x{ch}", "has_safety": self.safety is not None,
                 "bounds_min": lo.tolist(), "bounds_max": hi.tolist(),
                 "bytes": self.memory_bytes(), "params": self.params}
+
+
+MAX_UINT8_RADIUS = 255   # what bakes store in uint8, whatever the field's size
+MAX_COORDINATE = 1e15    # |world corner| beyond this cannot be drawn (float32 on the GPU)
+MAX_CONDITION = 1e12     # box_to_world this ill-conditioned loses the box in rounding
+MIN_EXTENT = 1e-20       # a smaller box underflows in float32 on the GPU
+
+
+def _checked_box(matrix) -> np.ndarray:
+    """box_to_world: finite, well conditioned, its corners finite and in front (w > 0).
+
+    w is affine in box coordinates, so w > 0 at the eight corners means w > 0 everywhere in
+    the box: a projective box never contains its plane at infinity.
+    """
+    m = np.asarray(matrix, dtype=np.float64)
+    if m.shape != (4, 4) or not np.isfinite(m).all():
+        raise UsageError("box_to_world must be a finite 4x4 matrix")
+    with np.errstate(all="ignore"):
+        condition = np.linalg.cond(m)
+        corners = np.c_[unit_cube_corners(), np.ones(8)] @ m.T
+    if not np.isfinite(condition) or condition > MAX_CONDITION:
+        raise UsageError(f"box_to_world is singular or badly conditioned (condition number "
+                         f"{condition:.3g}); the box cannot be drawn")
+    w = corners[:, 3]
+    if not (w > 0).all() and not (w < 0).all():
+        raise UsageError("box_to_world maps part of the box beyond the plane at infinity "
+                         "(w changes sign inside the box)")
+    points = corners[:, :3] / w[:, None]
+    extent = float(np.ptp(points, axis=0).max())
+    reach = float(np.abs(points).max())
+    if not np.isfinite(points).all() or reach > MAX_COORDINATE or extent <= reach * 1e-7 \
+            or extent < MIN_EXTENT:
+        raise UsageError(f"box_to_world puts the box at {reach:.3g} from the origin with a "
+                         f"size of {extent:.3g}; it cannot be drawn in float32")
+    return m
 
 
 def _box_or_none(value, name: str) -> np.ndarray | None:
