@@ -190,3 +190,15 @@ def test_a_mesh_and_its_bakes_share_one_camera(gl, tmp_path, kind):
             assert aovs["mask"].sum() > 500
     np.testing.assert_array_equal(cameras[0][0], cameras[1][0])
     np.testing.assert_array_equal(cameras[0][1], cameras[1][1])
+
+
+@pytest.mark.parametrize("kind, res", [("relief", 2048), ("relief-frustum", 4096),
+                                        ("relief-cube", 512)])
+def test_bakes_that_would_run_for_many_minutes_are_refused_up_front(kind, res):
+    from reliefkit.bake import bake
+    from reliefkit.errors import UsageError
+
+    with pytest.raises(UsageError, match=r"would take about \d+ minutes.*--no-safety"):
+        bake(make_asset("blob"), kind, depth_res=res)
+    with pytest.raises(UsageError, match="would take about"):
+        bake(np.zeros((2048, 2048)), "relief")

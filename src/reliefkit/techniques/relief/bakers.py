@@ -7,10 +7,28 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.params import param
+from ...errors import UsageError
 from .bake import DEFAULT_TOLERANCE, bake_relief, relief_from_heights
 from .frustum import bake_relief_cube, bake_relief_frustum
 
 AXES = ("x", "y", "z", "-x", "-y", "-z")
+# Safety radii cost about SAFETY_SECONDS_512 for a 512² field on a 2-core machine and grow
+# with the texel count (docs/benchmarks.md); above these sides a bake would run for many
+# minutes, so it is refused with a hint instead of leaving the user with a progress bar.
+SAFETY_SECONDS_512 = 55.0
+SAFETY_MAX_TEXELS = 1024 * 1024
+
+
+def check_safety_work(width: int, height: int, parts: int = 1) -> None:
+    """Refuse safety radii whose computation would take too long (estimate in the message)."""
+    texels = width * height * parts
+    if texels <= SAFETY_MAX_TEXELS:
+        return
+    minutes = SAFETY_SECONDS_512 * texels / 512**2 / 60
+    raise UsageError(f"safety radii for {parts} x {width}x{height} texels would take about "
+                     f"{minutes:.0f} minutes here (the limit is {SAFETY_MAX_TEXELS} texels); "
+                     "bake with --no-safety and render with --method exact or binary, or use "
+                     "a smaller --depth-res")
 
 
 def _depth_res(default: int):
@@ -67,6 +85,9 @@ class ReliefCubeParams:
 
 
 def bake_orthographic(source, p: ReliefParams, progress=None):
+    if p.safety:
+        side = max(source.shape) if isinstance(source, np.ndarray) else p.depth_res
+        check_safety_work(side, side)
     if isinstance(source, np.ndarray):
         return relief_from_heights(source, size=p.box, safety=p.safety,
                                    tolerance=p.safety_tolerance, progress=progress)
@@ -75,11 +96,15 @@ def bake_orthographic(source, p: ReliefParams, progress=None):
 
 
 def bake_frustum(source, p: ReliefFrustumParams, progress=None):
+    if p.safety:
+        check_safety_work(p.depth_res, p.depth_res)
     return bake_relief_frustum(source, depth_res=p.depth_res, color_res=p.color_res,
                                axis=p.axis, spread_deg=p.spread, clip=p.clip, safety=p.safety,
                                tolerance=p.safety_tolerance, progress=progress)
 
 
 def bake_cube(source, p: ReliefCubeParams, progress=None):
+    if p.safety:
+        check_safety_work(p.depth_res, p.depth_res, parts=6)
     return bake_relief_cube(source, depth_res=p.depth_res, color_res=p.color_res,
                             safety=p.safety, tolerance=p.safety_tolerance, progress=progress)
