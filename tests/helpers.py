@@ -60,3 +60,32 @@ def sample(technique_name: str, kind: str):
 
     table = {t.name: t for t in (*load_all(), toy_technique.TECHNIQUE)}
     return table[technique_name].samples()[kind]
+
+
+def shoelace(xy: np.ndarray) -> float:
+    """Signed area of a polygon (counter-clockwise positive)."""
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def inside_polygon(xy: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Even-odd rule, one horizontal ray per point: an independent inside test."""
+    inside = np.zeros(len(points), bool)
+    for a, b in zip(xy, np.roll(xy, -1, axis=0), strict=True):
+        crosses = (a[1] > points[:, 1]) != (b[1] > points[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = a[0] + (points[:, 1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+        inside ^= crosses & (points[:, 0] < x)
+    return inside
+
+
+def triangles_covering(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """How many of the (F, 3, 2) triangles contain each point (strictly, by edge signs)."""
+    def side(a, b):
+        return (b[:, None, 0] - a[:, None, 0]) * (points[None, :, 1] - a[:, None, 1]) - (
+            b[:, None, 1] - a[:, None, 1]) * (points[None, :, 0] - a[:, None, 0])
+
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    d1, d2, d3 = side(a, b), side(b, c), side(c, a)
+    inside = ((d1 > 0) & (d2 > 0) & (d3 > 0)) | ((d1 < 0) & (d2 < 0) & (d3 < 0))
+    return inside.sum(axis=0)

@@ -11,6 +11,7 @@ import re
 import numpy as np
 import pytest
 import trimesh
+from helpers import inside_polygon, shoelace, triangles_covering
 from PIL import Image
 
 from reliefkit.errors import MeshError
@@ -94,39 +95,15 @@ def obj_polygon(xy: np.ndarray, with_uvs: bool = False) -> str:
     return "\n".join([*lines, "f " + " ".join(corners)]) + "\n"
 
 
-def inside_polygon(xy: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Even-odd rule, one horizontal ray per point."""
-    inside = np.zeros(len(points), bool)
-    for a, b in zip(xy, np.roll(xy, -1, axis=0), strict=True):
-        crosses = (a[1] > points[:, 1]) != (b[1] > points[:, 1])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = a[0] + (points[:, 1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
-        inside ^= crosses & (points[:, 0] < x)
-    return inside
-
-
-def covered_times(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """How many of the (F, 3, 2) triangles contain each point."""
-    def side(a, b):
-        return (b[:, None, 0] - a[:, None, 0]) * (points[None, :, 1] - a[:, None, 1]) - (
-            b[:, None, 1] - a[:, None, 1]) * (points[None, :, 0] - a[:, None, 0])
-
-    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
-    d1, d2, d3 = side(a, b), side(b, c), side(c, a)
-    inside = ((d1 > 0) & (d2 > 0) & (d3 > 0)) | ((d1 < 0) & (d2 < 0) & (d3 < 0))
-    return inside.sum(axis=0)
-
-
 def assert_covers_exactly(mesh_out, xy: np.ndarray) -> None:
     triangles = mesh_out.positions[mesh_out.indices][..., :2].astype(np.float64)
     e1, e2 = triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
     signed = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    x, y = xy[:, 0], xy[:, 1]
-    area = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+    area = shoelace(xy)
     assert signed.min() >= -1e-9, "a triangle is flipped"
     np.testing.assert_allclose(signed.sum(), area, rtol=1e-5)
     points = np.random.default_rng(0).uniform(xy.min(axis=0), xy.max(axis=0), (3000, 2))
-    np.testing.assert_array_equal(covered_times(triangles, points),
+    np.testing.assert_array_equal(triangles_covering(triangles, points),
                                   inside_polygon(xy, points).astype(int))
 
 

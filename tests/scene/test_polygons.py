@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import inside_polygon, shoelace, triangles_covering
 from scipy.spatial.transform import Rotation
 
 from reliefkit.scene.loader.polygons import triangulate_polygon
@@ -46,34 +47,6 @@ def framed_hole() -> np.ndarray:
     return np.array(outer + inner, float)
 
 
-def shoelace(xy: np.ndarray) -> float:
-    x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-
-
-def inside_polygon(xy: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Even-odd rule, one horizontal ray per point."""
-    inside = np.zeros(len(points), bool)
-    for a, b in zip(xy, np.roll(xy, -1, axis=0), strict=True):
-        crosses = (a[1] > points[:, 1]) != (b[1] > points[:, 1])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = a[0] + (points[:, 1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
-        inside ^= crosses & (points[:, 0] < x)
-    return inside
-
-
-def coverage(xy: np.ndarray, triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """How many triangles contain each point (strictly, by barycentric signs)."""
-    def side(a, b):
-        return (b[0] - a[0]) * (points[:, 1] - a[1]) - (b[1] - a[1]) * (points[:, 0] - a[0])
-
-    count = np.zeros(len(points), int)
-    for a, b, c in xy[triangles]:
-        d1, d2, d3 = side(a, b), side(b, c), side(c, a)
-        count += ((d1 > 0) & (d2 > 0) & (d3 > 0)) | ((d1 < 0) & (d2 < 0) & (d3 < 0))
-    return count
-
-
 def assert_tiles(xy: np.ndarray, triangles: np.ndarray) -> None:
     """The triangles tile the polygon: n - 2 of them, same winding, each inside point once."""
     assert triangles.shape == (len(xy) - 2, 3)
@@ -83,7 +56,7 @@ def assert_tiles(xy: np.ndarray, triangles: np.ndarray) -> None:
     np.testing.assert_allclose(sum(areas), shoelace(xy), rtol=1e-9)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     points = np.random.default_rng(0).uniform(lo, hi, (4000, 2))
-    np.testing.assert_array_equal(coverage(xy, triangles, points),
+    np.testing.assert_array_equal(triangles_covering(xy[triangles], points),
                                   inside_polygon(xy, points).astype(int))
 
 
