@@ -8,9 +8,13 @@ an internal error (docs/cli.md).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import math
 import os
+import signal
 import sys
+import warnings
 from pathlib import Path
 
 from .errors import FormatError, ReliefkitError, UsageError
@@ -19,6 +23,8 @@ from .scene.views import DEFAULT_SIZE, DEFAULT_VIEW
 
 EXIT_INPUT, EXIT_USAGE, EXIT_INTERNAL = 1, 2, 3
 EXIT_BROKEN_PIPE = 141  # what a shell reports for a process stopped by SIGPIPE
+EXIT_TERMINATED = 143   # what a shell reports for a process stopped by SIGTERM
+MAX_OPTION_MAGNITUDE = 1e18  # no numeric option takes a value larger than this
 MSAA_CHOICES = (1, 2, 4, 8)
 
 CORE_EXAMPLES = {
@@ -110,12 +116,13 @@ def _add_view_args(p: _Parser) -> None:
               default=",".join(f"{x:g}" for x in DEFAULT_VIEW[:2]),
               help="orbit the bounding-box centre (of the source mesh for a baked .rk): "
                    "azimuth about +y from +z towards +x and elevation in degrees, distance in "
-                   "bounding-sphere radii (default: %(default)s, at the distance that fits the "
-                   "sphere in view)")
+                   "bounding-sphere radii, within [0.01, 10000] (default: %(default)s, at the "
+                   "distance that fits the sphere in view)")
     p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
                    help="image size in pixels (default: %(default)s)")
     _add_flag(p, "--fov", dash_value=True, type=float, default=40.0, metavar="DEG",
-              help="vertical field of view in degrees (default: %(default)g)")
+              help="vertical field of view in degrees, within [0.1, 179] (default: "
+                   "%(default)g)")
     _add_flag(p, "--light", dash_value=True, metavar="AZ,EL",
               default=",".join(f"{x:g}" for x in DEFAULT_LIGHT_ANGLES),
               help="where the light comes from: azimuth and elevation in degrees, as in "
@@ -150,9 +157,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write the frame's counters: covered pixels, fragments and loop "
                         "iterations per pixel (mean, max) where the renderer counts them")
     p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
-    p.add_argument("--background", default="transparent", metavar="transparent|LEVEL",
-                   help="'transparent' or a grey level 0..1 to composite over (default: "
-                        "%(default)s)")
+    _add_flag(p, "--background", dash_value=True, default="transparent",
+              metavar="transparent|LEVEL",
+              help="'transparent' or a grey level 0..1 to composite over (default: "
+                   "%(default)s)")
     p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
                    help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
                         "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
@@ -170,7 +178,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = _command(sub, "compare", "bake, then render the mesh and every variant side by side",
                  "Bake INPUT, render the mesh and each variant of the representation (its "
                  "methods or modes) from one view; write compare.png, metrics.md, metrics.json.")
-    _add_bake_args(p, table)
+    _add_bake_args(p, table, "mesh file or demo:NAME (not a heightmap: there is no mesh to "
+                             "compare against)")
     _add_view_args(p)
     p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
     p.set_defaults(run=cmd_compare)
@@ -278,16 +287,23 @@ def _applicable(given: dict, options, what: str) -> dict:
 def _checked(opt, value, what: str):
     """``opt.check`` with the message saying ``--flag`` (the declaration says ``flag``)."""
     try:
-        return opt.check(value, what)
+        checked = opt.check(value, what)
     except UsageError as exc:
         message, bare = str(exc), f"{what}: {opt.flag} "
         if message.startswith(bare):
             message = f"--{opt.flag} {message[len(bare):]} ({what})"
         raise UsageError(message) from None
+    if opt.kind in ("float", "floats") and checked is not None:
+        for v in (checked if opt.kind == "floats" else (checked,)):
+            if not (math.isfinite(v) and abs(v) <= MAX_OPTION_MAGNITUDE):
+                raise UsageError(f"--{opt.flag} needs finite numbers of magnitude at most "
+                                 f"{MAX_OPTION_MAGNITUDE:g}, got {value!r} ({what})")
+    return checked
 
 
-def _add_bake_args(p: argparse.ArgumentParser, table: dict) -> None:
-    p.add_argument("input", help="mesh file, demo:NAME, or a heightmap (.png/.npy)")
+def _add_bake_args(p: argparse.ArgumentParser, table: dict,
+                   input_help: str = "mesh file, demo:NAME, or a heightmap (.png/.npy)") -> None:
+    p.add_argument("input", help=input_help)
     kinds = tuple(table)
     p.add_argument("--as", dest="kind", default=kinds[0] if kinds else None, choices=kinds,
                    help="representation to bake (default: %(default)s)")
@@ -309,10 +325,30 @@ def _bake_source(spec: str, command: str = "bake"):
     if Path(spec).suffix.lower() == ".rk":
         raise UsageError(f"{command} needs a mesh or heightmap, not an .rk file ({spec})")
     if is_heightmap(spec):
+        if command == "compare":
+            raise UsageError(f"compare needs a mesh or demo:NAME as INPUT, not a heightmap "
+                             f"({spec}): there is no mesh to compare against; bake it with "
+                             "`reliefkit bake` and render the .rk instead")
         return load_heightmap(spec)
+    return _load(spec)
+
+
+def _load(spec: str):
+    """`load_input`, then each warning the loader left on a mesh as one `warning:` line."""
     from .io.inputs import load_input
 
-    return load_input(spec)
+    obj = load_input(spec)
+    _print_load_warnings(obj)
+    return obj
+
+
+def _print_load_warnings(obj) -> None:
+    """The loader's human-readable warnings (``mesh.extra["warnings"]``), one line each."""
+    extra = getattr(obj, "extra", None)
+    found = extra.get("warnings", ()) if isinstance(extra, dict) else ()
+    for text in found if isinstance(found, list | tuple) else ():
+        line = " ".join(str(text).split())
+        print(f"warning: {line}", file=sys.stderr)
 
 
 def _bake_input(args, source=None):
@@ -328,11 +364,13 @@ def _bake_input(args, source=None):
 
 
 def cmd_bake(args) -> int:
+    from .io.atomic import check_writable
     from .io.rk import array_bytes, file_sha256, save
     from .units import format_bytes
 
     if Path(args.output).suffix.lower() != ".rk":
         raise UsageError(f"output must be an .rk file, got {args.output}")
+    check_writable(args.output, "-o")
     rep = _bake_input(args)
     source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
     save(args.output, rep, source_hash=source_hash)
@@ -377,7 +415,6 @@ def _warn_nothing_visible(what: str) -> None:
 
 
 def cmd_render(args) -> int:
-    from .io.inputs import load_input
     from .render import render, render_options
     from .scene.views import check_fov, framing_bounds, orbit_bounds, parse_size, parse_view
 
@@ -388,7 +425,7 @@ def cmd_render(args) -> int:
     light = _light(args)
     _check_render_outputs(args)
     _check_not_empty(args.input)
-    obj = load_input(args.input)
+    obj = _load(args.input)
     options = _applicable(_given_options(args), render_options(obj),
                           f"{args.input}, a {type(obj).__name__}")
 
@@ -428,6 +465,13 @@ def _check_render_outputs(args) -> None:
         raise UsageError(f"output must be a .png file, got {args.output}")
     if args.stats and Path(args.stats).suffix.lower() != ".json":
         raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
+    if args.aovs and Path(args.aovs).suffix.lower() != ".npz":
+        raise UsageError(f"--aovs writes NumPy arrays: name the file *.npz, got {args.aovs}")
+    from .io.atomic import check_writable
+
+    for flag, value in (("-o", args.output), ("--aovs", args.aovs), ("--stats", args.stats)):
+        if value:
+            check_writable(value, flag)
 
 
 def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
@@ -473,6 +517,9 @@ def cmd_compare(args) -> int:
     size = parse_size(args.size)
     check_fov(args.fov)
     light = _light(args)
+    from .io.atomic import check_writable
+
+    check_writable(args.out, "--out", folder=True)
     mesh = _bake_source(args.input, "compare")
     if not hasattr(mesh, "triangle_count"):
         raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not a heightmap")
@@ -500,7 +547,9 @@ def _compare_with_progress(mesh, rep, camera, light) -> dict:
 
 def cmd_bench(args) -> int:
     from .bench import run_suite
+    from .io.atomic import check_writable
 
+    check_writable(args.out, "--out", folder=True)
     report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out))
     print(report)
     print("wrote " + ", ".join(map(str, paths)))
@@ -532,19 +581,23 @@ def _describe_file(spec: str) -> dict:
     checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
     _check_not_empty(spec)
     if Path(spec).suffix.lower() == ".rk":
-        from .io.rk import read_rk
+        from .io.rk import load, read_manifest
 
-        return {**read_rk(spec).manifest, "checksums": "ok"}
-    from .io.inputs import describe, load_input
+        load(spec)  # every check render makes: checksums, then the representation's own
+        return {**read_manifest(spec), "checksums": "ok", "valid": "ok"}
+    from .io.inputs import describe
 
-    return describe(load_input(spec))
+    return describe(_load(spec))
 
 
 def cmd_demo(args) -> int:
     from .demo import build_demo
+    from .io.atomic import check_writable
     from .scene.views import parse_size
 
-    sheet = build_demo(Path(args.out), tile_size=parse_size(args.size))
+    size = parse_size(args.size)
+    check_writable(args.out, "--out", folder=True)
+    sheet = build_demo(Path(args.out), tile_size=size)
     print(f"wrote {sheet}")
     return 0
 
@@ -559,6 +612,54 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "run", None):
         parser.print_help()
         return EXIT_USAGE
+    with _one_line_warnings(), _sigterm_interrupts():
+        return _run(args)
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: unwinds like KeyboardInterrupt, so every `atomic_path` removes its
+    temporary file, and is no Exception, so no `except Exception` swallows it."""
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts():
+    """While a command runs, SIGTERM raises `Terminated` (where Python can take signals)."""
+    def handler(signum, frame):
+        raise Terminated
+
+    try:
+        previous = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread (main() called from a test's thread)
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def _one_line_warnings():
+    """Python warnings become one ``warning: ...`` line each; numpy's floating-point
+    RuntimeWarnings (overflow, invalid value) are silenced: bad values are refused by the
+    checks that follow them, with their own one-line error. Deprecations are silenced;
+    PIL's DecompressionBombWarning stays (one line)."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        print(f"warning: {text}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.filterwarnings("ignore", category=DeprecationWarning)
+        warnings.filterwarnings("ignore", category=PendingDeprecationWarning)
+        warnings.filterwarnings("ignore", category=RuntimeWarning)
+        # ... but PIL's DecompressionBombWarning (a RuntimeWarning) matters: one line
+        warnings.filterwarnings("default", message=r"Image size \(", category=RuntimeWarning)
+        warnings.showwarning = show
+        yield
+
+
+def _run(args) -> int:
     try:
         status = args.run(args)
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
@@ -575,6 +676,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("error: terminated (SIGTERM); no output was left half-written", file=sys.stderr)
+        return EXIT_TERMINATED
     except Exception as exc:  # a bug, not bad input: still one line, details on request
         if os.environ.get("RELIEFKIT_DEBUG"):
             raise

@@ -77,13 +77,13 @@ class Option:
         for v in (value if self.kind == "floats" else (value,)):
             if self.kind in ("int", "float", "floats") and not (
                     (self.lo is None or v >= self.lo) and (self.hi is None or v <= self.hi)):
-                raise UsageError(f"{where} must be within [{_num(self.lo)}, {_num(self.hi)}], "
-                                 f"got {v!r}")
+                raise UsageError(f"{where} must be within [{_num(self.lo, '-inf')}, "
+                                 f"{_num(self.hi, 'inf')}], got {v!r}")
         return value
 
 
-def _num(x) -> str:
-    return "-inf" if x is None else f"{x:g}"
+def _num(x, unbounded: str) -> str:
+    return unbounded if x is None else f"{x:g}"
 
 
 def _convert(kind: str, value, count: int | None):

@@ -35,6 +35,48 @@ from .textures import MAX_TARGET_BYTES, read_depth, read_rgba, render_target
 FRAME_ATTACHMENTS = 3  # colour, position + coverage, normal
 MSAA_CHOICES = (1, 2, 4, 8)  # samples per pixel of the multisampled colour
 FRONT_OPACITY_UNIT = 15  # texture unit of u_front_opacity (drawables use the low units)
+MAX_HOST_BYTES = 4 << 30  # refuse renders whose read-back needs more host memory than this
+HOST_MEMORY_FRACTION = 0.5  # ... or more than this fraction of the machine's physical memory
+
+
+def host_limit() -> int:
+    """The host-memory cap of one render: `MAX_HOST_BYTES`, or less on a small machine."""
+    import os
+
+    try:
+        physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return MAX_HOST_BYTES
+    return min(MAX_HOST_BYTES, int(HOST_MEMORY_FRACTION * physical)) if physical > 0 else \
+        MAX_HOST_BYTES
+
+
+def host_bytes(width: int, height: int, extra_attachments: int = 0, *, msaa: int = 1,
+               transparent: bool = False) -> int:
+    """Host memory a render's read-back needs at its peak, estimated before allocating.
+
+    Every RGBA32F attachment is read as bytes and copied into a flipped array (2 x 16 bytes
+    per pixel), the depth likewise (2 x 4); the Frame built from them holds colour, position,
+    normal, depth, mask and the iteration counters (about 16 + 12 + 12 + 4 + 1 + 8 bytes);
+    the transparent pass reads three more attachments plus its zero upload, msaa two more.
+    """
+    per_pixel = 2 * 16 * (FRAME_ATTACHMENTS + extra_attachments) + 2 * 4 + 53
+    if msaa > 1:
+        per_pixel += 2 * 16 * 2 + 16
+    if transparent:
+        per_pixel += 2 * 16 * 3 + 16
+    return width * height * per_pixel
+
+
+def check_host_memory(width: int, height: int, extra_attachments: int = 0, *, msaa: int = 1,
+                      transparent: bool = False) -> None:
+    """Refuse a render whose read-back would need more host memory than `host_limit()`."""
+    needed = host_bytes(width, height, extra_attachments, msaa=msaa, transparent=transparent)
+    limit = host_limit()
+    if needed > limit:
+        raise GPUError(f"a {width}x{height} image with its AOVs needs about "
+                       f"{needed / 2**30:.1f} GiB of host memory to read back (limit "
+                       f"{limit / 2**30:.1f} GiB); render a smaller size")
 
 
 @dataclass
@@ -62,6 +104,8 @@ def draw_passes(ctx, size, opaque: Callable[[], None], transparent: list[Callabl
     import moderngl
 
     width, height = size
+    check_host_memory(width, height, extra_attachments, msaa=msaa,
+                      transparent=bool(transparent))
     fbo = render_target(ctx, width, height, FRAME_ATTACHMENTS + extra_attachments)
     depth = fbo.depth_attachment
     made = [fbo]

@@ -1,4 +1,10 @@
-"""The one atomic writer: a failed or interrupted write never leaves a torn file behind."""
+"""The one atomic writer: a failed or interrupted write never leaves a torn file behind.
+
+The temporary file is ``.NAME.XXXXXXXX.tmp`` in the destination's folder, with NAME the
+destination's name cut to `TEMP_NAME_BYTES` bytes: its length is bounded whatever the
+destination's, so any name the folder accepts can be written, and every error names the
+destination, never the temporary file.
+"""
 
 from __future__ import annotations
 
@@ -10,6 +16,9 @@ from pathlib import Path
 
 from ..errors import UsageError
 
+TEMP_NAME_BYTES = 40  # of the destination's name in the temporary file's (then 8 random + .tmp)
+TEMP_SUFFIX = ".tmp"
+
 
 @functools.cache
 def _umask() -> int:
@@ -18,21 +27,75 @@ def _umask() -> int:
     return mask
 
 
+def _reason(exc: OSError) -> str:
+    """The OS's words for an error (``No space left on device``), without any file name."""
+    return exc.strerror or str(exc) or type(exc).__name__
+
+
+def temp_prefix(name: str) -> str:
+    """``.NAME.`` with NAME cut to at most `TEMP_NAME_BYTES` bytes in the file system's
+    encoding (never inside a character)."""
+    cut = ""
+    for char in name:
+        if len(os.fsencode(cut + char)) > TEMP_NAME_BYTES:
+            break
+        cut += char
+    return f".{cut}."
+
+
+def check_writable(path, flag: str | None = None, *, folder: bool = False,
+                   error: type = UsageError) -> Path:
+    """Refuse, before any work, an output that cannot be written: a missing or read-only
+    folder, or a destination that is a directory (for ``folder=True``: a destination that
+    exists and is no directory, or whose nearest existing ancestor is not writable).
+
+    ``flag`` names the option in the message (``--aovs x/y.npz: the folder x does not
+    exist``). Returns the path.
+    """
+    dest = Path(path)
+    label = f"{flag} {dest}" if flag else str(dest)
+    if folder:
+        if dest.exists() and not dest.is_dir():
+            raise error(f"{label}: exists and is not a folder")
+        parent = dest
+        while not parent.exists():
+            if parent.parent == parent:
+                break
+            parent = parent.parent
+        if dest.exists():
+            parent = dest
+    else:
+        if dest.is_dir():
+            raise error(f"{label}: is a directory; name a file")
+        parent = dest.parent if str(dest.parent) else Path(".")
+        if not parent.exists():
+            raise error(f"{label}: the folder {parent} does not exist")
+    if not parent.is_dir():
+        raise error(f"{label}: {parent} is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise error(f"{label}: the folder {parent} is not writable")
+    return dest
+
+
 @contextlib.contextmanager
 def atomic_path(path, *, error: type = UsageError):
     """Yield a temporary path beside ``path``; on success fsync it, move it into place and
     fsync the folder so the rename survives a crash.
 
-    On any exception the temporary file is removed and an existing ``path`` stays intact;
-    an OSError becomes ``error`` (a ReliefkitError subclass) with a one-line message.
+    On any exception (also KeyboardInterrupt and the CLI's SIGTERM) the temporary file is
+    removed and an existing ``path`` stays intact; an OSError (disk full, file too large, a
+    directory in the way) becomes ``error`` (a ReliefkitError subclass) with a one-line
+    message naming ``path``.
     """
     dest = Path(path)
     folder = dest.parent if str(dest.parent) else Path(".")
+    if dest.is_dir():
+        raise error(f"cannot write {dest}: it is a directory; name a file")
     try:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{dest.name}.",
-                                   suffix=dest.suffix + ".tmp")
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=temp_prefix(dest.name),
+                                   suffix=TEMP_SUFFIX)
     except OSError as exc:
-        raise error(f"cannot write {dest}: {exc.strerror or exc}; check that the folder "
+        raise error(f"cannot write {dest}: {_reason(exc)}; check that the folder "
                     "exists and is writable") from None
     os.close(fd)
     try:
@@ -45,7 +108,7 @@ def atomic_path(path, *, error: type = UsageError):
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         if isinstance(exc, OSError):
-            raise error(f"cannot write {dest}: {exc.strerror or exc}; nothing was "
+            raise error(f"cannot write {dest}: {_reason(exc)}; nothing was "
                         "written") from exc
         raise
     _fsync_folder(folder)

@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import UsageError
+from ..errors import FormatError, UsageError
 from .camera import Camera
 
 DEFAULT_VIEW = (30.0, 25.0, None)  # distance None: fit the bounding sphere in the view
 FIT_MARGIN = 1.05                  # the fitted sphere fills 1 / FIT_MARGIN of the view
 DEFAULT_SIZE = (512, 512)
+DISTANCE_RANGE = (0.01, 1e4)       # --view DIST in bounding-sphere radii: near/far stay sane
+FOV_RANGE = (0.1, 179.0)           # --fov in degrees: the projection stays well conditioned
+MAX_BOUNDS = 1e18                  # coordinates past this overflow float32 products on the GPU
 
 
 def parse_view(text: str) -> tuple[float, float, float | None]:
@@ -31,6 +34,10 @@ def parse_view(text: str) -> tuple[float, float, float | None]:
     if not np.isfinite((az, el)).all() or (dist is not None and not (np.isfinite(dist)
                                                                       and dist > 0)):
         raise UsageError(f"--view needs finite angles and a positive distance, got {text!r}")
+    lo, hi = DISTANCE_RANGE
+    if dist is not None and not lo <= dist <= hi:
+        raise UsageError(f"--view distance must be within [{lo:g}, {hi:g}] bounding-sphere "
+                         f"radii, got {dist:g}")
     if abs(el) >= 90:
         raise UsageError(f"--view elevation must be strictly between -90 and 90, got {el}")
     return az, el, dist
@@ -50,9 +57,12 @@ def parse_light(text: str) -> tuple[float, float]:
 
 
 def check_fov(fov_deg: float) -> float:
-    """The vertical field of view in degrees, strictly between 0 and 180."""
-    if not 0 < fov_deg < 180:
-        raise UsageError(f"--fov must be strictly between 0 and 180 degrees, got {fov_deg:g}")
+    """The vertical field of view in degrees, within `FOV_RANGE` (a subset of (0, 180) where
+    the projection and the fitted distance stay finite and well conditioned)."""
+    lo, hi = FOV_RANGE
+    if not lo <= fov_deg <= hi:
+        raise UsageError(f"--fov must be within [{lo:g}, {hi:g}] degrees (strictly between 0 "
+                         f"and 180), got {fov_deg:.10g}")
     return fov_deg
 
 
@@ -94,13 +104,33 @@ def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float | Non
     """Orbit the box centre at ``distance`` bounding-sphere radii (None: fit the view),
     near/far hugging the box."""
     b = np.asarray(bounds, dtype=np.float64)
+    if b.shape != (2, 3) or not np.isfinite(b).all() or np.abs(b).max() > MAX_BOUNDS:
+        raise FormatError(f"the input's bounds {_shown(b)} are not finite or exceed "
+                          f"{MAX_BOUNDS:g}: no camera can frame them")
     if distance is None:
         distance = fit_distance(size, fov_deg)
     radius = bounds_radius(b)
     d = distance * radius
-    near = max(d - 1.05 * radius, 0.005 * d)
-    return Camera.orbit(tuple(b.mean(axis=0)), azimuth, elevation, d, fov_deg=fov_deg,
-                        size=size, near=near, far=d + 1.05 * radius)
+    near, far = max(d - 1.05 * radius, 0.005 * d), d + 1.05 * radius
+    centre = b.mean(axis=0)
+    if not (np.isfinite((d, near, far)).all() and 0 < near < far and d > 0
+            and far < MAX_BOUNDS and float(np.float32(near)) < float(np.float32(far))):
+        raise FormatError(f"cannot place a camera {distance:g} radii from a box of radius "
+                          f"{radius:g} (near {near:g}, far {far:g}): use another --view "
+                          "distance or check the input's bounds")
+    camera = Camera.orbit(tuple(centre), azimuth, elevation, d, fov_deg=fov_deg, size=size,
+                          near=near, far=far)
+    with np.errstate(all="ignore"):
+        finite = np.isfinite(camera.view).all() and np.isfinite(camera.proj).all()
+    if not finite:
+        raise FormatError(f"the camera for a box of radius {radius:g} has no finite matrices: "
+                          "check the input's bounds")
+    return camera
+
+
+def _shown(b: np.ndarray) -> str:
+    with np.printoptions(precision=3):
+        return str(b.tolist()) if b.size <= 6 else f"of shape {b.shape}"
 
 
 def turntable(bounds, count: int, elevation: float, distance: float | None, size=DEFAULT_SIZE,

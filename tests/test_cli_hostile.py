@@ -1,0 +1,302 @@
+"""Hostile command lines (issue 8): generated bad values, unwritable outputs, forged inputs.
+
+Each case asserts its outcome class: one ``error:`` line and the documented exit status
+(nothing else on stderr: no numpy warning, no progress), or a correct non-empty output.
+"""
+
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reliefkit import cli
+
+
+def run_cli(*args, cwd=None, **kw):
+    return subprocess.run([sys.executable, "-m", "reliefkit.cli", *map(str, args)],
+                          capture_output=True, text=True, timeout=300, cwd=cwd, **kw)
+
+
+def assert_one_line_error(result, *words, code=None):
+    assert result.returncode != 0, result.stdout
+    assert code is None or result.returncode == code, (result.returncode, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def heights(tmp_path_factory):
+    path = tmp_path_factory.mktemp("hm") / "h.npy"
+    np.save(path, np.random.default_rng(0).random((16, 16)).astype(np.float32))
+    return path
+
+
+@pytest.fixture(scope="module")
+def small_rk(tmp_path_factory, heights):
+    path = tmp_path_factory.mktemp("rk") / "s.rk"
+    out = run_cli("bake", heights, "--as", "relief", "-o", path)
+    assert out.returncode == 0, out.stderr
+    return path
+
+
+# ------------------------------------------------------------------ 1. values, one line
+
+@pytest.mark.parametrize("box", ["nan,1,1", "inf,1,1", "1,-inf,1", "1e-300,1,1",
+                                 "1e300,1e300,1e300", "1e400,1,1", "0,1,1"])
+def test_bad_box_values_are_one_usage_line(gl, heights, tmp_path, box):
+    result = run_cli("bake", heights, "--as", "relief", "--box", box, "-o", tmp_path / "b.rk")
+    assert_one_line_error(result, "--box", code=2)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("view, words", [
+    ("0,0,1e-300", ["--view distance", "0.01"]),
+    ("0,0,1e-6", ["--view distance"]),
+    ("0,0,1e300", ["--view distance"]),
+    ("0,0,nan", ["--view"]),
+    ("0,0,inf", ["--view"]),
+    ("nan,0", ["--view"]),
+    ("0,90", ["elevation"]),
+])
+def test_degenerate_views_are_one_usage_line(view, words, tmp_path):
+    result = run_cli("render", "demo:blob", "--view", view, "--size", "8x8", "-o",
+                     tmp_path / "v.png")
+    assert_one_line_error(result, *words, code=2)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("level", ["nan", "inf", "-inf", "1e400", "-0.5", "1.5", "grey"])
+def test_bad_backgrounds_are_one_usage_line(level, tmp_path):
+    result = run_cli("render", "demo:blob", "--background", level, "-o", tmp_path / "v.png")
+    assert_one_line_error(result, "--background", code=2)
+
+
+@pytest.mark.parametrize("fov", ["0", "180", "-1", "nan", "inf", "1e-300", "179.9999999",
+                                 "1e400"])
+def test_fovs_outside_the_range_are_one_usage_line(fov, tmp_path):
+    result = run_cli("render", "demo:blob", "--fov", fov, "-o", tmp_path / "v.png")
+    assert_one_line_error(result, "--fov", code=2)
+
+
+def test_edge_values_inside_the_ranges_still_render(gl, tmp_path):
+    result = run_cli("render", "demo:blob", "--view", "-30,10,0.5", "--fov", "170",
+                     "--background", "1", "--size", "16x16", "-o", tmp_path / "v.png")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "v.png").stat().st_size > 0
+    assert "warning" not in result.stderr or "0 pixels" in result.stderr
+
+
+@pytest.mark.parametrize("scale", [1e20, 1e300])
+def test_an_rk_framed_by_a_huge_box_is_one_input_line(gl, small_rk, tmp_path, scale):
+    """The camera cannot be built with finite matrices: refused before numpy warns."""
+    from reliefkit.io.rk import load, save
+
+    huge = tmp_path / "huge.rk"
+    save(huge, dataclasses.replace(load(small_rk),
+                                   source_bounds=np.array([[-scale] * 3, [scale] * 3])))
+    result = run_cli("render", huge, "--size", "8x8", "-o", tmp_path / "h.png")
+    assert_one_line_error(result, "bounds", code=1)
+    assert "near=nan" not in result.stderr and "RuntimeWarning" not in result.stderr
+    assert not (tmp_path / "h.png").exists()
+
+
+def test_camera_framing_refuses_non_finite_bounds():
+    from reliefkit.errors import FormatError
+    from reliefkit.scene.views import orbit_bounds
+
+    for bounds in ([[0, 0, 0], [np.inf, 1, 1]], [[0, 0, 0], [np.nan, 1, 1]],
+                   [[-1e300] * 3, [1e300] * 3]):
+        with pytest.raises(FormatError, match="bounds"):
+            orbit_bounds(np.array(bounds), 30, 25)
+    camera = orbit_bounds(np.array([[-1e6] * 3, [1e6] * 3]), 30, 25, 2.0)
+    assert np.isfinite(camera.proj).all() and camera.near < camera.far
+
+
+# ------------------------------------------------------------------ 3. outputs checked first
+
+@pytest.mark.parametrize("flag, name", [("--aovs", "missing/a.npz"), ("--aovs", "adir.npz"),
+                                        ("--stats", "missing/s.json"),
+                                        ("--stats", "adir.json"), ("-o", "missing/x.png"),
+                                        ("-o", "adir.png")])
+def test_a_bad_output_path_is_refused_before_rendering(tmp_path, flag, name):
+    (tmp_path / "adir.npz").mkdir()
+    (tmp_path / "adir.json").mkdir()
+    (tmp_path / "adir.png").mkdir()
+    args = ["render", "demo:blob", "--size", "8x8", "-o", "x.png", flag, name]
+    if flag == "-o":
+        args = ["render", "demo:blob", "--size", "8x8", "-o", name]
+    result = run_cli(*args, cwd=tmp_path)
+    assert_one_line_error(result, flag, name, code=2)
+    assert not (tmp_path / "x.png").exists()  # nothing rendered, nothing written
+    assert "wrote" not in result.stdout
+    assert not [p for p in tmp_path.rglob("*") if p.is_file()]
+
+
+def test_a_read_only_folder_is_refused_before_rendering(tmp_path, monkeypatch, capsys):
+    """Simulated (the tests may run as root, for whom every folder is writable)."""
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode: False if Path(p) == locked
+                        else real_access(p, mode))
+    monkeypatch.setattr("reliefkit.io.inputs.load_input",
+                        lambda spec: pytest.fail("the input was loaded"))
+    status = cli.main(["render", "demo:blob", "-o", str(tmp_path / "x.png"), "--aovs",
+                       str(locked / "a.npz")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "not writable" in err[0], err
+    assert not (tmp_path / "x.png").exists()
+    status = cli.main(["compare", "demo:blob", "--out", str(locked)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "--out" in err[0] and "not writable" in err[0]
+    status = cli.main(["bake", "demo:blob", "-o", str(locked / "b.rk")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "not writable" in err[0]
+
+
+def test_compare_out_that_is_a_file_is_refused_before_the_bake(tmp_path):
+    (tmp_path / "taken").write_text("")
+    result = run_cli("compare", "demo:blob", "--out", "taken", cwd=tmp_path)
+    assert_one_line_error(result, "--out", "taken", "not a folder", code=2)
+    assert "baking" not in result.stderr
+
+
+@pytest.mark.parametrize("command", [["demo"], ["bench", "relief", "--quick"]])
+def test_demo_and_bench_out_that_is_a_file_is_refused_first(tmp_path, command):
+    (tmp_path / "taken").write_text("")
+    result = run_cli(*command, "--out", "taken", cwd=tmp_path)
+    assert_one_line_error(result, "--out", "taken", "not a folder", code=2)
+
+
+def test_a_file_size_limit_names_the_output(tmp_path):
+    resource = pytest.importorskip("resource")
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (16 * 1024, 16 * 1024))
+
+    result = run_cli("render", "demo:blob", "--size", "300x300", "-o", "x.png", cwd=tmp_path,
+                     preexec_fn=limit, env={**os.environ, "MESA_SHADER_CACHE_DISABLE": "true"})
+    assert_one_line_error(result, "x.png", "File too large")
+    assert ".tmp" not in result.stderr and os.listdir(tmp_path) == []
+
+
+# ------------------------------------------------------------------ 4. compare and info agree
+
+def test_compare_refuses_a_heightmap_with_a_clear_line_and_help_says_so(heights, tmp_path):
+    result = run_cli("compare", heights, "--out", tmp_path / "c")
+    assert_one_line_error(result, "not a heightmap", "no mesh to compare", code=2)
+    assert not (tmp_path / "c").exists()
+    helptext = run_cli("compare", "--help").stdout
+    assert "not a heightmap" in " ".join(helptext.split())
+
+
+def test_info_says_ok_only_for_files_render_loads(gl, small_rk, tmp_path):
+    out = run_cli("info", small_rk)
+    assert out.returncode == 0, out.stderr
+    pairs = [line.split() for line in out.stdout.splitlines()]
+    assert ["checksums:", "ok"] in pairs and ["valid:", "ok"] in pairs
+    report = json.loads(run_cli("info", "--json", small_rk).stdout)["file"]
+    assert report["checksums"] == report["valid"] == "ok"
+    # a forged file whose checksums are right but whose representation is invalid
+    from reliefkit.io.rk import _codec_for_object, load, write_rk
+
+    rep = load(small_rk)
+    codec = _codec_for_object(rep)
+    arrays, params = codec.to_arrays(rep)
+    arrays = dict(arrays)
+    arrays["box_to_world"] = (np.diag([1e300] * 3 + [1.0]) @ arrays["box_to_world"]).astype(
+        arrays["box_to_world"].dtype)
+    forged = tmp_path / "forged.rk"
+    write_rk(forged, codec.kind, arrays, params)
+    rendered = run_cli("render", forged, "--size", "8x8", "-o", tmp_path / "f.png")
+    assert_one_line_error(rendered, "forged.rk", code=1)
+    for args in (["info", forged], ["info", "--json", forged]):
+        result = run_cli(*args)
+        assert_one_line_error(result, "forged.rk", code=1)
+        assert "ok" not in result.stdout
+
+
+# ------------------------------------------------------------------ 5. host memory
+
+def test_a_render_over_the_host_memory_cap_is_refused_before_allocating(gl, tmp_path):
+    result = run_cli("render", "demo:blob", "--size", "6000x6000", "-o", tmp_path / "b.png",
+                     "--aovs", tmp_path / "b.npz")
+    assert_one_line_error(result, "host memory", "GiB", code=1)
+    assert not list(tmp_path.iterdir())
+
+
+def test_host_memory_estimate_and_cap(monkeypatch):
+    from reliefkit.errors import GPUError
+    from reliefkit.gl import targets
+
+    assert targets.host_limit() <= targets.MAX_HOST_BYTES
+    assert targets.host_bytes(6000, 6000) > 4 << 30 > targets.host_bytes(4096, 4096)
+    assert targets.host_bytes(64, 64, 1, msaa=4, transparent=True) > \
+        targets.host_bytes(64, 64)
+    targets.check_host_memory(4096, 4096)
+    monkeypatch.setattr(targets, "host_limit", lambda: 1 << 20)
+    with pytest.raises(GPUError, match="host memory"):
+        targets.check_host_memory(512, 512)
+
+
+# ------------------------------------------------------------------ 6. loader warnings
+
+@pytest.fixture
+def warned_mesh(monkeypatch):
+    """``load_input`` returns a mesh that carries two loader warnings."""
+    from reliefkit.scene.assets import make_asset
+
+    mesh = make_asset("blob")
+    mesh.extra["warnings"] = ["model.mtl is missing: the default material is used",
+                              "texture a.png cannot be read\n(truncated): material colour"]
+    monkeypatch.setattr("reliefkit.io.inputs.load_input", lambda spec: mesh)
+    return mesh
+
+
+def _warnings_of(err: str) -> list[str]:
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert all(line.startswith("warning: ") or ": " in line for line in lines), lines
+    return [line for line in lines if line.startswith("warning: ")]
+
+
+@pytest.mark.parametrize("command", ["render", "bake", "info", "compare"])
+def test_loader_warnings_are_one_line_each(gl, warned_mesh, tmp_path, capsys, command):
+    args = {"render": ["render", "model.obj", "--size", "16x16", "-o", str(tmp_path / "x.png")],
+            "bake": ["bake", "model.obj", "--as", "relief", "--depth-res", "16", "-o",
+                     str(tmp_path / "x.rk")],
+            "info": ["info", "model.obj"],
+            "compare": ["compare", "model.obj", "--depth-res", "16", "--size", "16x16",
+                        "--out", str(tmp_path / "c")]}[command]
+    status = cli.main(args)
+    err = capsys.readouterr().err
+    assert status == 0, err
+    assert _warnings_of(err) == [
+        "warning: model.mtl is missing: the default material is used",
+        "warning: texture a.png cannot be read (truncated): material colour"], err
+    assert "error" not in err
+
+
+def test_python_warnings_become_one_warning_line(capsys):
+    """What `main` runs under: a library's warning is one line, numpy's float warnings none."""
+    import warnings
+
+    with np.errstate(all="warn"), cli._one_line_warnings():
+        warnings.warn("a big\ntexture", UserWarning, stacklevel=1)
+        np.array([1e39]).astype(np.float32)  # "overflow encountered in cast": silenced
+        np.float32(3e38) * np.float32(10)
+        np.zeros(1) / np.zeros(1)
+        from PIL import Image
+
+        warnings.warn("Image size (200000000 pixels) exceeds limit of 178956970 pixels, "
+                      "could be decompression bomb DOS attack.", Image.DecompressionBombWarning,
+                      stacklevel=1)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0] == "warning: a big texture" and len(err) == 2, err
+    assert err[1].startswith("warning: Image size (200000000 pixels)"), err
