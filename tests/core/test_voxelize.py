@@ -9,7 +9,7 @@ import trimesh
 
 from reliefkit.bake.voxelize import VoxelGrid, voxelize
 from reliefkit.errors import GPUError, UsageError
-from reliefkit.scene.mesh import RenderMesh, vertex_normals
+from reliefkit.scene.mesh import Material, RenderMesh, vertex_normals
 
 CUBE = np.array([[2.0, 0, 0, -1], [0, 2.0, 0, -1], [0, 0, 2.0, -1], [0, 0, 0, 1]])  # [-1, 1]^3
 UNIT = np.eye(4)
@@ -37,13 +37,14 @@ def faceted_box(extents, center=(0.0, 0.0, 0.0), color=(0.8, 0.6, 0.4, 1.0)):
     return RenderMesh(v, f, n, np.tile(np.asarray(color, np.float32), (len(v), 1)))
 
 
-def quad(corners, color=(1.0, 1.0, 1.0, 1.0), uvs=None, texture=None):
-    """Two triangles over four corners given counter-clockwise."""
+def quad(corners, color=(1.0, 1.0, 1.0, 1.0), uvs=None, texture=None, alpha_mode="OPAQUE"):
+    """Two triangles over four corners given counter-clockwise, one material."""
     p = np.asarray(corners, np.float64)
     f = np.array([[0, 1, 2], [0, 2, 3]])
     n = vertex_normals(p, f)
     c = np.tile(np.asarray(color, np.float32), (4, 1))
-    return RenderMesh(p, f, n, c, uvs=uvs, texture=texture, name="quad")
+    material = Material(texture=texture, alpha_mode=alpha_mode)
+    return RenderMesh(p, f, n, c, uvs=uvs, materials=(material,), name="quad")
 
 
 def plane_quad(axis: int, position: float, pad: float = 0.2):
@@ -303,7 +304,8 @@ def test_two_colours_land_in_their_voxels(gl):
     both = RenderMesh(np.vstack([red.positions, blue.positions]),
                       np.vstack([red.indices, blue.indices + len(red.positions)]),
                       np.vstack([red.normals, blue.normals]),
-                      np.vstack([red.colors, blue.colors]))
+                      np.vstack([red.colors, blue.colors]),
+                      materials=(Material(alpha_mode="BLEND"),))  # vertex alpha counts
     for mode in ("surface", "solid"):
         grid = voxelize(both, CUBE, 32, mode=mode, ctx=gl)
         x = grid.centres()[..., 0]
@@ -337,7 +339,7 @@ def test_transparent_texels_are_holes(gl):
     texture[:, :4, 3] = 100    # left half partly transparent
     corners = [[0, 0, 0.5], [1, 0, 0.5], [1, 1, 0.5], [0, 1, 0.5]]
     uvs = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32)
-    leaf = quad(corners, uvs=uvs, texture=texture)
+    leaf = quad(corners, uvs=uvs, texture=texture, alpha_mode="BLEND")
     grid = voxelize(leaf, UNIT, (16, 16, 8), supersample=1, ctx=gl)
     assert (grid.occupancy[4, :, 1:7] == 1).all()
     assert (grid.occupancy[4, :, 9:15] == 0).all()
@@ -347,7 +349,8 @@ def test_transparent_texels_are_holes(gl):
     # a closed mesh keeps its inside where the texture is transparent
     box = trimesh.creation.box(extents=(0.6, 0.6, 0.6))
     ghost = RenderMesh(box.vertices, box.faces, vertex_normals(box.vertices, box.faces),
-                       np.tile([1, 1, 1, 0.0], (len(box.vertices), 1)))
+                       np.tile([1, 1, 1, 0.0], (len(box.vertices), 1)),
+                       materials=(Material(alpha_mode="BLEND"),))
     solid = voxelize(ghost, CUBE, 16, mode="solid", supersample=1, ctx=gl)
     expected = (np.abs(solid.centres()) < 0.3).all(axis=-1)
     np.testing.assert_array_equal(solid.inside > 0, expected)
@@ -492,3 +495,16 @@ def test_every_material_lands_in_its_voxels(gl):
     back, front = grid.color[4, 8, 8], grid.color[12, 8, 8]  # voxels at z = -0.5 and +0.5
     np.testing.assert_allclose(back, [0, 0, 0.5 * srgb_decode(1.0), 1], atol=1e-3)
     np.testing.assert_allclose(front, [1, 0, 0, 1], atol=1e-3)
+
+
+@pytest.mark.parametrize("mode, expected", [("OPAQUE", 1.0), ("MASK", 0.0), ("BLEND", 0.25)])
+def test_the_materials_alpha_mode_applies(gl, mode, expected):
+    """As in the renderer: OPAQUE ignores alpha, MASK cuts below its cutoff, BLEND keeps it."""
+    corners = [[0, 0, 0.5], [1, 0, 0.5], [1, 1, 0.5], [0, 1, 0.5]]
+    leaf = quad(corners, color=(1, 1, 1, 0.25), alpha_mode=mode)
+    if mode == "MASK":
+        with pytest.raises(UsageError, match="no part of the mesh"):
+            voxelize(leaf, UNIT, (8, 8, 4), supersample=1, ctx=gl)
+        return
+    grid = voxelize(leaf, UNIT, (8, 8, 4), supersample=1, ctx=gl)
+    np.testing.assert_allclose(grid.color[2, 2:6, 2:6, 3], expected, atol=1e-6)

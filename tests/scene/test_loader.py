@@ -558,10 +558,12 @@ def test_obj_relative_indices(tmp_path):
     expect_error(path, "relative")
 
 
-def test_obj_missing_mtl(tmp_path):
+def test_obj_missing_mtl_loads_with_the_default_material_and_one_warning(tmp_path):
     path = write_export(textured_quad(), tmp_path / "q.obj")
     (tmp_path / "material.mtl").unlink()
-    expect_error(path, "references missing file", "material.mtl")
+    mesh = load_mesh(path)
+    assert not mesh.textured and len(mesh.extra["warnings"]) == 1
+    assert "material.mtl" in mesh.extra["warnings"][0]
 
 
 def test_obj_missing_texture(tmp_path):

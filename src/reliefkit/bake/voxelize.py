@@ -344,7 +344,7 @@ class _Sweeps:
         prog = program(ctx, "voxelize.glsl", defines)
         to_slab = np.eye(4)[list(perm) + [3]]  # (u, v, h) -> (x', y', z')
         set_uniforms(prog, {"u_box_to_slab": to_slab, "u_signed": self.signed,
-                            "u_alpha_cutoff": self.alpha_cutoff})
+                            "u_hole_alpha": self.alpha_cutoff})
         vao, _ = self._vao(prog, indices)
         attachments = 4 if winding else 2
         fbo = self._target(nx * s, ny * s, attachments)

@@ -7,7 +7,11 @@ out, so a version 1 file is a valid version 2 file and one reader reads both:
 - ``material`` (F,) uint16 per-triangle material index (absent: every triangle uses 0);
 - ``material_colors`` (M, 4) float32 linear colour factors (absent: one white material);
 - ``texture`` material 0's texture, ``texture_K`` material K's (K < `MAX_TEXTURED`);
-- ``uv_transforms`` (M, 3, 3) float32 (absent: none); param ``materials``: their names.
+- ``uv_transforms`` (M, 3, 3) float32 (absent: none); param ``materials``: their names;
+- param ``alpha_modes``: M of "OPAQUE", "MASK", "BLEND" (absent: every material OPAQUE, the
+  `Material` default, also for files written before alpha modes existed: their texture and
+  factor alpha is then ignored, as glTF's default alphaMode says);
+- ``alpha_cutoffs`` (M,) float32 MASK thresholds in [0, 1] (absent: 0.5 each).
 """
 
 from __future__ import annotations
@@ -15,13 +19,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import FormatError
-from ..scene.mesh import Material, RenderMesh
+from ..scene.mesh import ALPHA_MODES, Material, RenderMesh
 from .rk import ArraySpec, Codec, register
 
 #: Materials 0 .. MAX_TEXTURED - 1 can keep a texture in a .rk file.
 MAX_TEXTURED = 64
 
 _WHITE = np.ones(4, np.float32)
+_CUTOFF = 0.5  # `Material.alpha_cutoff`'s default
 
 
 def texture_array_name(k: int) -> str:
@@ -44,6 +49,10 @@ def _mesh_to_arrays(mesh: RenderMesh) -> tuple[dict[str, np.ndarray], dict]:
              for m in materials])
     if any(m.name for m in materials):
         params["materials"] = [m.name for m in materials]
+    if any(m.alpha_mode != "OPAQUE" for m in materials):
+        params["alpha_modes"] = [m.alpha_mode for m in materials]
+    if any(m.alpha_cutoff != _CUTOFF for m in materials):
+        arrays["alpha_cutoffs"] = np.array([m.alpha_cutoff for m in materials], np.float32)
     for k, m in enumerate(materials):
         if m.texture is None:
             continue
@@ -64,7 +73,18 @@ def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh
     if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
         raise FormatError("mesh param 'materials' must be a list of material names")
     transforms = arrays.get("uv_transforms")
+    modes = params.get("alpha_modes", ["OPAQUE"] * count)
+    if not isinstance(modes, list) or not all(isinstance(m, str) and m in ALPHA_MODES
+                                              for m in modes):
+        raise FormatError(f"mesh param 'alpha_modes' must be a list of {', '.join(ALPHA_MODES)}")
+    cutoffs = arrays.get("alpha_cutoffs")
+    if cutoffs is None:
+        cutoffs = np.full(count, _CUTOFF, np.float32)
+    elif cutoffs.size and (cutoffs.min() < 0 or cutoffs.max() > 1):
+        raise FormatError("mesh array 'alpha_cutoffs' must hold values in [0, 1]")
     for what, n in (("names in param 'materials'", len(names)),
+                    ("modes in param 'alpha_modes'", len(modes)),
+                    ("alpha_cutoffs", len(cutoffs)),
                     ("uv_transforms", count if transforms is None else len(transforms))):
         if n != count:
             raise FormatError(f"mesh has {count} material colours but {n} {what}")
@@ -73,7 +93,8 @@ def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh
         raise FormatError(f"array '{texture_array_name(textured[-1])}' belongs to material "
                           f"{textured[-1]}, but the mesh has {count} materials")
     materials = [Material(names[k], colors[k], arrays.get(texture_array_name(k)),
-                          None if transforms is None else transforms[k]) for k in range(count)]
+                          None if transforms is None else transforms[k], modes[k],
+                          float(cutoffs[k])) for k in range(count)]
     return RenderMesh(arrays["positions"], arrays["indices"], arrays["normals"],
                       arrays["colors"], arrays.get("uvs"), name=name, materials=materials,
                       material=arrays.get("material"))
@@ -99,6 +120,7 @@ register(Codec(
         "material_colors": _rows("float32", 4, finite=True, required=False),
         "uv_transforms": ArraySpec(("float32",), ndim=3, trailing=(3, 3), finite=True,
                                    required=False),
+        "alpha_cutoffs": ArraySpec(("float32",), ndim=1, finite=True, required=False),
         **{texture_array_name(k): _TEXTURE for k in range(MAX_TEXTURED)},
     },
     to_arrays=_mesh_to_arrays,

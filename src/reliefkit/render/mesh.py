@@ -1,7 +1,9 @@
 """Ground truth: rasterize the original mesh into a Frame with every AOV.
 
 The mesh is drawn one material at a time (its triangles are contiguous in the index buffer),
-each with its colour factor and, when it has one, its texture and UV transform.
+each with its colour factor, its alpha mode (OPAQUE: alpha 1; MASK: fragments below the
+cutoff discarded, the rest alpha 1; BLEND: alpha kept as the Frame's coverage) and, when it has
+one, its texture and UV transform.
 """
 
 from __future__ import annotations
@@ -23,6 +25,9 @@ PROGRAM = "core:mesh.glsl"
 MESH_PROGRAMS = tuple(  # the draw-path variants (compiled as GLSL ES by the tests too)
     ProgramVariant(PROGRAM, {"HAS_TEXTURE": textured, "COUNT_ITERATIONS": counted})
     for textured in (False, True) for counted in (False, True))
+
+#: u_alpha_mode of shaders/mesh.glsl for each `Material.alpha_mode`.
+ALPHA_MODE_CODES = {"OPAQUE": 0, "MASK": 1, "BLEND": 2}
 
 _LAYOUT = (("in_position", 3), ("in_normal", 3), ("in_color", 4), ("in_uv", 2))
 
@@ -113,11 +118,14 @@ class MeshDrawable:
 
 
 def material_uniforms(material: Material) -> dict:
-    """u_base_color, u_uv_transform and u_texture (unit 0) of shaders that draw a material."""
+    """u_base_color, u_uv_transform, u_texture (unit 0), u_alpha_mode and u_alpha_cutoff of
+    shaders that draw a material (a program that lacks one ignores it)."""
     uv_transform = np.eye(3) if material.uv_transform is None else material.uv_transform
     return {"u_base_color": tuple(float(c) for c in material.color),
             "u_uv_transform": tuple(float(x) for x in uv_transform.T.ravel()),  # column-major
-            "u_texture": 0}
+            "u_texture": 0,
+            "u_alpha_mode": ALPHA_MODE_CODES[material.alpha_mode],
+            "u_alpha_cutoff": float(material.alpha_cutoff)}
 
 
 def _register() -> None:

@@ -14,6 +14,9 @@ from ..errors import MeshError
 #: Most materials one mesh may have (per-triangle material indices are uint16).
 MAX_MATERIALS = 1 << 16
 
+#: How a material's alpha (vertex colour x factor x texture) is used, as glTF's alphaMode.
+ALPHA_MODES = ("OPAQUE", "MASK", "BLEND")
+
 
 @dataclass(frozen=True, eq=False)
 class Material:
@@ -28,12 +31,19 @@ class Material:
     texture : (h, w, 4) uint8 sRGB-encoded base-colour image, row 0 at v = 0, or None.
     uv_transform : (3, 3) float32 affine map of (u, v, 1) applied before the lookup (glTF's
         KHR_texture_transform, in this mesh's UV convention), or None for the identity.
+    alpha_mode : "OPAQUE" (the default, as in glTF: alpha is ignored and drawn as 1), "MASK"
+        (fragments whose alpha is below `alpha_cutoff` are discarded, the rest drawn with
+        alpha 1) or "BLEND" (alpha kept as coverage/opacity).
+    alpha_cutoff : float in [0, 1], the MASK threshold (glTF's alphaCutoff, default 0.5);
+        kept but unused in the other modes.
     """
 
     name: str = ""
     color: np.ndarray = (1.0, 1.0, 1.0, 1.0)
     texture: np.ndarray | None = None
     uv_transform: np.ndarray | None = None
+    alpha_mode: str = "OPAQUE"
+    alpha_cutoff: float = 0.5
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -55,13 +65,26 @@ class Material:
                 raise MeshError(f"{where}: uv_transform must be a 3x3 affine matrix "
                                 "(last row 0, 0, 1)")
             set_(self, "uv_transform", None if np.array_equal(matrix, np.eye(3)) else matrix)
+        if not isinstance(self.alpha_mode, str) or self.alpha_mode not in ALPHA_MODES:
+            raise MeshError(f"{where}: alpha_mode must be one of {', '.join(ALPHA_MODES)}, "
+                            f"got {self.alpha_mode!r}")
+        try:
+            cutoff = float(self.alpha_cutoff)
+        except (TypeError, ValueError):
+            cutoff = float("nan")
+        if isinstance(self.alpha_cutoff, bool) or not 0.0 <= cutoff <= 1.0:
+            raise MeshError(f"{where}: alpha_cutoff must be a number in [0, 1], "
+                            f"got {self.alpha_cutoff!r}")
+        set_(self, "alpha_cutoff", float(np.float32(cutoff)))  # as stored in .rk files
 
     def __eq__(self, other) -> bool:
         if not isinstance(other, Material):
             return NotImplemented
         return (self.name == other.name and np.array_equal(self.color, other.color)
                 and _same_or_none(self.texture, other.texture)
-                and _same_or_none(self.uv_transform, other.uv_transform))
+                and _same_or_none(self.uv_transform, other.uv_transform)
+                and self.alpha_mode == other.alpha_mode
+                and self.alpha_cutoff == other.alpha_cutoff)
 
     __hash__ = None
 

@@ -1,5 +1,7 @@
 // Ground truth: rasterize a triangle mesh with Phong shading and write every AOV.
-// One draw per material: its colour factor, and with HAS_TEXTURE its texture and UV transform.
+// One draw per material: its colour factor, its alpha mode (u_alpha_mode: 0 OPAQUE, alpha drawn
+// as 1; 1 MASK, fragments with alpha < u_alpha_cutoff discarded, the rest drawn as 1; 2 BLEND,
+// alpha kept), and with HAS_TEXTURE its texture and UV transform.
 //! defines: HAS_TEXTURE
 
 #if defined VERTEX_SHADER
@@ -33,6 +35,8 @@ void main() {
 #include "include/frame_outputs.glsl"
 #include "include/iterations.glsl"
 uniform vec4 u_base_color;  // the material's linear colour factor
+uniform int u_alpha_mode;  // 0 OPAQUE, 1 MASK, 2 BLEND (ALPHA_MODE_CODES in render/mesh.py)
+uniform float u_alpha_cutoff;  // MASK threshold
 #if defined HAS_TEXTURE
 uniform sampler2D u_texture;  // sRGB texture: sampling returns linear colour
 in vec2 v_uv;
@@ -46,6 +50,8 @@ void main() {
 #if defined HAS_TEXTURE
     base *= texture(u_texture, v_uv);
 #endif
+    if (u_alpha_mode == 1 && base.a < u_alpha_cutoff) discard;
+    if (u_alpha_mode != 2) base.a = 1.0;
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;  // two-sided: leaves and open meshes shade from both sides
     write_frame(vec4(shade_phong(base.rgb, n, towards_eye(v_world), 1.0), base.a), v_world, n);

@@ -31,7 +31,9 @@ void main() {
 
 #if defined FRAGMENT_SHADER
 uniform vec2 u_slab;           // keep crossings with u_slab.x <= z' < u_slab.y (half open)
-uniform float u_alpha_cutoff;  // base alpha <= this is a hole (cut-out leaves), not surface
+uniform float u_hole_alpha;    // base alpha <= this is a hole (cut-out leaves), not surface
+uniform int u_alpha_mode;      // the material's: 0 OPAQUE, 1 MASK, 2 BLEND (as mesh.glsl)
+uniform float u_alpha_cutoff;  // the material's MASK threshold
 uniform vec4 u_base_color;     // the material's linear colour factor
 #if defined HAS_TEXTURE
 uniform sampler2D u_texture;   // sRGB texture: sampling returns linear colour
@@ -58,8 +60,10 @@ void main() {
 #if defined HAS_TEXTURE
     base *= texture(u_texture, v_uv);
 #endif
+    if (u_alpha_mode == 1) base.a = base.a < u_alpha_cutoff ? 0.0 : 1.0;
+    else if (u_alpha_mode == 0) base.a = 1.0;
     float len = length(v_normal);
-    if (base.a > u_alpha_cutoff) {
+    if (base.a > u_hole_alpha) {
         f_color = vec4(base.rgb * base.a, base.a);
         f_normal = vec4(len > 0.0 ? v_normal / len : vec3(0.0), 1.0);
     } else {  // a hole in the surface; a closed mesh still counts it for the winding

@@ -2,7 +2,8 @@
 
 Parsing is trimesh's, quietly (:mod:`.parse`); this package adds what a renderer needs on top
 of it: a structural check per format before parsing (:mod:`.obj`, which also triangulates
-concave polygons with :mod:`.polygons`, :mod:`.ply`, :mod:`.stl`, :mod:`.off`, :mod:`.gltf`),
+concave polygons with :mod:`.polygons`, :mod:`.ply`, :mod:`.stl`, :mod:`.off`, :mod:`.gltf`,
+with triangle fans rewritten as lists by :mod:`.fans`),
 the scene flattened with its transforms applied (:mod:`.scene`), linear colours and every
 material with its texture (:mod:`.materials`, :mod:`.texture_transform`, :mod:`.merge`),
 usable normals (:mod:`.normals`), and one `MeshError` naming the file for any bad input.
@@ -10,12 +11,16 @@ usable normals (:mod:`.normals`), and one `MeshError` naming the file for any ba
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
+import warnings
 from pathlib import Path
 
 from ...errors import MeshError
 from ..mesh import RenderMesh
-from .badfile import BadFile
+from .badfile import MAX_FILE_BYTES, BadFile, read_regular, regular_file_size
+from .fans import triangulate_fans
 from .gltf import check_glb, check_gltf
 from .materials import DEFAULT_COLOR  # noqa: F401  (public name, kept importable here)
 from .merge import render_mesh
@@ -23,11 +28,11 @@ from .obj import check_obj
 from .off import check_off
 from .parse import parse_file
 from .ply import check_ply
-from .scene import scene_parts
+from .scene import MAX_COORDINATE, check_visible, scene_parts
 from .stl import check_stl
 from .texture_transform import uv_transforms
 
-__all__ = ["SUPPORTED_EXTENSIONS", "load_mesh"]
+__all__ = ["MAX_COORDINATE", "MAX_FILE_BYTES", "SUPPORTED_EXTENSIONS", "load_mesh"]
 
 #: File name extensions `load_mesh` reads (lower case, with the dot).
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".gltf", ".glb")
@@ -49,7 +54,7 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
 
     Parameters
     ----------
-    path : str or os.PathLike
+    path : str, bytes or os.PathLike
         An .obj, .ply (ASCII or binary), .stl (ASCII or binary), .off, .gltf or .glb file.
         Files it references (.mtl, textures, .bin buffers, images) are looked up next to it.
     name : str, optional
@@ -66,16 +71,61 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
     Raises
     ------
     MeshError
-        The file is missing, unsupported (glTF 1.0, a required glTF extension that cannot be
-        read), unreadable, truncated, empty, has NaN/Inf coordinates or out-of-range face
-        indices, or references a missing file. The message is one line that starts with the
-        path; nothing the parsing libraries log or warn reaches stderr.
+        The file is missing, not a regular file (a FIFO, a device such as a link to
+        /dev/zero, a socket: also for the files it references), larger than
+        `MAX_FILE_BYTES`, unsupported (glTF 1.0, a required glTF extension that cannot be
+        read), unreadable, truncated, empty, has NaN/Inf coordinates, coordinates or
+        scene-graph matrices beyond `MAX_COORDINATE` or not finite, out-of-range face
+        indices, no triangle with a visible area (every face of zero area: collinear or
+        coincident corners, a node scaled to 0, slivers far thinner than float32 can
+        resolve), or references a missing file other than an OBJ's .mtl. The message is one
+        line that starts with the path; nothing the parsing libraries log or warn reaches
+        stderr. Any other failure while parsing bad input (running out of memory, a parser's
+        internal error) is turned into a `MeshError` naming the file as well.
+
+    Notes
+    -----
+    A mesh with some visible triangles keeps its zero-area ones (they draw nothing). Problems
+    that do not stop the mesh from rendering are listed, one line each, in
+    ``extra["warnings"]`` (present only when there are some): an OBJ whose ``mtllib`` file is
+    missing is drawn with the default material.
     """
-    path = Path(path)
+    path = Path(os.fsdecode(path))  # bytes names too (undecodable bytes as surrogates)
     try:
-        return _load(path, name or path.stem)
+        with _silenced():
+            return _load(path, name or path.stem)
     except BadFile as exc:
         raise MeshError(f"{path}: {exc}") from None
+    except MeshError:
+        raise
+    except MemoryError:
+        raise MeshError(
+            f"{path}: ran out of memory while reading it; is it corrupt, or too large for "
+            "this machine?") from None
+    except RecursionError:
+        raise MeshError(f"{path}: is nested too deeply to read; is it corrupt?") from None
+    except Exception as exc:  # noqa: BLE001 - the last resort: bad input is never a crash
+        detail = " ".join(str(exc).split())[:200] or "no details"
+        raise MeshError(
+            f"{path}: could not be read ({type(exc).__name__}: {detail}); is it corrupt?"
+        ) from exc  # the cause kept for a traceback (RELIEFKIT_DEBUG)
+
+
+@contextlib.contextmanager
+def _silenced():
+    """No library warning or trimesh log record reaches stderr while loading (also outside
+    parsing: trimesh computes scene-graph transforms and caches lazily)."""
+    log = logging.getLogger("trimesh")
+    quiet, propagate = logging.NullHandler(), log.propagate
+    log.addHandler(quiet)
+    log.propagate = False
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        log.removeHandler(quiet)
+        log.propagate = propagate
 
 
 def _load(path: Path, label: str) -> RenderMesh:
@@ -84,20 +134,28 @@ def _load(path: Path, label: str) -> RenderMesh:
     if not data:
         raise BadFile("is empty (0 bytes)")
     data = _PRECHECKS[file_type](data)
-    scene = parse_file(data, file_type, path)
+    if file_type in _GLTF_FORMATS:
+        data = triangulate_fans(data, file_type, path.parent)
+    notes: list[str] = []  # the load's warnings (a missing .mtl)
+    scene = parse_file(data, file_type, path, notes)
     transforms = uv_transforms(data, file_type, scene) if file_type in _GLTF_FORMATS else {}
     parts = scene_parts(scene, srgb=file_type not in _GLTF_FORMATS, uv_transforms=transforms)
     if not parts:
         raise BadFile("contains no triangles (only points, lines or nothing); nothing to render")
-    return render_mesh(parts, label, path)
+    check_visible(parts)
+    mesh = render_mesh(parts, label, path)
+    if notes:  # before the ones merging found (textures, see .materials)
+        mesh.extra["warnings"] = notes + list(mesh.extra.get("warnings", []))
+    return mesh
 
 
 def _file_type(path: Path) -> str:
     """Return the trimesh file type of `path` after checking it is a readable kind of file."""
-    if not path.exists():
+    if not os.path.lexists(path):
         raise BadFile("no such file")
-    if path.is_dir():
-        raise BadFile("is a directory, not a mesh file")
+    if not path.exists():
+        raise BadFile("is a broken symbolic link")
+    regular_file_size(path)  # not a directory, FIFO or device, and within the size cap
     suffix = path.suffix.lower()
     if suffix not in SUPPORTED_EXTENSIONS:
         raise BadFile(
@@ -108,7 +166,4 @@ def _file_type(path: Path) -> str:
 
 
 def _read_bytes(path: Path) -> bytes:
-    try:
-        return path.read_bytes()
-    except OSError as exc:
-        raise BadFile(f"cannot read the file ({exc.strerror or exc})") from None
+    return read_regular(path)

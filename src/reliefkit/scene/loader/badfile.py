@@ -10,11 +10,74 @@ it into one `MeshError` that starts with the path.
 
 from __future__ import annotations
 
+import os
+import stat
+
 import numpy as np
+
+#: The largest file (the mesh or one it references) the loader reads, in bytes: 4 GiB.
+#: Anything larger is refused before a byte is read.
+MAX_FILE_BYTES = 4 * 1024**3
 
 
 class BadFile(Exception):
     """Internal: what is wrong with the file; `load_mesh` adds the path."""
+
+
+def regular_file_size(path: str | os.PathLike) -> int:
+    """The size of `path`, checked to be a regular file (symlinks followed) within the cap.
+
+    FIFOs, devices (a link to /dev/zero), sockets and directories raise `BadFile`, so nothing
+    blocks on a pipe or reads an endless device.
+    """
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise BadFile(f"cannot read the file ({exc.strerror or exc})") from None
+    _check_stat(info)
+    return info.st_size
+
+
+def read_regular(path: str | os.PathLike) -> bytes:
+    """The bytes of `path`, a regular file of at most `MAX_FILE_BYTES` (else `BadFile`).
+
+    The file is opened without blocking and checked again on the open descriptor, so a
+    file swapped for a FIFO after the first check cannot block either, and at most the
+    cap plus one byte is ever read.
+    """
+    regular_file_size(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise BadFile(f"cannot read the file ({exc.strerror or exc})") from None
+    try:
+        _check_stat(os.fstat(fd))
+        with os.fdopen(fd, "rb", closefd=False) as stream:
+            data = stream.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise BadFile(f"cannot read the file ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_FILE_BYTES:
+        raise BadFile(_too_large(len(data)))
+    return data
+
+
+def _check_stat(info: os.stat_result) -> None:
+    if stat.S_ISDIR(info.st_mode):
+        raise BadFile("is a directory, not a mesh file")
+    if not stat.S_ISREG(info.st_mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(info.st_mode)
+                else "a device" if stat.S_ISCHR(info.st_mode) or stat.S_ISBLK(info.st_mode)
+                else "a socket" if stat.S_ISSOCK(info.st_mode) else "not a plain file")
+        raise BadFile(f"is not a regular file (it is {kind}); give a file on disk")
+    if info.st_size > MAX_FILE_BYTES:
+        raise BadFile(_too_large(info.st_size))
+
+
+def _too_large(size: int) -> str:
+    return (f"is too large ({size} bytes; the loader reads files of at most "
+            f"{MAX_FILE_BYTES} bytes)")
 
 
 def decode_text(data: bytes, what: str) -> str:

@@ -64,17 +64,20 @@ def json_tree(data: bytes, file_type: str) -> dict:
         tree = json.loads(decode_text(data, "glTF"))
     except json.JSONDecodeError as exc:
         raise BadFile(f"is not valid glTF JSON ({exc})") from None
+    except RecursionError:
+        raise BadFile("is not usable glTF JSON (it is nested too deeply); is it corrupt?") from None
     if not isinstance(tree, dict):
         raise BadFile("is not a glTF file (its JSON is not an object)")
     return tree
 
 
 def _check_tree(tree: dict) -> None:
-    """The version, and the extensions a reader must understand (`extensionsRequired`)."""
+    """The version, the node hierarchy, and the extensions a reader must understand."""
     asset = tree.get("asset")
     version = str(asset.get("version", "")) if isinstance(asset, dict) else ""
     if version.startswith("1"):
         raise BadFile(_GLTF1)
+    _check_nodes(tree.get("nodes"))
     required = tree.get("extensionsRequired", [])
     for name in required if isinstance(required, list) else []:
         if name == _DRACO and not _draco_decoder_installed():
@@ -84,6 +87,39 @@ def _check_tree(tree: dict) -> None:
             )
         if name not in _READABLE and not str(name).startswith(_HARMLESS_PREFIX):
             raise BadFile(f"requires the glTF extension {name}, which is not supported")
+
+
+def _check_nodes(nodes) -> None:
+    """Node children must be node indices, and the hierarchy must be a forest (no cycles)."""
+    if not isinstance(nodes, list):
+        return
+    children = []
+    for k, node in enumerate(nodes):
+        kids = node.get("children", []) if isinstance(node, dict) else []
+        if not isinstance(kids, list) or not all(
+                isinstance(c, int) and not isinstance(c, bool) and 0 <= c < len(nodes)
+                for c in kids):
+            raise BadFile(f"glTF node {k} has children that are not node indices; is it corrupt?")
+        children.append(kids)
+    state = [0] * len(nodes)  # 0 unseen, 1 on the current path, 2 done
+    for root in range(len(nodes)):
+        if state[root]:
+            continue
+        stack = [(root, iter(children[root]))]
+        state[root] = 1
+        while stack:
+            node, kids = stack[-1]
+            child = next(kids, None)
+            if child is None:
+                state[node] = 2
+                stack.pop()
+            elif state[child] == 1:
+                raise BadFile(
+                    f"its glTF node hierarchy has a cycle (node {node} has ancestor {child} as "
+                    "a child); is it corrupt?")
+            elif state[child] == 0:
+                state[child] = 1
+                stack.append((child, iter(children[child])))
 
 
 def _draco_decoder_installed() -> bool:

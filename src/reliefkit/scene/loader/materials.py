@@ -1,17 +1,33 @@
 """Colours and materials of trimesh visuals: linear RGBA, `Material`s with sRGB textures.
 
 sRGB-encoded 8-bit colours are decoded; glTF colours are linear by specification and kept.
+
+Alpha follows each format's rules. glTF: ``alphaMode`` (default OPAQUE: alpha ignored; MASK
+with ``alphaCutoff``, default 0.5; BLEND) becomes `Material.alpha_mode` / `alpha_cutoff`.
+OBJ/MTL: alpha comes only from ``d`` (or ``Tr`` = 1 - d, when there is no ``d``) and
+``map_d``; a material with d = 1 and no map_d is OPAQUE (an RGBA ``map_Kd``'s alpha channel
+is unused), otherwise BLEND with the factor's alpha d, and the texture's alpha channel is
+kept only when ``map_d`` names the ``map_Kd`` image (a separate map_d image is not read: one
+warning). Formats without materials (PLY, OFF, STL vertex or face colours) are OPAQUE.
+
+A texture image that cannot be decoded (corrupt or truncated data, or more pixels than
+`max_texture_pixels()`) is not an error: the material keeps its colour factor without the
+texture and `SurfaceReader.warnings` gets one line for it, which the merged mesh carries in
+``extra["warnings"]``. No PIL warning reaches stderr.
 """
 
 from __future__ import annotations
 
+import contextvars
+import warnings
 from dataclasses import replace
 
 import numpy as np
 import trimesh
+from PIL import Image
 
 from ...colorspace import srgb_decode
-from ..mesh import Material
+from ..mesh import ALPHA_MODES, Material
 from .badfile import BadFile
 
 #: Linear base colour of a surface whose file gives none.
@@ -50,6 +66,8 @@ class SurfaceReader:
 
     def __init__(self, srgb: bool):
         self.srgb = srgb
+        #: one human-readable line per problem worked around (see the module docstring)
+        self.warnings: list[str] = _start_reader_warnings()
         # keyed by id(); each entry keeps its trimesh object alive so the id stays its own
         self._materials: dict[int, tuple[object, Material]] = {}
         self._images: dict[int, tuple[object, np.ndarray]] = {}
@@ -87,25 +105,140 @@ class SurfaceReader:
         if isinstance(material, trimesh.visual.material.PBRMaterial):
             factor = material.baseColorFactor  # linear by the glTF specification
             factor = np.ones(4) if factor is None else np.asarray(factor) / 255.0
-            return Material(name, factor, self._texture(material.baseColorTexture))
+            mode, cutoff = _gltf_alpha(material)
+            return Material(name, factor, self._texture(material.baseColorTexture, name),
+                            alpha_mode=mode, alpha_cutoff=cutoff)
         if isinstance(material, trimesh.visual.material.SimpleMaterial):
             image = None if _is_placeholder(material.image) else material.image
             kd = material.kwargs.get("kd")  # present only when the .mtl file gave Kd
+            texture = self._texture(image, name)
             if kd is None:
-                return Material(name, DEFAULT_COLOR if image is None else (1.0, 1.0, 1.0, 1.0),
-                                self._texture(image))
-            kd = np.atleast_1d(np.asarray(kd, dtype=np.float64))
-            rgb = kd[:3] if kd.size >= 3 else np.full(3, kd[0])
-            return Material(name, np.append(srgb_decode(rgb), 1.0), self._texture(image))
+                color = np.array(DEFAULT_COLOR if texture is None else (1.0, 1.0, 1.0, 1.0))
+            else:
+                kd = np.atleast_1d(np.asarray(kd, dtype=np.float64))
+                rgb = kd[:3] if kd.size >= 3 else np.full(3, kd[0])
+                color = np.append(srgb_decode(rgb), 1.0)
+            dissolve, texture_alpha = self._mtl_alpha(material, name, image)
+            color[3] = dissolve
+            blend = dissolve < 1.0 or (texture_alpha and texture is not None)
+            if blend and texture is not None and not texture_alpha \
+                    and not (texture[..., 3] == 255).all():
+                texture = texture.copy()  # alpha is d alone: the image's alpha is unused
+                texture[..., 3] = 255
+            return Material(name, color, texture, alpha_mode="BLEND" if blend else "OPAQUE")
         return Material(name, DEFAULT_COLOR)
 
-    def _texture(self, image) -> np.ndarray | None:
+    def _mtl_alpha(self, material, name: str, image) -> tuple[float, bool]:
+        """MTL ``d`` (else 1 - ``Tr``) in [0, 1], and whether ``map_d`` uses the texture alpha."""
+        kwargs = material.kwargs
+        dissolve = _mtl_number(kwargs.get("d"))
+        if dissolve is None:
+            transparency = _mtl_number(kwargs.get("tr"))
+            dissolve = 1.0 if transparency is None else 1.0 - transparency
+        map_d = kwargs.get("map_d")
+        texture_alpha = False
+        if map_d:
+            file_name = " ".join(str(x) for x in map_d) if isinstance(map_d, list) else str(map_d)
+            own = None if image is None else image.info.get("file_path")
+            texture_alpha = own is not None and _same_file_name(file_name, own)
+            if not texture_alpha:
+                self.warnings.append(f"material '{name}': its map_d image '{file_name}' is not "
+                                     "read (only a map_d naming the map_Kd image is); its "
+                                     "alpha comes from d")
+        return float(np.clip(dissolve, 0.0, 1.0)), texture_alpha
+
+    def _texture(self, image, name: str) -> np.ndarray | None:
+        """The image as an RGBA array, or None (and one warning) when it cannot be decoded."""
         if image is None:
             return None
         kept = self._images.get(id(image))
         if kept is None:
-            kept = self._images[id(image)] = (image, _texture_array(image))
+            array, problem = _texture_array(image)
+            if problem:
+                file_name = image.info.get("file_path") if hasattr(image, "info") else None
+                what = f"'{file_name}'" if file_name else "image"
+                self.warnings.append(f"material '{name}': its texture {what} {problem}; "
+                                     "drawn with the material colour instead")
+            kept = self._images[id(image)] = (image, array)
         return kept[1]
+
+
+def max_texture_pixels() -> int | None:
+    """Most pixels a texture may have: PIL's decompression-bomb limit, read at each use (so a
+    caller that changes `PIL.Image.MAX_IMAGE_PIXELS` is honoured; None: no limit)."""
+    return Image.MAX_IMAGE_PIXELS
+
+
+# The warnings of the load in progress, in the list of its `SurfaceReader` (`merge.render_mesh`
+# takes them), and the notes made while parsing, before that reader exists.
+_WARNINGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar(
+    "reliefkit_loader_warnings", default=None)
+_PENDING: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar(
+    "reliefkit_loader_pending_warnings", default=None)
+
+
+def begin_warnings() -> None:
+    """Start a new load: forget the warnings a load that failed may have left."""
+    _WARNINGS.set(None)
+    _PENDING.set(None)
+
+
+def note_texture_problem(name: str, problem: str) -> None:
+    """Record that texture `name` could not be used (`problem`, e.g. "could not be opened").
+
+    For the parsing step, which sees images that trimesh drops without a trace; the next
+    `SurfaceReader` (the same load's, when `begin_warnings` started it) takes the note.
+    """
+    pending = _PENDING.get()
+    if pending is None:
+        pending = []
+        _PENDING.set(pending)
+    pending.append(f"texture '{name}' {problem}; drawn with the material colour instead")
+
+
+def take_warnings() -> list[str]:
+    """The current load's warnings (each once), and forget them."""
+    collected = _WARNINGS.get() or []
+    _WARNINGS.set(None)
+    return list(dict.fromkeys(collected))
+
+
+def _start_reader_warnings() -> list[str]:
+    """The list of a new reader: the notes made while parsing, then its own."""
+    fresh = list(_PENDING.get() or [])
+    _PENDING.set(None)
+    _WARNINGS.set(fresh)
+    return fresh
+
+
+def _gltf_alpha(material) -> tuple[str, float]:
+    """glTF's alphaMode (OPAQUE when absent or unknown) and alphaCutoff (0.5 when absent)."""
+    mode = getattr(material, "alphaMode", None)
+    mode = mode.upper() if isinstance(mode, str) else "OPAQUE"
+    cutoff = getattr(material, "alphaCutoff", None)
+    try:
+        cutoff = float(cutoff)
+    except (TypeError, ValueError):
+        cutoff = 0.5
+    if not 0.0 <= cutoff <= 1.0:  # also NaN
+        cutoff = 0.5
+    return (mode if mode in ALPHA_MODES else "OPAQUE"), cutoff
+
+
+def _mtl_number(value) -> float | None:
+    """The first number of an MTL statement's values (trimesh keeps them as strings)."""
+    if isinstance(value, (list, tuple)):
+        value = value[0] if value else None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if np.isfinite(number) else None
+
+
+def _same_file_name(a: str, b: str) -> bool:
+    a, b = (str(x).replace("\\", "/").strip().lower() for x in (a, b))
+    return a == b or a.rsplit("/", 1)[-1] == b.rsplit("/", 1)[-1]
 
 
 def _is_placeholder(image) -> bool:
@@ -117,10 +250,24 @@ def _is_placeholder(image) -> bool:
                                                              np.asarray(placeholder))
 
 
-def _texture_array(image) -> np.ndarray:
-    """A PIL image as (h, w, 4) uint8 RGBA with row 0 at v = 0 (PIL's row 0 is the top)."""
+def _texture_array(image) -> tuple[np.ndarray | None, str | None]:
+    """A PIL image as (h, w, 4) uint8 RGBA with row 0 at v = 0 (PIL's row 0 is the top), or
+    None and why not."""
+    limit = max_texture_pixels()
     try:
-        rgba = np.asarray(image.convert("RGBA"), dtype=np.uint8)
+        width, height = image.size
+    except Exception:  # noqa: BLE001 - not an image at all
+        return None, "is not an image"
+    if limit is not None and width * height > limit:
+        return None, (f"is {width}x{height}, more than {limit} pixels; scale it down to "
+                      "use it")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # PIL warns as well as failing; say it once
+            rgba = np.asarray(image.convert("RGBA"), dtype=np.uint8)
     except Exception as exc:  # noqa: BLE001 - PIL decodes lazily, so errors surface here
-        raise BadFile(f"its texture image could not be decoded ({exc})") from None
-    return np.ascontiguousarray(rgba[::-1])
+        detail = " ".join(str(exc).split())[:120] or type(exc).__name__
+        return None, f"could not be decoded ({detail}); is it corrupt or truncated?"
+    if rgba.ndim != 3 or rgba.shape[2] != 4 or rgba.size == 0:
+        return None, "is empty"
+    return np.ascontiguousarray(rgba[::-1]), None

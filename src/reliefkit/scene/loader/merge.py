@@ -1,4 +1,8 @@
-"""Merging the placed parts into one `RenderMesh`, each distinct material kept once."""
+"""Merging the placed parts into one `RenderMesh`, each distinct material kept once.
+
+The warnings of the load (textures that could not be read, see :mod:`.materials`) go to the
+mesh's ``extra["warnings"]``: one human-readable line each, present only when there are some.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +13,7 @@ import numpy as np
 from ...errors import MeshError
 from ..mesh import Material, RenderMesh
 from .badfile import BadFile
+from .materials import take_warnings
 from .normals import usable_normals
 from .scene import Part
 
@@ -26,9 +31,13 @@ def render_mesh(parts: list[Part], label: str, path: Path) -> RenderMesh:
                               for p in parts])
     normals = usable_normals(np.concatenate([p.normals for p in parts]), positions, faces)
     colors = np.clip(np.concatenate([p.colors for p in parts]), 0.0, 1.0)
+    extra: dict = {"source": str(path)}
+    found = take_warnings()
+    if found:
+        extra["warnings"] = found
     try:
         return RenderMesh(positions, faces, normals, colors, uvs, name=label,
-                          extra={"source": str(path)}, materials=materials, material=material)
+                          extra=extra, materials=materials, material=material)
     except MeshError as exc:  # the final guard; name the file like every other message
         raise BadFile(str(exc).removeprefix(f"{label}: ")) from None
 

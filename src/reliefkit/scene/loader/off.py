@@ -28,7 +28,11 @@ def check_off(data: bytes) -> bytes:
             f"truncated: its header declares {n_vertices} vertices and {n_faces} faces, "
             f"the file has {len(vertex_lines)} and {len(face_lines)}"
         )
-    check_range(_off_face_indices(face_lines), n_vertices)
+    try:
+        indices = _off_face_indices(face_lines)
+    except OverflowError:
+        raise BadFile("has a face index too large to be real; is it corrupt?") from None
+    check_range(indices, n_vertices)
     return data
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import io
 import logging
+import os
 import urllib.parse
 import warnings
 from pathlib import Path, PurePosixPath
@@ -13,7 +14,7 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 import trimesh
 
-from .badfile import BadFile, as_utf8
+from .badfile import BadFile, as_utf8, read_regular
 
 
 class _RecordingResolver(trimesh.resolvers.FilePathResolver):
@@ -23,20 +24,43 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
     afterwards. Names are looked up as other importers do: also URL-decoded (glTF URIs escape
     spaces as %20), with `\\` as a separator (files written on Windows), and at last with
     any case, in the named subfolder or the mesh's own folder. Names that lead out of the
-    folder are refused. .mtl files are handed over as UTF-8 like the OBJ itself.
+    folder are refused. .mtl files are handed over as UTF-8 like the OBJ itself. Only regular
+    files within the size cap are read (`read_regular`): a FIFO, a device or a socket is
+    refused and remembered, never opened for blocking reads.
     """
 
     def __init__(self, source: Path):
         super().__init__(str(source))
+        # trimesh names geometry after the file and hashes those names as UTF-8: a file name
+        # that is not valid UTF-8 (surrogate escapes) gets replacement characters there
+        safe = os.fsencode(str(source)).decode("utf-8", "replace")
+        self.file_path, self.file_name = safe, os.path.basename(safe)
         self.missing: list[str] = []
         self.outside: list[str] = []
+        self.refused: list[tuple[str, str]] = []
+
+    def _read(self, candidate: str) -> bytes:
+        """A name as trimesh's resolver looks it up, read only if it is a regular file."""
+        stripped = candidate.strip()
+        for option in (stripped, stripped.lstrip("/"), os.path.split(candidate)[-1]):
+            try:
+                path = Path(self.absolute(option))
+            except ValueError:
+                continue
+            if os.path.lexists(path):
+                return read_regular(path)
+        self.absolute(candidate)  # raises ValueError for a name that leads out of the folder
+        raise FileNotFoundError(candidate)
 
     def get(self, name: str) -> bytes:
         unquoted = urllib.parse.unquote(name)
         spellings = (name, unquoted, name.replace("\\", "/"), unquoted.replace("\\", "/"))
         for candidate in dict.fromkeys(spellings):
             try:
-                data = super().get(candidate)
+                data = self._read(candidate)
+            except BadFile as exc:
+                self.refused.append((name, str(exc)))
+                raise FileNotFoundError(name) from None
             except FileNotFoundError:
                 continue
             except ValueError:  # the name leads out of the mesh's folder
@@ -47,22 +71,40 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         if found is None:
             self.missing.append(name)
             raise FileNotFoundError(name)
-        return self._decoded(name, found.read_bytes())
+        try:
+            data = read_regular(found)
+        except BadFile as exc:
+            self.refused.append((name, str(exc)))
+            raise FileNotFoundError(name) from None
+        return self._decoded(name, data)
 
     @staticmethod
     def _decoded(name: str, data: bytes) -> bytes:
         return as_utf8(data, "MTL") if name.lower().endswith(".mtl") else data
 
     def problem(self) -> str | None:
-        """A message for the first unusable reference, or None."""
-        if self.missing:
-            return f"references missing file '{self.missing[0]}' (looked in {self.parent})"
+        """A message for the first unusable reference, or None (a missing .mtl is a warning)."""
+        if self.refused:
+            name, reason = self.refused[0]
+            return f"references '{name}', which {reason.removeprefix('is ')}"
+        missing = [m for m in self.missing if not _is_mtl(m)]
+        if missing:
+            return f"references missing file '{missing[0]}' (looked in {self.parent})"
         if self.outside:
             return (
                 f"references '{self.outside[0]}' outside its folder, which is not read; "
                 "copy it next to the mesh"
             )
         return None
+
+    def warnings(self) -> list[str]:
+        """One line per missing .mtl file (the mesh renders with the default material)."""
+        return [f"material library '{m}' not found (looked in {self.parent}); using the "
+                "default material" for m in dict.fromkeys(self.missing) if _is_mtl(m)]
+
+
+def _is_mtl(name: str) -> bool:
+    return name.strip().lower().endswith(".mtl")
 
 
 def _any_case(folder: Path, name: PurePosixPath) -> Path | None:
@@ -93,19 +135,31 @@ def _child_any_case(folder: Path, name: str) -> Path | None:
     return min((p for p in folder.iterdir() if p.name.lower() == name.lower()), default=None)
 
 
-def parse_file(data: bytes, file_type: str, path: Path) -> trimesh.Scene:
-    """Parse with trimesh quietly; what it raises, or logs as lost, becomes `BadFile`."""
+def parse_file(data: bytes, file_type: str, path: Path,
+               warnings_out: list[str] | None = None) -> trimesh.Scene:
+    """Parse with trimesh quietly; what it raises, or logs as lost, becomes `BadFile`.
+
+    Problems that still leave a usable mesh (a missing .mtl) are appended to `warnings_out`.
+    """
     resolver = _RecordingResolver(path)
     try:
         with _quiet() as logged:
             scene = trimesh.load_scene(
                 io.BytesIO(data), file_type=file_type, resolver=resolver, process=False
             )
+    except MemoryError:
+        raise BadFile(resolver.problem() or "ran out of memory while parsing it; is it corrupt, "
+                      "or too large for this machine?") from None
+    except RecursionError:
+        raise BadFile(resolver.problem() or "is nested too deeply to parse (its scene graph or "
+                      "structure recurses without end); is it corrupt?") from None
     except Exception as exc:  # noqa: BLE001 - any parser failure is a bad file
         raise BadFile(resolver.problem() or _parse_failure(file_type, exc)) from None
     problem = resolver.problem() or _data_lost(logged)
     if problem:
         raise BadFile(problem)
+    if warnings_out is not None:
+        warnings_out.extend(resolver.warnings())
     return scene if isinstance(scene, trimesh.Scene) else trimesh.Scene(scene)
 
 

@@ -1,7 +1,8 @@
 """Flattening a trimesh scene into `Part`s: every instance of every triangle geometry, placed.
 
 Scene-graph transforms are applied in the file's own world coordinates (never rescaled or
-recentred).
+recentred). Coordinates are checked against `MAX_COORDINATE` in float64, before anything
+casts them to float32 (where 3e38 and more overflow).
 """
 
 from __future__ import annotations
@@ -15,6 +16,16 @@ from ..mesh import Material
 from .badfile import BadFile, check_range
 from .materials import SurfaceReader, decode_colors, is_face_colored
 from .normals import file_normals
+
+#: The largest coordinate magnitude the loader accepts, in the file's units, before and after
+#: the scene-graph transforms. Far beyond any real mesh, yet small enough that the squared
+#: distances the renderer computes in float32 (limit 3.4e38) never overflow.
+MAX_COORDINATE = 1e18
+
+# A triangle is visible when its doubled area exceeds (_VISIBLE * extent)**2, the extent being
+# the diagonal of the whole mesh's bounds: thinner than float32 resolves at that scale, it
+# draws nothing.
+_VISIBLE = 2.0**-23
 
 
 @dataclass(frozen=True)
@@ -41,7 +52,8 @@ def scene_parts(scene: trimesh.Scene, srgb: bool,
     several = len(scene.geometry) > 1
     surfaces = SurfaceReader(srgb)
     for node in scene.graph.nodes_geometry:
-        matrix, geometry_name = scene.graph[node]
+        with np.errstate(all="ignore"):  # trimesh multiplies the matrices lazily, here
+            matrix, geometry_name = scene.graph[node]
         if geometry_name not in local:
             geometry = scene.geometry[geometry_name]
             where = f" in mesh '{geometry_name}'" if several else ""
@@ -66,6 +78,7 @@ def _local_part(geometry, surfaces: SurfaceReader, where: str) -> Part | None:
     bad = int((~np.isfinite(positions)).any(axis=1).sum())
     if bad:
         raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates{where}")
+    _check_magnitude(positions, where)
     surface = surfaces.surface(geometry.visual, len(positions))
     part = Part(positions, faces, file_normals(geometry), *surface)
     if is_face_colored(geometry.visual):
@@ -73,6 +86,41 @@ def _local_part(geometry, surfaces: SurfaceReader, where: str) -> Part | None:
         corner_colors = np.repeat(face_colors, 3, axis=0)
         part = replace(_unshared(part), colors=corner_colors)
     return part
+
+
+def _check_magnitude(positions: np.ndarray, where: str) -> None:
+    """Refuse coordinates beyond `MAX_COORDINATE` (finite ones; NaN/Inf are refused before)."""
+    if positions.size == 0:
+        return
+    big = float(np.abs(positions).max())
+    if big > MAX_COORDINATE:
+        count = int((np.abs(positions) > MAX_COORDINATE).any(axis=1).sum())
+        raise BadFile(
+            f"{_vertices_have(count)} coordinates beyond {MAX_COORDINATE:g} "
+            f"(largest {big:.3g}){where}, more than reliefkit can render; is it corrupt, or "
+            "in the wrong units?")
+
+
+def check_visible(parts: list[Part]) -> None:
+    """Refuse a mesh none of whose triangles has a visible area.
+
+    Zero-area faces (collinear or coincident corners, a node scaled to 0) and slivers thinner
+    than float32 can resolve at the mesh's size draw nothing; a mesh made only of those
+    would render an empty picture. Meshes with at least one visible triangle are kept as
+    they are, zero-area faces included.
+    """
+    with np.errstate(all="ignore"):
+        low = np.min([p.positions.min(axis=0) for p in parts], axis=0)
+        high = np.max([p.positions.max(axis=0) for p in parts], axis=0)
+        threshold = (_VISIBLE * float(np.linalg.norm(high - low))) ** 2
+        for part in parts:
+            a, b, c = (part.positions[part.faces[:, k]] for k in range(3))
+            doubled = np.linalg.norm(np.cross(b - a, c - a), axis=1)
+            if (doubled > threshold).any():
+                return
+    raise BadFile(
+        "has no triangle with a visible area (every face has zero area: collinear or "
+        "coincident corners, or a scale of 0); nothing visible would be drawn")
 
 
 def _vertices_have(count: int) -> str:
@@ -96,6 +144,8 @@ def _placed(part: Part, matrix: np.ndarray) -> Part:
     """`part` moved by a 4x4 scene-graph matrix; a mirroring matrix reverses the winding."""
     if np.array_equal(matrix, np.eye(4)):
         return part
+    if not np.isfinite(matrix).all():
+        raise BadFile("has a scene-graph transform with NaN or Inf values")
     linear = matrix[:3, :3]
     det = np.linalg.det(linear)
     with np.errstate(all="ignore"):
@@ -104,6 +154,7 @@ def _placed(part: Part, matrix: np.ndarray) -> Part:
     bad = int((~np.isfinite(positions)).any(axis=1).sum())
     if bad:
         raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates after the scene transforms")
+    _check_magnitude(positions, " after the scene transforms")
     faces = part.faces[:, ::-1] if det < 0 else part.faces
     return replace(part, positions=positions, faces=np.ascontiguousarray(faces), normals=normals)
 
