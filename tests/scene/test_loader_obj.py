@@ -153,3 +153,24 @@ def test_convex_faces_and_relative_indices_stay_as_trimesh_splits_them(tmp_path)
     expected = trimesh.load_mesh(path, process=False)
     mesh_out = load_mesh(path)
     np.testing.assert_array_equal(mesh_out.indices, expected.faces)
+
+
+@pytest.mark.parametrize("faces, what", [("f 1/1/1 2/2/2 3/3/3", "texture coordinates"),
+                                         ("f 1//1 2//2 3//3", "normals")])
+def test_references_to_undefined_uvs_or_normals_are_dropped_with_a_warning(tmp_path, faces,
+                                                                           what):
+    """Such files exist (exporters that write v/vt/vn without the vt or vn records); common
+    importers read them, so the triangle is kept and the references ignored."""
+    path = tmp_path / "t.obj"
+    normals = "vn 0 0 1\n" * 3 if what == "texture coordinates" else ""
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n" + normals + faces + "\n")
+    mesh = load_mesh(path)
+    assert mesh.triangle_count == 1
+    assert len(mesh.extra["warnings"]) == 1 and what in mesh.extra["warnings"][0]
+
+
+def test_backslash_continues_a_line(tmp_path):
+    path = tmp_path / "c.obj"
+    path.write_bytes(b"v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nf 1 2 \\\r\n 3 4\r\n")
+    mesh = load_mesh(path)
+    assert mesh.triangle_count == 2 and "warnings" not in mesh.extra

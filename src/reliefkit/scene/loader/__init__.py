@@ -133,10 +133,10 @@ def _load(path: Path, label: str) -> RenderMesh:
     data = _read_bytes(path)
     if not data:
         raise BadFile("is empty (0 bytes)")
-    data = _PRECHECKS[file_type](data)
+    notes: list[str] = []  # the load's warnings (a missing .mtl, dropped references)
+    data = check_obj(data, notes) if file_type == "obj" else _PRECHECKS[file_type](data)
     if file_type in _GLTF_FORMATS:
         data = triangulate_fans(data, file_type, path.parent)
-    notes: list[str] = []  # the load's warnings (a missing .mtl)
     scene = parse_file(data, file_type, path, notes)
     transforms = uv_transforms(data, file_type, scene) if file_type in _GLTF_FORMATS else {}
     parts = scene_parts(scene, srgb=file_type not in _GLTF_FORMATS, uv_transforms=transforms)

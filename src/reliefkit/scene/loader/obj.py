@@ -1,8 +1,11 @@
 """OBJ text before trimesh parses it: face corners checked, concave polygons triangulated.
 
-Every face corner is checked against the v/vt/vn it refers to. trimesh splits polygons into
-fans (quads along the diagonal from their first corner), which is wrong for concave ones, so
-those faces are rewritten as the triangles of an ear clipping, corners kept verbatim.
+Lines continued with a trailing backslash are joined. Every face corner is checked against
+the v/vt/vn it refers to; references to texture coordinates or normals that the file does not
+define at all are dropped with a warning (as common importers read such files). trimesh
+splits polygons into fans (quads along the diagonal from their first corner), which is wrong
+for concave ones, so those faces are rewritten as the triangles of an ear clipping, corners
+kept verbatim.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import numpy as np
 from .badfile import BadFile, decode_text
 from .polygons import triangulate_polygon
 
+_CONTINUATION = re.compile(r"\\[ \t]*\r?\n")  # a backslash ending a line continues it
 # OBJ records that define or use indices: (keyword, rest of the line without its comment)
 _OBJ_RECORD = re.compile(r"(?m)^[ \t]*(vt|vn|v|f)[ \t]+([^\n#]*)")
 
@@ -25,14 +29,23 @@ _OBJ_SLOTS = {
 }
 
 
-def check_obj(data: bytes) -> bytes:
-    """Check every face corner of an OBJ against the v/vt/vn it defines."""
-    text = decode_text(data, "OBJ").replace("\\\n", "")
+def check_obj(data: bytes, notes: list[str] | None = None) -> bytes:
+    """Check every face corner of an OBJ against the v/vt/vn it defines; warnings (dropped
+    references) are appended to ``notes``."""
+    text = _CONTINUATION.sub(" ", decode_text(data, "OBJ"))
     matches = list(_OBJ_RECORD.finditer(text))
     records = [m.groups() for m in matches]
     kinds = [kind for kind, _ in records]
     totals = {slot: kinds.count(slot) for slot in _OBJ_SLOTS}
     fields = _obj_face_fields(" ".join(rest for kind, rest in records if kind == "f"))
+    undefined = [slot for slot in ("vt", "vn") if fields.get(slot) and not totals[slot]]
+    if undefined:
+        text = _without_slots(text, matches, undefined)
+        for slot in undefined:
+            if notes is not None:
+                notes.append(f"its faces refer to {_OBJ_SLOTS[slot][1]}, but it defines none; "
+                             "those references are ignored")
+        return check_obj(text.encode("utf-8"), notes)
     for slot, values in fields.items():
         indices = _integers(values)
         if (indices < 0).any():  # relative indices depend on what precedes each face
@@ -42,6 +55,25 @@ def check_obj(data: bytes) -> bytes:
         if bad.size:
             _check_obj_index(str(bad[0]), slot, totals[slot], totals[slot])
     return _triangulated(text, matches, totals["v"]).encode("utf-8")
+
+
+def _without_slots(text: str, matches: list[re.Match], slots: list[str]) -> str:
+    """`text` with the vt and/or vn fields of every face corner removed."""
+    drop = [list(_OBJ_SLOTS).index(slot) for slot in slots]
+    pieces, end = [], 0
+    for match in matches:
+        if match.group(1) != "f":
+            continue
+        corners = []
+        for corner in match.group(2).split():
+            fields = corner.split("/") + [""] * 2
+            for k in drop:
+                fields[k] = ""
+            v, vt, vn = fields[:3]
+            corners.append(v + (f"/{vt}/{vn}" if vn else f"/{vt}" if vt else ""))
+        pieces += [text[end:match.start(2)], " ".join(corners)]
+        end = match.end(2)
+    return "".join(pieces) + text[end:]
 
 
 def _obj_face_fields(faces: str) -> dict[str, list[str]]:
