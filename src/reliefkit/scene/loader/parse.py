@@ -15,6 +15,7 @@ import numpy as np
 import trimesh
 
 from .badfile import BadFile, as_utf8, read_regular
+from .materials import begin_warnings, note_texture_problem
 
 
 class _RecordingResolver(trimesh.resolvers.FilePathResolver):
@@ -38,6 +39,7 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         self.missing: list[str] = []
         self.outside: list[str] = []
         self.refused: list[tuple[str, str]] = []
+        self.last_name: str | None = None  # the file asked for last (an image that may fail)
 
     def _read(self, candidate: str) -> bytes:
         """A name as trimesh's resolver looks it up, read only if it is a regular file."""
@@ -53,6 +55,7 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         raise FileNotFoundError(candidate)
 
     def get(self, name: str) -> bytes:
+        self.last_name = name
         unquoted = urllib.parse.unquote(name)
         spellings = (name, unquoted, name.replace("\\", "/"), unquoted.replace("\\", "/"))
         for candidate in dict.fromkeys(spellings):
@@ -142,8 +145,9 @@ def parse_file(data: bytes, file_type: str, path: Path,
     Problems that still leave a usable mesh (a missing .mtl) are appended to `warnings_out`.
     """
     resolver = _RecordingResolver(path)
+    begin_warnings()  # a new load: notes a failed one may have left are forgotten
     try:
-        with _quiet() as logged:
+        with _quiet(resolver) as logged:
             scene = trimesh.load_scene(
                 io.BytesIO(data), file_type=file_type, resolver=resolver, process=False
             )
@@ -155,25 +159,40 @@ def parse_file(data: bytes, file_type: str, path: Path,
                       "structure recurses without end); is it corrupt?") from None
     except Exception as exc:  # noqa: BLE001 - any parser failure is a bad file
         raise BadFile(resolver.problem() or _parse_failure(file_type, exc)) from None
-    problem = resolver.problem() or _data_lost(logged)
+    problem = resolver.problem() or _data_lost(logged.messages)
     if problem:
         raise BadFile(problem)
+    for name in dict.fromkeys(logged.failed_images):
+        note_texture_problem(name, "could not be opened (corrupt, truncated or too large)")
     if warnings_out is not None:
         warnings_out.extend(resolver.warnings())
     return scene if isinstance(scene, trimesh.Scene) else trimesh.Scene(scene)
 
 
+IMAGE_FAILURES = ("failed to load image", "unable to load image")  # trimesh's DEBUG notes
+
+
 class _Collect(logging.Handler):
-    def __init__(self) -> None:
-        super().__init__(logging.WARNING)
+    """trimesh's log of one parse: warnings, and the images it could not open (which it
+    notes only at DEBUG level and then drops), named by the resolver's last request."""
+
+    def __init__(self, resolver=None) -> None:
+        super().__init__(logging.DEBUG)
         self.messages: list[str] = []
+        self.resolver = resolver
+        self.failed_images: list[str] = []
 
     def emit(self, record: logging.LogRecord) -> None:
-        self.messages.append(record.getMessage())
+        message = record.getMessage()
+        if message.lower().startswith(IMAGE_FAILURES):
+            name = getattr(self.resolver, "last_name", None) or "an embedded image"
+            self.failed_images.append(os.path.basename(name.replace("\\", "/")))
+        elif record.levelno >= logging.WARNING:
+            self.messages.append(message)
 
 
 @contextlib.contextmanager
-def _quiet():
+def _quiet(resolver=None):
     """Keep what trimesh logs and any library warns off the caller's handlers and stderr.
 
     Yields the messages trimesh logged at WARNING and above, for `_data_lost` to judge. Python
@@ -181,16 +200,18 @@ def _quiet():
     data (`np.errstate`).
     """
     log = logging.getLogger("trimesh")
-    collect, propagate = _Collect(), log.propagate
+    collect, propagate, level = _Collect(resolver), log.propagate, log.level
     log.addHandler(collect)
     log.propagate = False
+    log.setLevel(logging.DEBUG)
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
-            yield collect.messages
+            yield collect
     finally:
         log.removeHandler(collect)
         log.propagate = propagate
+        log.setLevel(level)
 
 
 def _data_lost(messages: list[str]) -> str | None:
