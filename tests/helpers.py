@@ -89,3 +89,13 @@ def triangles_covering(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
     d1, d2, d3 = side(a, b), side(b, c), side(c, a)
     inside = ((d1 > 0) & (d2 > 0) & (d3 > 0)) | ((d1 < 0) & (d2 < 0) & (d3 < 0))
     return inside.sum(axis=0)
+
+
+def write_obj_quad(folder, mtl_text: str, material: str, positions, uvs, name: str = "q"):
+    """An OBJ of two triangles over four corners using ``material`` of an .mtl beside it."""
+    (folder / f"{name}.mtl").write_text(mtl_text)
+    (folder / f"{name}.obj").write_text(
+        f"mtllib {name}.mtl\n" + "".join(f"v {x:g} {y:g} {z:g}\n" for x, y, z in positions)
+        + "".join(f"vt {u:g} {v:g}\n" for u, v in uvs)
+        + f"usemtl {material}\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n")
+    return folder / f"{name}.obj"

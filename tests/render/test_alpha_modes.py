@@ -15,6 +15,7 @@ import struct
 import numpy as np
 import pytest
 import trimesh
+from helpers import write_obj_quad
 from PIL import Image
 
 from reliefkit.render import render
@@ -114,13 +115,8 @@ def obj_quad(tmp_path, mtl_lines: list[str], alpha: int = LOW):
     """An OBJ quad whose map_Kd is a uniform RGBA image with the given alpha byte."""
     Image.fromarray(np.full((4, 4, 4), (200, 120, 60, alpha), np.uint8), "RGBA").save(
         tmp_path / "rgba.png")
-    (tmp_path / "quad.mtl").write_text("\n".join(["newmtl paint", "Kd 1 1 1",
-                                                  "map_Kd rgba.png", *mtl_lines]) + "\n")
-    (tmp_path / "quad.obj").write_text(
-        "mtllib quad.mtl\n" + "".join(f"v {x:g} {y:g} {z:g}\n" for x, y, z in QUAD_POSITIONS)
-        + "".join(f"vt {u:g} {v:g}\n" for u, v in QUAD_UV)
-        + "usemtl paint\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n")
-    return tmp_path / "quad.obj"
+    mtl = "\n".join(["newmtl paint", "Kd 1 1 1", "map_Kd rgba.png", *mtl_lines]) + "\n"
+    return write_obj_quad(tmp_path, mtl, "paint", QUAD_POSITIONS, QUAD_UV, name="quad")
 
 
 @pytest.mark.parametrize("lines, expected", [

@@ -13,6 +13,7 @@ import zlib
 import numpy as np
 import pytest
 import trimesh
+from helpers import write_obj_quad
 from PIL import Image
 
 from reliefkit.errors import MeshError
@@ -72,12 +73,7 @@ def obj_quad(tmp_path, mtl: str, image: np.ndarray | None = None, image_bytes=No
         Image.fromarray(image, "RGBA").save(tmp_path / "tex.png")
     if image_bytes is not None:
         (tmp_path / "tex.png").write_bytes(image_bytes)
-    (tmp_path / "q.mtl").write_text(mtl)
-    (tmp_path / "q.obj").write_text(
-        "mtllib q.mtl\n" + "".join(f"v {x:g} {y:g} {z:g}\n" for x, y, z in QUAD)
-        + "".join(f"vt {u:g} {v:g}\n" for u, v in QUAD_UV)
-        + "usemtl m\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n")
-    return tmp_path / "q.obj"
+    return write_obj_quad(tmp_path, mtl, "m", QUAD, QUAD_UV)
 
 
 @pytest.mark.parametrize("lines, mode, alpha", [
