@@ -1,0 +1,122 @@
+"""The `reliefkit` command line: parses arguments, calls the library, prints results.
+
+Every failure is one line ``error: ...`` on stderr and a non-zero exit status: 2 for a usage
+error (argparse's or a `UsageError`), 1 for bad input (a mesh, an .rk file, the GPU), 3 for
+an internal error (docs/cli.md). The package: `parser` builds the argument parser from the
+technique registry, `options` turns declared options into flags and checks their values,
+`commands` holds the subcommands, `exits` the exit statuses; `main` here runs one command
+with its error handling.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import warnings
+
+from ..errors import ReliefkitError, UsageError
+from .exits import EXIT_BROKEN_PIPE, EXIT_INPUT, EXIT_INTERNAL, EXIT_TERMINATED, EXIT_USAGE
+from .parser import build_parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        parser = build_parser()
+    except ReliefkitError as exc:  # a technique failed to register
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    args = parser.parse_args(argv)
+    if not getattr(args, "run", None):
+        parser.print_help()
+        return EXIT_USAGE
+    with _one_line_warnings(), _sigterm_interrupts():
+        return _run(args)
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: unwinds like KeyboardInterrupt, so every `atomic_path` removes its
+    temporary file, and is no Exception, so no `except Exception` swallows it."""
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts():
+    """While a command runs, SIGTERM raises `Terminated` (where Python can take signals)."""
+    def handler(signum, frame):
+        raise Terminated
+
+    try:
+        previous = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread (main() called from a test's thread)
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def _one_line_warnings():
+    """Python warnings become one ``warning: ...`` line each; numpy's floating-point
+    RuntimeWarnings (overflow, invalid value) are silenced: bad values are refused by the
+    checks that follow them, with their own one-line error. Deprecations are silenced;
+    PIL's DecompressionBombWarning stays (one line)."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        print(f"warning: {text}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.filterwarnings("ignore", category=DeprecationWarning)
+        warnings.filterwarnings("ignore", category=PendingDeprecationWarning)
+        warnings.filterwarnings("ignore", category=RuntimeWarning)
+        # ... but PIL's DecompressionBombWarning (a RuntimeWarning) matters: one line
+        warnings.filterwarnings("default", message=r"Image size \(", category=RuntimeWarning)
+        warnings.showwarning = show
+        yield
+
+
+def _run(args) -> int:
+    try:
+        status = args.run(args)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
+        return status
+    except BrokenPipeError:
+        return _broken_pipe()
+    except ReliefkitError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_USAGE if isinstance(exc, UsageError) else EXIT_INPUT
+    except OSError as exc:
+        name = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"error: cannot access{name}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+    except Terminated:
+        print("error: terminated (SIGTERM); no output was left half-written", file=sys.stderr)
+        return EXIT_TERMINATED
+    except Exception as exc:  # a bug, not bad input: still one line, details on request
+        if os.environ.get("RELIEFKIT_DEBUG"):
+            raise
+        print(f"error: internal error ({type(exc).__name__}: {exc}); "
+              "rerun with RELIEFKIT_DEBUG=1 for a traceback", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+def _broken_pipe() -> int:
+    """The reader of stdout went away (``... | head``): stop quietly, as `cat` would.
+
+    stdout is pointed at /dev/null so the interpreter's final flush cannot fail again.
+    """
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return EXIT_BROKEN_PIPE
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+

@@ -1,0 +1,298 @@
+"""The subcommands: each loads, calls the library and prints what it wrote."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..errors import FormatError, UsageError
+from .options import applicable, given_options
+
+
+def _check_not_empty(spec: str) -> None:
+    """A zero-byte input file is refused as such (before a loader guesses why it fails)."""
+    path = Path(spec)
+    if path.is_file() and path.stat().st_size == 0:
+        raise FormatError(f"{spec}: the file is empty (0 bytes)")
+
+
+def _bake_source(spec: str, command: str = "bake"):
+    """The mesh or heightmap ``bake`` and ``compare`` start from."""
+    from ..scene.heightmap import is_heightmap, load_heightmap
+
+    _check_not_empty(spec)
+    if Path(spec).suffix.lower() == ".rk":
+        raise UsageError(f"{command} needs a mesh or heightmap, not an .rk file ({spec})")
+    if is_heightmap(spec):
+        if command == "compare":
+            raise UsageError(f"compare needs a mesh or demo:NAME as INPUT, not a heightmap "
+                             f"({spec}): there is no mesh to compare against; bake it with "
+                             "`reliefkit bake` and render the .rk instead")
+        return load_heightmap(spec)
+    return _load(spec)
+
+
+def _load(spec: str):
+    """`load_input`, then each warning the loader left on a mesh as one `warning:` line."""
+    from ..io.inputs import load_input
+
+    obj = load_input(spec)
+    _print_load_warnings(obj)
+    return obj
+
+
+def _print_load_warnings(obj) -> None:
+    """The loader's human-readable warnings (``mesh.extra["warnings"]``), one line each."""
+    extra = getattr(obj, "extra", None)
+    found = extra.get("warnings", ()) if isinstance(extra, dict) else ()
+    for text in found if isinstance(found, list | tuple) else ():
+        line = " ".join(str(text).split())
+        print(f"warning: {line}", file=sys.stderr)
+
+
+def _bake_input(args, source=None):
+    from ..bake import bake
+    from ..core.technique import baker
+    from ..progress import progress_bar
+
+    _, chosen = baker(args.kind)
+    params = applicable(given_options(args), chosen.options, f"--as {args.kind}")
+    source = _bake_source(args.input) if source is None else source
+    with progress_bar(f"baking {args.kind}", 1) as advance:
+        return bake(source, args.kind, progress=advance, **params)
+
+
+def cmd_bake(args) -> int:
+    from ..io.atomic import check_writable
+    from ..io.rk import array_bytes, file_sha256, save
+    from ..units import format_bytes
+
+    if Path(args.output).suffix.lower() != ".rk":
+        raise UsageError(f"output must be an .rk file, got {args.output}")
+    check_writable(args.output, "-o")
+    rep = _bake_input(args)
+    source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
+    save(args.output, rep, source_hash=source_hash)
+    sizes = array_bytes(rep)
+    parts = ", ".join(f"{name} {format_bytes(n)}" for name, n in sizes.items())
+    print(f"wrote {args.output}: {format_bytes(sum(sizes.values()))} of arrays ({parts}), "
+          f"{format_bytes(Path(args.output).stat().st_size)} on disk")
+    return 0
+
+
+def _background(text: str):
+    """--background: None (transparent) or a linear grey (level, level, level) in 0..1."""
+    if text == "transparent":
+        return None
+    try:
+        level = float(text)
+    except ValueError:
+        level = float("nan")
+    if not 0.0 <= level <= 1.0:
+        raise UsageError(f"--background must be 'transparent' or a grey level within [0, 1], "
+                         f"got {text!r}")
+    return (level, level, level)
+
+
+def _light(args):
+    from ..scene.light import DirectionalLight
+    from ..scene.views import parse_light
+
+    return DirectionalLight.from_angles(*parse_light(args.light))
+
+
+def _warn_nothing_visible(what: str) -> None:
+    """A picture with nothing in it is written, but never silently (exit status 0 still)."""
+    print(f"warning: {what} 0 pixels: nothing visible (check --view, --fov and the input's "
+          "bounds)", file=sys.stderr)
+
+
+def cmd_render(args) -> int:
+    from ..render import render, render_options
+    from ..scene.views import check_fov, framing_bounds, orbit_bounds, parse_size, parse_view
+
+    az, el, dist = parse_view(args.view)
+    size = parse_size(args.size)
+    check_fov(args.fov)
+    background = _background(args.background)
+    light = _light(args)
+    _check_render_outputs(args)
+    _check_not_empty(args.input)
+    obj = _load(args.input)
+    options = applicable(given_options(args), render_options(obj),
+                          f"{args.input}, a {type(obj).__name__}")
+
+    def draw(camera, msaa=args.msaa, **core):
+        return render(obj, camera, light=light, msaa=msaa, **core, **options)
+
+    if args.turntable is not None:
+        return _render_turntable(args, framing_bounds(obj), draw, el, dist, size, background)
+    camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
+    frame = draw(camera)
+    frame.save(args.output, background)
+    print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
+    if frame.stats["covered"] == 0:
+        _warn_nothing_visible("the render covers")
+    if args.aovs:
+        frame.save_aovs(args.aovs)
+        print(f"wrote {args.aovs}")
+    if args.stats:
+        counted = draw(camera, msaa=1, count_iterations=True)  # counters are single-sample
+        _write_stats(args, frame, counted)
+    return 0
+
+
+def _check_render_outputs(args) -> None:
+    """The output names fit what is written; per-frame outputs do not go with --turntable."""
+    suffix = Path(args.output).suffix.lower()
+    if args.turntable is not None:
+        if suffix != ".gif":
+            raise UsageError("--turntable writes an animated .gif: name the output *.gif")
+        given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
+                 if value]
+        if given:
+            raise UsageError(f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not "
+                             "apply to --turntable (one frame's arrays and counters): render "
+                             "a single --view for them")
+    elif suffix != ".png":
+        raise UsageError(f"output must be a .png file, got {args.output}")
+    if args.stats and Path(args.stats).suffix.lower() != ".json":
+        raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
+    if args.aovs and Path(args.aovs).suffix.lower() != ".npz":
+        raise UsageError(f"--aovs writes NumPy arrays: name the file *.npz, got {args.aovs}")
+    from ..io.atomic import check_writable
+
+    for flag, value in (("-o", args.output), ("--aovs", args.aovs), ("--stats", args.stats)):
+        if value:
+            check_writable(value, flag)
+
+
+def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
+    """``args.turntable`` views of ``draw(camera)`` into a GIF, warning about empty views."""
+    from ..pictures import TILE_BACKGROUND, save_gif
+    from ..progress import progress_bar
+    from ..scene.views import turntable
+
+    cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
+    frames, empty = [], []
+    with progress_bar("turntable", len(cameras)) as advance:
+        for k, camera in enumerate(cameras):
+            frame = draw(camera)
+            if frame.stats["covered"] == 0:
+                empty.append(str(k + 1))
+            frames.append(frame.rgba8(background or TILE_BACKGROUND))
+            advance(k + 1)
+    save_gif(frames, args.output)
+    print(f"wrote {args.output} ({len(frames)} views)")
+    if empty:
+        many = len(empty) > 1
+        _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
+                              f"cover{'' if many else 's'}")
+    return 0
+
+
+def _write_stats(args, frame, counted) -> None:
+    """The plain frame's counters plus the instrumented pass's (fragments, iterations)."""
+    from ..io.atomic import atomic_path
+
+    stats = {"input": args.input, "size": list(frame.size), "view": args.view,
+             **counted.stats, **frame.stats}
+    with atomic_path(args.stats) as tmp:
+        tmp.write_text(json.dumps(stats, indent=2) + "\n")
+    print(f"wrote {args.stats}")
+
+
+def cmd_compare(args) -> int:
+    from ..compare import metrics_markdown, write_comparison
+    from ..scene.views import check_fov, orbit_bounds, parse_size, parse_view
+
+    az, el, dist = parse_view(args.view)
+    size = parse_size(args.size)
+    check_fov(args.fov)
+    light = _light(args)
+    from ..io.atomic import check_writable
+
+    check_writable(args.out, "--out", folder=True)
+    mesh = _bake_source(args.input, "compare")
+    if not hasattr(mesh, "triangle_count"):
+        raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not a heightmap")
+    rep = _bake_input(args, mesh)
+    camera = orbit_bounds(mesh.bounds, az, el, dist, size, args.fov)
+    result = _compare_with_progress(mesh, rep, camera, light)
+    title = f"{mesh.name} as {args.kind}, view {args.view}"
+    paths = write_comparison(result, Path(args.out), title)
+    print(metrics_markdown(result, title))
+    print("wrote " + ", ".join(str(p) for p in paths.values()))
+    return 0
+
+
+def _compare_with_progress(mesh, rep, camera, light) -> dict:
+    """`compare` with a progress line per variant (the mesh, then each available variant)."""
+    from ..compare import compare
+    from ..core.technique import technique_of
+    from ..progress import progress_bar
+
+    tech = technique_of(rep)
+    variants = [v for v in (tech.compare_variants if tech else ()) if v.available(rep)]
+    with progress_bar("compare", len(variants) + 1) as advance:
+        return compare(mesh, rep, camera, light=light, progress=advance)
+
+
+def cmd_bench(args) -> int:
+    from ..bench import run_suite
+    from ..io.atomic import check_writable
+
+    check_writable(args.out, "--out", folder=True)
+    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out))
+    print(report)
+    print("wrote " + ", ".join(map(str, paths)))
+    return 0
+
+
+def cmd_info(args) -> int:
+    if not args.gl and not args.file:
+        raise UsageError("info needs --gl and/or a FILE")
+    report = {}
+    if args.gl:
+        from ..gl.context import gl_info
+
+        report["gl"] = gl_info()
+    if args.file:
+        report["file"] = _describe_file(args.file)
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        for section in report.values():
+            for key, value in section.items():
+                shown = json.dumps(value) if isinstance(value, dict | list) else value
+                print(f"{key:>24}: {shown}")
+    return 0
+
+
+def _describe_file(spec: str) -> dict:
+    """A mesh's counts and bounds, or an .rk file's manifest once every array is read and its
+    checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
+    _check_not_empty(spec)
+    if Path(spec).suffix.lower() == ".rk":
+        from ..io.rk import load, read_manifest
+
+        load(spec)  # every check render makes: checksums, then the representation's own
+        return {**read_manifest(spec), "checksums": "ok", "valid": "ok"}
+    from ..io.inputs import describe
+
+    return describe(_load(spec))
+
+
+def cmd_demo(args) -> int:
+    from ..demo import build_demo
+    from ..io.atomic import check_writable
+    from ..scene.views import parse_size
+
+    size = parse_size(args.size)
+    check_writable(args.out, "--out", folder=True)
+    sheet = build_demo(Path(args.out), tile_size=size)
+    print(f"wrote {sheet}")
+    return 0
+
+

@@ -1,0 +1,200 @@
+"""Building the argument parser from the registry: commands, flags, help, examples."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .. import __version__
+from ..scene.light import DEFAULT_LIGHT_ANGLES
+from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW
+from .commands import cmd_bake, cmd_bench, cmd_compare, cmd_demo, cmd_info, cmd_render
+from .exits import EXIT_USAGE
+from .options import add_flag, add_options
+
+MSAA_CHOICES = (1, 2, 4, 8)
+
+CORE_EXAMPLES = {
+    "demo": ["reliefkit demo --out out                          contact sheet of every demo"],
+    "render": ["reliefkit render bunny.ply -o bunny.png           one view (default --view "
+               "30,25)",
+               "reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs "
+               "side.npz",
+               "reliefkit render demo:tree --turntable 36 -o spin.gif"],
+    "info": ["reliefkit info --gl                               the OpenGL renderer and its "
+             "limits",
+             "reliefkit info model.obj                          counts and bounds of a mesh "
+             "(or an .rk)"],
+}
+ORDER = ("demo", "render", "bake", "compare", "bench", "info")
+
+
+def _examples(command: str | None = None) -> list[str]:
+    """Example lines: the core's and every technique's, for one command or all in order."""
+    from ..core.technique import techniques
+
+    table = {name: list(lines) for name, lines in CORE_EXAMPLES.items()}
+    for tech in techniques():
+        for name, lines in tech.cli_examples.items():
+            table.setdefault(name, []).extend(lines)
+    names = [command] if command else [n for n in ORDER if n in table]
+    return [line for name in names for line in table.get(name, [])]
+
+
+def _epilog() -> str:
+    from ..core.technique import bakers
+
+    heightmap_kinds = [name for name, (_, b) in bakers().items() if "heightmap" in b.sources]
+    lines = ["examples:", *(f"  {line}" for line in _examples()), "",
+             "inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME",
+             "(demo assets: terrain, blob, tree, vehicle)"]
+    if heightmap_kinds:
+        lines[-1] += (f", or for `bake --as {'/'.join(heightmap_kinds)}` a heightmap")
+        lines.append("(8/16-bit greyscale .png or a 2D .npy array)")
+    return "\n".join(lines) + ".\n"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports errors as one `error:` line (exit status 2), and lets the flags
+    in ``dash_values`` take a value that starts with '-' (``--axis -y``, ``--view -30,20``),
+    which argparse alone would read as another option."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.dash_values: set[str] = set()
+
+    def error(self, message: str):  # noqa: D102
+        self.exit(EXIT_USAGE, f"error: {message} (see {self.prog} --help)\n")
+
+    def parse_known_args(self, args=None, namespace=None):  # noqa: D102
+        args = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(self._join_dash_values(args), namespace)
+
+    def _join_dash_values(self, args: list[str]) -> list[str]:
+        """``--flag -value`` -> ``--flag=-value`` for those flags, unless -value is an option."""
+        out, k = [], 0
+        while k < len(args):
+            arg = args[k]
+            following = args[k + 1] if k + 1 < len(args) else None
+            if (arg in self.dash_values and following is not None and following.startswith("-")
+                    and following not in self._option_string_actions):
+                out.append(f"{arg}={following}")
+                k += 2
+            else:
+                out.append(arg)
+                k += 1
+            if arg == "--":
+                return out + args[k:]
+        return out
+
+
+def _add_view_args(p: _Parser) -> None:
+    """--view, --size, --fov and --light: the camera and light of every render."""
+    add_flag(p, "--view", dash_value=True, metavar="AZ,EL[,DIST]",
+              default=",".join(f"{x:g}" for x in DEFAULT_VIEW[:2]),
+              help="orbit the bounding-box centre (of the source mesh for a baked .rk): "
+                   "azimuth about +y from +z towards +x and elevation in degrees, distance in "
+                   "bounding-sphere radii, within [0.01, 10000] (default: %(default)s, at the "
+                   "distance that fits the sphere in view)")
+    p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
+                   help="image size in pixels (default: %(default)s)")
+    add_flag(p, "--fov", dash_value=True, type=float, default=40.0, metavar="DEG",
+              help="vertical field of view in degrees, within [0.1, 179] (default: "
+                   "%(default)g)")
+    add_flag(p, "--light", dash_value=True, metavar="AZ,EL",
+              default=",".join(f"{x:g}" for x in DEFAULT_LIGHT_ANGLES),
+              help="where the light comes from: azimuth and elevation in degrees, as in "
+                   "--view (default: %(default)s, a low sun from the side)")
+
+
+def _command(sub, name: str, summary: str, description: str):
+    """A subcommand parser whose --help ends with its examples."""
+    epilog = "examples:\n" + "\n".join(f"  {line}" for line in _examples(name))
+    return sub.add_parser(name, help=summary, description=description, epilog=epilog,
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from ..bench import suite_names
+    from ..core.technique import bakers, bench_suites, techniques
+
+    parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
+                     epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"reliefkit {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    table = bakers()
+
+    p = _command(sub, "render", "render a mesh or an .rk representation to PNG / GIF",
+                 "Render a mesh (ground truth) or an .rk representation.")
+    p.add_argument("input", help="mesh file, .rk file or demo:NAME")
+    _add_view_args(p)
+    p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable)")
+    p.add_argument("--aovs", metavar="OUT.npz",
+                   help="also write color, mask, depth, position, normal, view, proj, viewport")
+    p.add_argument("--stats", metavar="OUT.json",
+                   help="also write the frame's counters: covered pixels, fragments and loop "
+                        "iterations per pixel (mean, max) where the renderer counts them")
+    p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
+    add_flag(p, "--background", dash_value=True, default="transparent",
+              metavar="transparent|LEVEL",
+              help="'transparent' or a grey level 0..1 to composite over (default: "
+                   "%(default)s)")
+    p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
+                   help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
+                        "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
+    add_options(p, [(t.name, spec.option_list) for t in techniques() for spec in t.drawables],
+                 "render options")
+    p.set_defaults(run=cmd_render)
+
+    p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",
+                 "Bake a mesh (or a heightmap) into a representation. Representations: "
+                 + "; ".join(f"{name}: {b.summary}" for name, (_, b) in table.items()) + ".")
+    _add_bake_args(p, table)
+    p.add_argument("-o", "--output", required=True, help="output .rk file")
+    p.set_defaults(run=cmd_bake)
+
+    p = _command(sub, "compare", "bake, then render the mesh and every variant side by side",
+                 "Bake INPUT, render the mesh and each variant of the representation (its "
+                 "methods or modes) from one view; write compare.png, metrics.md, metrics.json.")
+    _add_bake_args(p, table, "mesh file or demo:NAME (not a heightmap: there is no mesh to "
+                             "compare against)")
+    _add_view_args(p)
+    p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
+    p.set_defaults(run=cmd_compare)
+
+    names = suite_names()
+    p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",
+                 "Benchmarks measured side by side in one run: "
+                 + "; ".join(f"{n}: {s.summary}" for n, (_, s) in bench_suites().items()) + ".")
+    p.add_argument("name", choices=names, help="which benchmark")
+    p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
+    p.set_defaults(run=cmd_bench)
+
+    p = _command(sub, "info", "GL capabilities, or the contents of a mesh / .rk file",
+                 "Print the OpenGL renderer and limits (--gl) and/or summarise a mesh or .rk "
+                 "file.")
+    p.add_argument("file", nargs="?", help="mesh file, .rk file or demo:NAME")
+    p.add_argument("--gl", action="store_true", help="print renderer, GL version and limits")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(run=cmd_info)
+
+    p = _command(sub, "demo", "render the demo assets into a titled contact sheet",
+                 "Render every demo asset (and representation) into OUT/demo.png plus one "
+                 "PNG per tile.")
+    p.add_argument("--out", default="out", help="output folder (default: %(default)s)")
+    p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
+    p.set_defaults(run=cmd_demo)
+    return parser
+
+
+
+def _add_bake_args(p: argparse.ArgumentParser, table: dict,
+                   input_help: str = "mesh file, demo:NAME, or a heightmap (.png/.npy)") -> None:
+    p.add_argument("input", help=input_help)
+    kinds = tuple(table)
+    p.add_argument("--as", dest="kind", default=kinds[0] if kinds else None, choices=kinds,
+                   help="representation to bake (default: %(default)s)")
+    add_options(p, [(name, b.options) for name, (_, b) in table.items()], "bake options")
+
+
