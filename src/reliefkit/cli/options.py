@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..core.transforms import MAX_COORDINATE
 from ..errors import UsageError
-
-MAX_OPTION_MAGNITUDE = 1e18  # no numeric option takes a value larger than this
 
 
 def add_flag(parser, *args, within=None, dash_value: bool = False, **kwargs):
@@ -104,9 +103,9 @@ def checked(opt, value, what: str):
         raise UsageError(message) from None
     if opt.kind in ("float", "floats") and checked is not None:
         for v in (checked if opt.kind == "floats" else (checked,)):
-            if not (math.isfinite(v) and abs(v) <= MAX_OPTION_MAGNITUDE):
+            if not (math.isfinite(v) and abs(v) <= MAX_COORDINATE):
                 raise UsageError(f"--{opt.flag} needs finite numbers of magnitude at most "
-                                 f"{MAX_OPTION_MAGNITUDE:g}, got {value!r} ({what})")
+                                 f"{MAX_COORDINATE:g}, got {value!r} ({what})")
     return checked
 
 

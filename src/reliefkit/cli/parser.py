@@ -188,7 +188,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-
 def _add_bake_args(p: argparse.ArgumentParser, table: dict,
                    input_help: str = "mesh file, demo:NAME, or a heightmap (.png/.npy)") -> None:
     p.add_argument("input", help=input_help)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+MAX_COORDINATE = 1e18  # |coordinate| beyond this overflows float32 products on the GPU: refused
+
 
 def homogeneous(points) -> np.ndarray:
     """(..., 3) points -> (..., 4) with w = 1 (float64)."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.transforms import MAX_COORDINATE
 from ..errors import FormatError, UsageError
 from .camera import Camera
 
@@ -17,7 +18,6 @@ FIT_MARGIN = 1.05                  # the fitted sphere fills 1 / FIT_MARGIN of t
 DEFAULT_SIZE = (512, 512)
 DISTANCE_RANGE = (0.01, 1e4)       # --view DIST in bounding-sphere radii: near/far stay sane
 FOV_RANGE = (0.1, 179.0)           # --fov in degrees: the projection stays well conditioned
-MAX_BOUNDS = 1e18                  # coordinates past this overflow float32 products on the GPU
 
 
 def parse_view(text: str) -> tuple[float, float, float | None]:
@@ -104,9 +104,9 @@ def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float | Non
     """Orbit the box centre at ``distance`` bounding-sphere radii (None: fit the view),
     near/far hugging the box."""
     b = np.asarray(bounds, dtype=np.float64)
-    if b.shape != (2, 3) or not np.isfinite(b).all() or np.abs(b).max() > MAX_BOUNDS:
+    if b.shape != (2, 3) or not np.isfinite(b).all() or np.abs(b).max() > MAX_COORDINATE:
         raise FormatError(f"the input's bounds {_shown(b)} are not finite or exceed "
-                          f"{MAX_BOUNDS:g}: no camera can frame them")
+                          f"{MAX_COORDINATE:g}: no camera can frame them")
     if distance is None:
         distance = fit_distance(size, fov_deg)
     radius = bounds_radius(b)
@@ -114,7 +114,7 @@ def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float | Non
     near, far = max(d - 1.05 * radius, 0.005 * d), d + 1.05 * radius
     centre = b.mean(axis=0)
     if not (np.isfinite((d, near, far)).all() and 0 < near < far and d > 0
-            and far < MAX_BOUNDS and float(np.float32(near)) < float(np.float32(far))):
+            and far < MAX_COORDINATE and float(np.float32(near)) < float(np.float32(far))):
         raise FormatError(f"cannot place a camera {distance:g} radii from a box of radius "
                           f"{radius:g} (near {near:g}, far {far:g}): use another --view "
                           "distance or check the input's bounds")

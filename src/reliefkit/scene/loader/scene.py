@@ -12,6 +12,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import trimesh
 
+from ...core.transforms import MAX_COORDINATE
 from ..mesh import Material
 from .badfile import BadFile, check_range
 from .materials import SurfaceReader, decode_colors, is_face_colored
@@ -20,7 +21,6 @@ from .normals import file_normals
 #: The largest coordinate magnitude the loader accepts, in the file's units, before and after
 #: the scene-graph transforms. Far beyond any real mesh, yet small enough that the squared
 #: distances the renderer computes in float32 (limit 3.4e38) never overflow.
-MAX_COORDINATE = 1e18
 
 # A triangle is visible when its doubled area exceeds (_VISIBLE * extent)**2, the extent being
 # the diagonal of the whole mesh's bounds: thinner than float32 resolves at that scale, it

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.transforms import transform_points, unit_cube_corners
+from ...core.transforms import MAX_COORDINATE, transform_points, unit_cube_corners
 from ...errors import UsageError
 
 
@@ -137,7 +137,6 @@ class ReliefTexture:
 
 
 MAX_UINT8_RADIUS = 255   # what bakes store in uint8, whatever the field's size
-MAX_COORDINATE = 1e15    # |world corner| beyond this cannot be drawn (float32 on the GPU)
 MAX_CONDITION = 1e12     # box_to_world this ill-conditioned loses the box in rounding
 MIN_EXTENT = 1e-20       # a smaller box underflows in float32 on the GPU
 
