@@ -59,7 +59,7 @@ def test_several_materials_round_trip_bit_exact(tmp_path):
 
 def test_arrays_and_params_of_a_multi_material_file(tmp_path):
     manifest = rk.read_manifest(rk.save(tmp_path / "m.rk", three_materials()))
-    assert manifest["kind_version"] == 2
+    assert manifest["kind_version"] == 3
     assert manifest["params"] == {"name": "three", "materials": ["bricks", "paint", ""]}
     arrays = manifest["arrays"]
     assert {"material", "material_colors", "uv_transforms", "texture", "texture_2"} <= set(arrays)

@@ -28,7 +28,7 @@ from reliefkit.core.technique import (
 from reliefkit.errors import FormatError, UsageError
 from reliefkit.gl.shaders import program
 from reliefkit.gl.targets import FRONT_OPACITY_UNIT
-from reliefkit.gl.uniforms import camera_uniforms, set_uniforms
+from reliefkit.gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from reliefkit.io.rk import ArraySpec, Codec
 
 PROGRAM = "toy:toy.glsl"
@@ -111,7 +111,8 @@ class ToyDrawable:
         self.prog = program(ctx, PROGRAM, {
             "TRANSPARENT": self.transparent, "CHECKER": options.method == "checker",
             "COUNT_ITERATIONS": bool(self.extra_attachments)})
-        tris = quad.corners[[0, 1, 2, 0, 2, 3]].astype(np.float32)
+        self.origin = quad.corners.mean(axis=0)  # geometry relative to it (camera-relative)
+        tris = (quad.corners[[0, 1, 2, 0, 2, 3]] - self.origin).astype(np.float32)
         self.vbo = ctx.buffer(tris.tobytes())
         self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f", "in_position")])
 
@@ -119,7 +120,7 @@ class ToyDrawable:
         return float(np.linalg.norm(self.quad.corners.mean(axis=0) - np.asarray(camera.eye)))
 
     def draw(self, camera, light) -> None:
-        set_uniforms(self.prog, camera_uniforms(camera) | {
+        set_uniforms(self.prog, camera_uniforms(camera) | model_offset(camera, self.origin) | {
             "u_color": tuple(float(c) for c in self.quad.color),
             "u_normal": tuple(float(c) for c in self.quad.normal),
             "u_front_opacity": FRONT_OPACITY_UNIT})

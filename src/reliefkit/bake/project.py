@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.transforms import box_center, invert_box
 from ..errors import UsageError
 from ..scene.camera import MatrixCamera
 from ..scene.light import DirectionalLight
@@ -61,10 +62,11 @@ class Projection:
 
 def box_camera(box_to_world: np.ndarray, size) -> MatrixCamera:
     """The camera that rasterizes world space through ``box_to_world`` at ``size`` (W, H)."""
-    world_to_box = np.linalg.inv(box_to_world)
+    world_to_box = invert_box(box_to_world)
     up = box_to_world[:3, 2] - box_to_world[3, 2] * box_to_world[:3, 3] / box_to_world[3, 3]
     return MatrixCamera(view=world_to_box, proj=BOX_TO_CLIP, size=tuple(size),
-                        view_dir=tuple(up / np.linalg.norm(up)))
+                        view_dir=tuple(up / np.linalg.norm(up)),
+                        origin=tuple(box_center(box_to_world)))
 
 
 def project_mesh(mesh, box_to_world: np.ndarray, size, ctx=None) -> Projection:

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.transforms import invert_box
 from ..errors import GPUError, UsageError
 from ..gl.textures import read_rgba
 from ..gl.uniforms import set_uniforms
@@ -233,10 +234,10 @@ class _Sweeps:
         self.ctx, self.mesh, self.size, self.s = ctx, mesh, size, s
         self.solid, self.signed = solid, rule == "nonzero"
         self.alpha_cutoff, self.progress = alpha_cutoff, progress
-        self.world_to_box = np.linalg.inv(box_to_world)
+        self.world_to_box = invert_box(box_to_world)
         # box coordinates in float64 here, uploaded instead of world positions: float32
         # world coordinates far from the origin would blur the slab bounds
-        pos = mesh.positions.astype(np.float64)
+        pos = mesh.world_positions
         self.box_pos = pos @ self.world_to_box[:3, :3].T + self.world_to_box[:3, 3]
         self.objects: list = []
 

@@ -20,6 +20,29 @@ def transform_points(matrix, points) -> np.ndarray:
         return hom[..., :3] / hom[..., 3:4]
 
 
+def translation(offset) -> np.ndarray:
+    """4x4 matrix moving points by ``offset`` (3,)."""
+    matrix = np.eye(4)
+    matrix[:3, 3] = np.asarray(offset, dtype=np.float64)
+    return matrix
+
+
+def box_center(box_to_world) -> np.ndarray:
+    """World point at the centre of a (possibly projective) box: box coordinates 0.5."""
+    return transform_points(box_to_world, np.full(3, 0.5))
+
+
+def invert_box(box_to_world) -> np.ndarray:
+    """world_to_box of a box far from the world origin, as exact as near it.
+
+    A plain inverse of a matrix holding a 1e8 translation (and a projective row) loses the
+    box in rounding; inverting it relative to the box's centre does not.
+    """
+    centre = box_center(box_to_world)
+    relative = translation(-centre) @ np.asarray(box_to_world, dtype=np.float64)
+    return np.linalg.inv(relative) @ translation(-centre)
+
+
 def unit_cube_corners() -> np.ndarray:
     """(8, 3) corners of [0, 1]^3, index = x + 2y + 4z."""
     return np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=np.float64)

@@ -57,10 +57,10 @@ def host_bytes(width: int, height: int, extra_attachments: int = 0, *, msaa: int
 
     Every RGBA32F attachment is read as bytes and copied into a flipped array (2 x 16 bytes
     per pixel), the depth likewise (2 x 4); the Frame built from them holds colour, position,
-    normal, depth, mask and the iteration counters (about 16 + 12 + 12 + 4 + 1 + 8 bytes);
+    normal, depth, mask and the iteration counters (about 16 + 24 + 12 + 4 + 1 + 8 bytes);
     the transparent pass reads three more attachments plus its zero upload, msaa two more.
     """
-    per_pixel = 2 * 16 * (FRAME_ATTACHMENTS + extra_attachments) + 2 * 4 + 53
+    per_pixel = 2 * 16 * (FRAME_ATTACHMENTS + extra_attachments) + 2 * 4 + 65
     if msaa > 1:
         per_pixel += 2 * 16 * 2 + 16
     if transparent:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.transforms import translation
+
 
 def set_uniforms(prog, values: dict) -> None:
     """Set the uniforms a program actually uses (the compiler drops unused ones)."""
@@ -17,12 +19,27 @@ def set_uniforms(prog, values: dict) -> None:
 
 
 def camera_uniforms(camera) -> dict:
-    """The uniforms of shaders/include/camera.glsl for any camera."""
+    """The uniforms of shaders/include/camera.glsl for any camera.
+
+    Shaders see world space relative to ``camera.origin`` (camera-relative rendering): the
+    matrices are composed in float64 with the translation to it, so a mesh 1e8 units from
+    the world origin keeps the float32 precision it has at the origin. Drawables upload
+    their geometry relative to an origin of their own and add `model_offset` to it.
+    """
+    origin = np.asarray(camera.origin, dtype=np.float64)
+    view = np.asarray(camera.view) @ translation(origin)
     view_dir = np.asarray(camera.eye) - np.asarray(camera.target)
     view_dir = view_dir / np.linalg.norm(view_dir)
-    view_proj = np.asarray(camera.proj) @ np.asarray(camera.view)
-    return {"u_view": camera.view, "u_proj": camera.proj,
-            "u_inv_view_proj": np.linalg.inv(view_proj),
-            "u_eye": tuple(float(x) for x in camera.eye), "u_orthographic": camera.orthographic,
+    return {"u_view": view, "u_proj": camera.proj,
+            "u_inv_view_proj": np.linalg.inv(np.asarray(camera.proj) @ view),
+            "u_eye": tuple(float(x) for x in np.asarray(camera.eye) - origin),
+            "u_orthographic": camera.orthographic,
             "u_view_dir": tuple(float(x) for x in view_dir),
             "u_viewport": tuple(float(x) for x in camera.size)}
+
+
+def model_offset(camera, origin) -> dict:
+    """``u_model_offset``: what a drawable adds to geometry stored relative to ``origin``
+    (float64 world point) to place it in the camera's relative world space."""
+    offset = np.asarray(origin, dtype=np.float64) - np.asarray(camera.origin, dtype=np.float64)
+    return {"u_model_offset": tuple(float(x) for x in offset)}

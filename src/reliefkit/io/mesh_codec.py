@@ -1,8 +1,8 @@
 """The core's own .rk kind, ``mesh``: a RenderMesh stored as plain arrays, every material kept.
 
 Version 2 added materials to the arrays of version 1, which describe a one-material mesh
-with at most one texture (``texture``). Arrays that would only repeat the defaults are left
-out, so a version 1 file is a valid version 2 file and one reader reads both:
+with at most one texture (``texture``); version 3 the origin. Arrays that would only repeat
+the defaults are left out, so older files are valid newer ones and one reader reads all:
 
 - ``material`` (F,) uint16 per-triangle material index (absent: every triangle uses 0);
 - ``material_colors`` (M, 4) float32 linear colour factors (absent: one white material);
@@ -11,7 +11,9 @@ out, so a version 1 file is a valid version 2 file and one reader reads both:
 - param ``alpha_modes``: M of "OPAQUE", "MASK", "BLEND" (absent: every material OPAQUE, the
   `Material` default, also for files written before alpha modes existed: their texture and
   factor alpha is then ignored, as glTF's default alphaMode says);
-- ``alpha_cutoffs`` (M,) float32 MASK thresholds in [0, 1] (absent: 0.5 each).
+- ``alpha_cutoffs`` (M,) float32 MASK thresholds in [0, 1] (absent: 0.5 each);
+- ``origin`` (3,) float64 world point ``positions`` are relative to (absent: the zero
+  vector; `RenderMesh.origin`, set for meshes far from the world origin).
 """
 
 from __future__ import annotations
@@ -39,6 +41,8 @@ def _mesh_to_arrays(mesh: RenderMesh) -> tuple[dict[str, np.ndarray], dict]:
     arrays = {"positions": mesh.positions, "indices": mesh.indices, "normals": mesh.normals,
               "colors": mesh.colors, "uvs": mesh.uvs}
     params = {"name": mesh.name}
+    if mesh.origin.any():
+        arrays["origin"] = mesh.origin
     if len(materials) > 1:
         arrays["material"] = mesh.material
     if len(materials) > 1 or not np.array_equal(materials[0].color, _WHITE):
@@ -97,7 +101,7 @@ def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh
                           float(cutoffs[k])) for k in range(count)]
     return RenderMesh(arrays["positions"], arrays["indices"], arrays["normals"],
                       arrays["colors"], arrays.get("uvs"), name=name, materials=materials,
-                      material=arrays.get("material"))
+                      material=arrays.get("material"), origin=arrays.get("origin", np.zeros(3)))
 
 
 def _rows(dtype: str, cols: int, **options) -> ArraySpec:
@@ -121,9 +125,10 @@ register(Codec(
         "uv_transforms": ArraySpec(("float32",), ndim=3, trailing=(3, 3), finite=True,
                                    required=False),
         "alpha_cutoffs": ArraySpec(("float32",), ndim=1, finite=True, required=False),
+        "origin": ArraySpec(("float64",), ndim=1, finite=True, required=False),
         **{texture_array_name(k): _TEXTURE for k in range(MAX_TEXTURED)},
     },
     to_arrays=_mesh_to_arrays,
     from_arrays=_mesh_from_arrays,
-    version=2,
+    version=3,
 ))

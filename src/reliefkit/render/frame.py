@@ -21,7 +21,8 @@ class Frame:
     color : (H, W, 4) float32 linear RGB with straight alpha.
     mask : (H, W) bool, the representation covers the pixel.
     depth : (H, W) float32 window depth in [0, 1] (1 where nothing was drawn).
-    position : (H, W, 3) float32 world-space hit point, NaN where ``mask`` is False.
+    position : (H, W, 3) float64 world-space hit point, NaN where ``mask`` is False (float64:
+        the file's own coordinates, exact also for meshes far from the world origin).
     normal : (H, W, 3) float32 world-space unit normal, 0 where ``mask`` is False.
     view, proj : 4x4 float64 camera matrices; viewport : (x, y, w, h) int32.
     stats : counters: ``covered`` pixels always; ``fragments`` and ``iterations_*`` where
@@ -83,11 +84,14 @@ def frame_from_passes(camera, images) -> Frame:
     Opaque pixels keep their colour and AOVs; where the transparent pass drew, its
     premultiplied colour lies over the opaque one, and the AOVs belong to the point where the
     accumulated opacity first reached 0.5 (the transparent gate, else the opaque surface
-    behind, else NaN). Colour is returned straight (not premultiplied).
+    behind, else NaN). Colour is returned straight (not premultiplied). Shaders write
+    positions relative to ``camera.origin`` (`gl.uniforms.camera_uniforms`); the Frame's are
+    world coordinates in float64.
     """
     covered = images.position[..., 3] > 0.5
     color = np.where(covered[..., None], images.color, 0.0)
-    pos = np.where(covered[..., None], images.position[..., :3], np.nan)
+    origin = np.asarray(camera.origin, dtype=np.float64)
+    pos = np.where(covered[..., None], images.position[..., :3] + origin, np.nan)
     nrm = np.where(covered[..., None], images.normal[..., :3], 0.0)
     depth = np.where(covered, images.depth, 1.0)  # counted misses leave depth below 1
     mask = covered
@@ -101,13 +105,13 @@ def frame_from_passes(camera, images) -> Frame:
             straight = np.where(alpha > 0, rgb / np.where(alpha > 0, alpha, 1.0), 0.0)
         color = np.concatenate([straight, alpha], axis=-1)
         gate = t_pos[..., 3] > 0.5
-        pos = np.where(gate[..., None], t_pos[..., :3], pos)
+        pos = np.where(gate[..., None], t_pos[..., :3] + origin, pos)
         nrm = np.where(gate[..., None], t_nrm[..., :3], nrm)
         depth = np.where(gate, window_depth(pos, camera.view, camera.proj, depth), depth)
         mask = covered | (t_alpha[..., 0] > 0)
         pos = np.where((covered | gate)[..., None], pos, np.nan)
     return Frame(color=color.astype(np.float32), mask=mask, depth=depth.astype(np.float32),
-                 position=pos.astype(np.float32), normal=nrm.astype(np.float32),
+                 position=pos, normal=nrm.astype(np.float32),
                  view=camera.view, proj=camera.proj, viewport=camera.viewport)
 
 

@@ -16,7 +16,7 @@ from ..core.technique import DrawableSpec, ProgramVariant
 from ..gl.context import check_gl_error
 from ..gl.shaders import program
 from ..gl.textures import texture2d
-from ..gl.uniforms import camera_uniforms, set_uniforms
+from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from ..scene.light import DirectionalLight
 from ..scene.mesh import Material, RenderMesh
 from .registry import register_core_drawable
@@ -99,7 +99,7 @@ class MeshDrawable:
                                                 index_element_size=4))
 
     def draw(self, camera, light: DirectionalLight) -> None:
-        shared = camera_uniforms(camera) | light.uniforms()
+        shared = camera_uniforms(camera) | model_offset(camera, self.mesh.origin) | light.uniforms()
         for prog in self.programs:
             set_uniforms(prog, shared)
         for draw in self.draws:

@@ -1,6 +1,7 @@
 """Convex proxy geometry: the halfspaces of a (projective) box, an AABB, their intersection.
 
-A proxy is a convex polyhedron in world space with outward counter-clockwise triangles,
+A proxy is a convex polyhedron in world space with outward counter-clockwise triangles
+(float32 vertices relative to a float64 ``origin`` inside it, so far boxes stay exact),
 rasterized so that a fragment shader can resolve the detail inside it. Shaders that rebuild
 each pixel's ray from the window position accept any convex proxy that contains the visible
 surface: a whole box (frustum), or a box cut to the object's bounds, which rasterizes fewer
@@ -19,9 +20,15 @@ from ..errors import UsageError
 
 @dataclass(frozen=True)
 class Proxy:
-    positions: np.ndarray   # (V, 3) float32 world
+    positions: np.ndarray   # (V, 3) float32 relative to origin
     triangles: np.ndarray   # (F, 3) uint32, outward CCW
-    planes: np.ndarray      # (P, 4) inside where planes @ (x, y, z, 1) <= 0
+    planes: np.ndarray      # (P, 4) world, inside where planes @ (x, y, z, 1) <= 0
+    origin: np.ndarray      # (3,) float64 world point inside the proxy
+
+    @property
+    def world_positions(self) -> np.ndarray:
+        """(V, 3) float64 world vertices."""
+        return self.positions.astype(np.float64) + self.origin
 
 
 def box_planes(world_to_box: np.ndarray) -> np.ndarray:
@@ -53,18 +60,30 @@ def _normalise(planes: np.ndarray) -> np.ndarray:
     return planes / np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
 
 
-def convex_proxy(planes: np.ndarray) -> Proxy:
-    """Triangulated intersection of halfspaces ``planes @ (x, 1) <= 0``."""
+def convex_proxy(planes: np.ndarray, near=(0.0, 0.0, 0.0)) -> Proxy:
+    """Triangulated intersection of halfspaces ``planes @ (x, 1) <= 0``.
+
+    Solved around ``near`` (a world point close to the region, e.g. a box's centre) and then
+    around a point inside: the solvers' tolerances are relative to the coordinates'
+    magnitude, which far from the world origin would swamp the box.
+    """
     planes = _normalise(np.asarray(planes, dtype=np.float64))
-    interior = _interior_point(planes)
-    vertices = HalfspaceIntersection(planes, interior).intersections
+    near = np.asarray(near, dtype=np.float64)
+    origin = near + _interior_point(_moved(planes, near))
+    local = _moved(planes, origin)
+    vertices = HalfspaceIntersection(local, np.zeros(3)).intersections
     hull = ConvexHull(vertices)
     tris = hull.simplices.copy()
     centre = vertices[hull.vertices].mean(axis=0)
     a, b, c = (vertices[tris[:, k]] for k in range(3))
     outward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - centre) > 0
     tris[~outward] = tris[~outward][:, ::-1]
-    return Proxy(vertices.astype(np.float32), tris.astype(np.uint32), planes)
+    return Proxy(vertices.astype(np.float32), tris.astype(np.uint32), planes, origin)
+
+
+def _moved(planes: np.ndarray, origin: np.ndarray) -> np.ndarray:
+    """The planes in coordinates relative to ``origin``."""
+    return np.hstack([planes[:, :3], planes[:, 3:] + planes[:, :3] @ origin[:, None]])
 
 
 def _interior_point(planes: np.ndarray) -> np.ndarray:

@@ -118,6 +118,12 @@ class Camera:
         return self.ortho_height is not None
 
     @property
+    def origin(self) -> np.ndarray:
+        """The point shaders measure world space from (`gl.uniforms.camera_uniforms`): the
+        target, so that float32 keeps full precision around what the camera looks at."""
+        return np.asarray(self.target, dtype=np.float64)
+
+    @property
     def view(self) -> np.ndarray:
         """World -> eye 4x4 matrix."""
         return look_at(self.eye, self.target, self.up)
@@ -158,6 +164,8 @@ class MatrixCamera:
     """A camera given directly by its matrices (projective ``view`` allowed), for baking.
 
     Shading treats it as orthographic looking along ``view_dir`` (scene towards viewer).
+    ``origin`` is the world point shaders measure from (see `Camera.origin`), e.g. the
+    centre of the baked box.
     """
 
     view: np.ndarray
@@ -165,6 +173,7 @@ class MatrixCamera:
     size: tuple
     view_dir: tuple = (0.0, 0.0, 1.0)
     near: float = 0.0
+    origin: tuple = (0.0, 0.0, 0.0)
 
     orthographic = True
 

@@ -14,6 +14,12 @@ from ..errors import MeshError
 #: Most materials one mesh may have (per-triangle material indices are uint16).
 MAX_MATERIALS = 1 << 16
 
+#: A mesh whose bounding-box centre lies farther from the world origin than this many times
+#: its extent keeps its positions relative to that centre (`RenderMesh.origin`): float32
+#: resolves about 2^-24 of a coordinate's magnitude, so beyond this ratio it would blur the
+#: mesh's own detail (georeferenced scans sit 1e6..1e8 units away).
+FAR_RATIO = 256.0
+
 #: How a material's alpha (vertex colour x factor x texture) is used, as glTF's alphaMode.
 ALPHA_MODES = ("OPAQUE", "MASK", "BLEND")
 
@@ -99,7 +105,10 @@ class RenderMesh:
 
     Attributes
     ----------
-    positions : (V, 3) float32 world-space vertex positions.
+    positions : (V, 3) float32 vertex positions relative to `origin`.
+    origin : (3,) float64 world point the positions are relative to: the zero vector unless
+        the mesh lies far from the world origin (`FAR_RATIO`), then its bounding-box centre;
+        `world_positions`, `bounds` and `center` are in the file's own world coordinates.
     indices : (F, 3) uint32 triangle corners (counter-clockwise is the front face).
     normals : (V, 3) float32 unit vertex normals.
     colors : (V, 4) float32 linear RGBA base colour per vertex, in [0, 1].
@@ -127,11 +136,13 @@ class RenderMesh:
 
     def __init__(self, positions, indices, normals, colors, uvs=None, texture=None,
                  name: str = "mesh", extra: dict | None = None, *, materials=None,
-                 material=None) -> None:
+                 material=None, origin=None) -> None:
         set_ = object.__setattr__
         set_(self, "name", name)
         set_(self, "extra", {} if extra is None else extra)
-        set_(self, "positions", _array(positions, np.float32, 3, "positions", name))
+        relative, origin = _relative_positions(positions, origin, name)
+        set_(self, "positions", relative)
+        set_(self, "origin", origin)
         set_(self, "indices", _indices(indices, len(self.positions), name))
         set_(self, "normals", _array(normals, np.float32, 3, "normals", name))
         set_(self, "colors", _array(colors, np.float32, 4, "colors", name))
@@ -173,19 +184,26 @@ class RenderMesh:
                 for k, m in enumerate(self.materials) if counts[k]]
 
     @property
+    def world_positions(self) -> np.ndarray:
+        """(V, 3) float64 vertex positions in world coordinates (`positions` + `origin`)."""
+        return self.positions.astype(np.float64) + self.origin
+
+    @property
     def bounds(self) -> np.ndarray:
-        """(2, 3) array: minimum and maximum corner of the axis-aligned bounding box."""
-        return np.stack([self.positions.min(axis=0), self.positions.max(axis=0)])
+        """(2, 3) float64 minimum and maximum world corner of the axis-aligned bounding box."""
+        local = np.stack([self.positions.min(axis=0), self.positions.max(axis=0)])
+        return local.astype(np.float64) + self.origin
 
     @property
     def center(self) -> np.ndarray:
-        """Centre of the bounding box."""
+        """Centre of the bounding box (world)."""
         return self.bounds.mean(axis=0)
 
     @property
     def radius(self) -> float:
         """Radius of the bounding sphere around `center` (never zero)."""
-        r = float(np.linalg.norm(self.positions - self.center, axis=1).max())
+        local_center = self.center - self.origin
+        r = float(np.linalg.norm(self.positions - local_center, axis=1).max())
         return r if r > 0 else 1.0
 
     @property
@@ -204,6 +222,35 @@ def _array(a, dtype, cols: int, label: str, name: str) -> np.ndarray:
         bad = int((~np.isfinite(arr)).any(axis=1).sum())
         raise MeshError(f"{name}: {label} has {bad} rows with NaN or Inf values")
     return arr
+
+
+def _relative_positions(positions, origin, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """float32 positions relative to a float64 origin: the given one, or the zero vector, or
+    (for a mesh far from the world origin, see `FAR_RATIO`) its bounding-box centre."""
+    dtype = getattr(positions, "dtype", None)
+    wide = dtype if dtype in (np.float32, np.float64) else np.float64  # no float32 round trip
+    points = _array(positions, wide, 3, "positions", name)
+    if origin is not None:
+        origin = np.asarray(origin, dtype=np.float64)
+        if origin.shape != (3,) or not np.isfinite(origin).all():
+            raise MeshError(f"{name}: origin must be 3 finite numbers")
+        return np.ascontiguousarray(points, dtype=np.float32), origin
+    origin = _far_origin(points)
+    if origin.any():
+        points = points.astype(np.float64) - origin
+    return np.ascontiguousarray(points, dtype=np.float32), origin
+
+
+def _far_origin(points: np.ndarray) -> np.ndarray:
+    """The bounding-box centre of points far from the world origin, else the zero vector."""
+    if not len(points):
+        return np.zeros(3)
+    low = points.min(axis=0).astype(np.float64)
+    high = points.max(axis=0).astype(np.float64)
+    centre = (low + high) / 2
+    if np.abs(centre).max() > FAR_RATIO * float((high - low).max()):
+        return centre
+    return np.zeros(3)
 
 
 def _materials(materials, texture, name: str) -> tuple[Material, ...]:

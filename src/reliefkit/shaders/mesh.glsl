@@ -6,6 +6,7 @@
 
 #if defined VERTEX_SHADER
 #include "include/camera.glsl"
+uniform vec3 u_model_offset;  // from the mesh's origin to the camera's (gl/uniforms.py)
 in vec3 in_position;
 in vec3 in_normal;
 in vec4 in_color;
@@ -19,13 +20,13 @@ out vec2 v_uv;
 #endif
 
 void main() {
-    v_world = in_position;
+    v_world = in_position + u_model_offset;
     v_normal = in_normal;
     v_color = in_color;
 #if defined HAS_TEXTURE
     v_uv = (u_uv_transform * vec3(in_uv, 1.0)).xy;
 #endif
-    gl_Position = u_proj * u_view * vec4(in_position, 1.0);
+    gl_Position = u_proj * u_view * vec4(v_world, 1.0);
 }
 #endif
 

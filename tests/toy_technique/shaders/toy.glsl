@@ -3,12 +3,13 @@
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
+uniform vec3 u_model_offset;  // from the quad's centre to the camera's origin
 in vec3 in_position;
 out vec3 v_world;
 
 void main() {
-    v_world = in_position;
-    gl_Position = u_proj * u_view * vec4(in_position, 1.0);
+    v_world = in_position + u_model_offset;
+    gl_Position = u_proj * u_view * vec4(v_world, 1.0);
 }
 #endif
 

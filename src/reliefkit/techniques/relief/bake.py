@@ -33,7 +33,7 @@ def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, 
     if depth_res < 8:
         raise UsageError(f"depth resolution must be at least 8, got {depth_res}")
     frame = axis_frame(axis)
-    local = mesh.positions.astype(np.float64) @ frame.T
+    local = mesh.world_positions @ frame.T
     lo, hi = local.min(axis=0), local.max(axis=0)
     ext = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1e-30))
     texel = max(ext[0], ext[1]) / (depth_res - 2 * BORDER_TEXELS)

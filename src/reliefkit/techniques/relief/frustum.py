@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...bake.project import axis_frame, cube_face_frames
+from ...core.transforms import translation
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
 from .bake import BORDER_TEXELS, DEFAULT_TOLERANCE, bake_through
@@ -30,13 +31,12 @@ def frustum_matrix(apex, frame, tan_u: float, tan_v: float, near: float,
         raise UsageError(f"frustum needs 0 < near < far, got {near}, {far}")
     view = np.eye(4)
     axes = np.asarray(frame, dtype=np.float64) * np.array([[1.0], [1.0], [-1.0]])
-    view[:3, :3] = axes
-    view[:3, 3] = -axes @ np.asarray(apex, dtype=np.float64)
+    view[:3, :3] = axes  # looking from the world origin; moved to the apex afterwards, exactly
     proj = np.zeros((4, 4))  # OpenGL perspective: eye looks down -z, w = distance > 0
     proj[0, 0], proj[1, 1] = 1.0 / tan_u, 1.0 / tan_v
     proj[2, 2], proj[2, 3] = (far + near) / (near - far), 2.0 * far * near / (near - far)
     proj[3, 2] = -1.0
-    return np.linalg.inv(UNIT_FROM_NDC @ proj @ view)
+    return translation(apex) @ np.linalg.inv(UNIT_FROM_NDC @ proj @ view)
 
 
 def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 30.0,
@@ -49,7 +49,7 @@ def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 3
     if not 1.0 <= spread_deg <= 75.0:
         raise UsageError(f"frustum spread must be between 1 and 75 degrees, got {spread_deg}")
     frame = axis_frame(axis)
-    local = mesh.positions.astype(np.float64) @ frame.T
+    local = mesh.world_positions @ frame.T
     lo, hi = local.min(axis=0), local.max(axis=0)
     centre = (lo + hi) / 2
     half = np.maximum((hi - lo) / 2, 1e-9 * float(np.max(hi - lo)))

@@ -7,11 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.params import param
+from ...core.transforms import translation
 from ...errors import UsageError
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
 from ...gl.textures import texture2d
-from ...gl.uniforms import camera_uniforms, set_uniforms
+from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
 from ...render.proxy import aabb_planes, box_planes, convex_proxy
 from .representation import ReliefObject, ReliefTexture
@@ -47,7 +48,7 @@ def relief_proxy(relief: ReliefTexture):
     planes = box_planes(relief.world_to_box)
     if relief.clip_bounds is not None:
         planes = np.vstack([planes, aabb_planes(relief.clip_bounds)])
-    return convex_proxy(planes)
+    return convex_proxy(planes, near=relief.center)
 
 
 class ReliefDrawable:
@@ -90,7 +91,6 @@ class ReliefDrawable:
             self.release()
             raise
         self.uniforms = {
-            "u_box_to_world": relief.box_to_world, "u_world_to_box": relief.world_to_box,
             "u_hf_size": (w, h), "u_linear_steps": opts.linear_steps,
             "u_binary_steps": opts.binary_steps,
             "u_max_iterations": opts.max_iterations or 4 * (w + h) + 64,
@@ -105,13 +105,16 @@ class ReliefDrawable:
         Then its front faces would be clipped and the back faces are drawn instead; the
         shader builds the ray from the window position, not from the face it was drawn for.
         """
-        eye_z = np.c_[self.proxy.positions, np.ones(len(self.proxy.positions))] @ camera.view[2]
+        corners = self.proxy.world_positions
+        eye_z = np.c_[corners, np.ones(len(corners))] @ camera.view[2]
         return bool(eye_z.max() > -camera.near * 1.001)
 
     def draw(self, camera, light) -> None:
         import moderngl
 
-        set_uniforms(self.prog, self.uniforms | camera_uniforms(camera) | light.uniforms())
+        set_uniforms(self.prog, self.uniforms | self._box_uniforms(camera)
+                     | camera_uniforms(camera) | model_offset(camera, self.proxy.origin)
+                     | light.uniforms())
         for unit, (name, tex) in enumerate(self.textures.items()):
             tex.use(unit)
             set_uniforms(self.prog, {name: unit})
@@ -119,6 +122,11 @@ class ReliefDrawable:
         self.ctx.cull_face = "front" if self.reaches_near_plane(camera) else "back"
         self.vao.render()
         self.ctx.disable(moderngl.CULL_FACE)
+
+    def _box_uniforms(self, camera) -> dict:
+        """The box transforms in the camera's relative world space (float64 products)."""
+        relative = translation(-np.asarray(camera.origin)) @ self.relief.box_to_world
+        return {"u_box_to_world": relative, "u_world_to_box": np.linalg.inv(relative)}
 
     def finish(self, frame) -> None:
         """Depth AOV from the hit positions (in conservative mode the Z-buffer holds the box)."""

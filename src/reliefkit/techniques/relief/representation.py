@@ -6,7 +6,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.transforms import MAX_COORDINATE, transform_points, unit_cube_corners
+from ...core.transforms import (
+    MAX_COORDINATE,
+    box_center,
+    invert_box,
+    transform_points,
+    translation,
+    unit_cube_corners,
+)
 from ...errors import UsageError
 
 
@@ -95,12 +102,17 @@ class ReliefTexture:
 
     @property
     def world_to_box(self) -> np.ndarray:
-        return np.linalg.inv(self.box_to_world)
+        return invert_box(self.box_to_world)
 
     @property
     def corners(self) -> np.ndarray:
         """(8, 3) world positions of the box (frustum) corners, index = u + 2v + 4h."""
         return transform_points(self.box_to_world, unit_cube_corners())
+
+    @property
+    def center(self) -> np.ndarray:
+        """World point at the centre of the box (frustum): box coordinates (0.5, 0.5, 0.5)."""
+        return box_center(self.box_to_world)
 
     @property
     def bounds(self) -> np.ndarray:
@@ -151,7 +163,10 @@ def _checked_box(matrix) -> np.ndarray:
     if m.shape != (4, 4) or not np.isfinite(m).all():
         raise UsageError("box_to_world must be a finite 4x4 matrix")
     with np.errstate(all="ignore"):
-        condition = np.linalg.cond(m)
+        centre = m @ [0.5, 0.5, 0.5, 1.0]
+        centre = centre[:3] / centre[3] if np.isfinite(centre[:3] / centre[3]).all() else 0.0
+        # conditioned as drawn: relative to the box (camera-relative rendering), wherever it is
+        condition = np.linalg.cond(translation(-centre) @ m)
         corners = np.c_[unit_cube_corners(), np.ones(8)] @ m.T
     if not np.isfinite(condition) or condition > MAX_CONDITION:
         raise UsageError(f"box_to_world is singular or badly conditioned (condition number "
@@ -163,10 +178,10 @@ def _checked_box(matrix) -> np.ndarray:
     points = corners[:, :3] / w[:, None]
     extent = float(np.ptp(points, axis=0).max())
     reach = float(np.abs(points).max())
-    if not np.isfinite(points).all() or reach > MAX_COORDINATE or extent <= reach * 1e-7 \
+    if not np.isfinite(points).all() or reach > MAX_COORDINATE or extent <= reach * 1e-12 \
             or extent < MIN_EXTENT:
         raise UsageError(f"box_to_world puts the box at {reach:.3g} from the origin with a "
-                         f"size of {extent:.3g}; it cannot be drawn in float32")
+                         f"size of {extent:.3g}; it cannot be drawn there")
     return m
 
 

@@ -4,10 +4,11 @@
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
-in vec3 in_position;   // proxy vertex in world space (render.py relief_proxy)
+in vec3 in_position;   // proxy vertex relative to its origin (render.py relief_proxy)
+uniform vec3 u_model_offset;  // from the proxy's origin to the camera's (gl/uniforms.py)
 
 void main() {
-    gl_Position = u_proj * u_view * vec4(in_position, 1.0);
+    gl_Position = u_proj * u_view * vec4(in_position + u_model_offset, 1.0);
 }
 #endif
 
