@@ -111,7 +111,9 @@ class RenderMesh:
         `world_positions`, `bounds` and `center` are in the file's own world coordinates.
     indices : (F, 3) uint32 triangle corners (counter-clockwise is the front face).
     normals : (V, 3) float32 unit vertex normals.
-    colors : (V, 4) float32 linear RGBA base colour per vertex, in [0, 1].
+    colors : (V, 4) float32 linear RGBA base colour per vertex, in [0, 1]; one colour for all
+        vertices may be a read-only broadcast view (stride 0), which takes no memory per
+        vertex (loaders give uncoloured meshes so).
     uvs : (V, 2) float32 texture coordinates (GL convention, v up) or None; shared by all
         materials, required when one has a texture.
     materials : tuple of at least one `Material`.
@@ -145,7 +147,7 @@ class RenderMesh:
         set_(self, "origin", origin)
         set_(self, "indices", _indices(indices, len(self.positions), name))
         set_(self, "normals", _array(normals, np.float32, 3, "normals", name))
-        set_(self, "colors", _array(colors, np.float32, 4, "colors", name))
+        set_(self, "colors", _colors(colors, name))
         v = len(self.positions)
         for label, arr in (("normals", self.normals), ("colors", self.colors)):
             if len(arr) != v:
@@ -236,9 +238,25 @@ def _relative_positions(positions, origin, name: str) -> tuple[np.ndarray, np.nd
             raise MeshError(f"{name}: origin must be 3 finite numbers")
         return np.ascontiguousarray(points, dtype=np.float32), origin
     origin = _far_origin(points)
-    if origin.any():
-        points = points.astype(np.float64) - origin
-    return np.ascontiguousarray(points, dtype=np.float32), origin
+    if not origin.any():
+        return np.ascontiguousarray(points, dtype=np.float32), origin
+    relative = np.empty(points.shape, np.float32)  # in blocks: no second float64 copy
+    for start in range(0, len(points), _BLOCK):
+        block = slice(start, start + _BLOCK)
+        relative[block] = points[block] - origin
+    return relative, origin
+
+
+def _colors(colors, name: str) -> np.ndarray:
+    """(V, 4) float32 colours; a broadcast of one row stays a view (checked once)."""
+    if isinstance(colors, np.ndarray) and colors.ndim == 2 and colors.shape[1] == 4 \
+            and colors.strides[0] == 0 and len(colors):
+        row = _array(colors[:1], np.float32, 4, "colors", name)
+        return np.broadcast_to(row[0], colors.shape)
+    return _array(colors, np.float32, 4, "colors", name)
+
+
+_BLOCK = 1 << 16  # rows per block of whole-mesh arithmetic
 
 
 def _far_origin(points: np.ndarray) -> np.ndarray:

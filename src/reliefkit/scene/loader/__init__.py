@@ -12,6 +12,7 @@ usable normals (:mod:`.normals`), and one `MeshError` naming the file for any ba
 from __future__ import annotations
 
 import contextlib
+import gc
 import logging
 import os
 import warnings
@@ -27,9 +28,10 @@ from .merge import render_mesh
 from .obj import check_obj
 from .off import check_off
 from .parse import parse_file
+from .plain_obj import read_plain_obj
 from .ply import check_ply
 from .scene import MAX_COORDINATE, check_visible, scene_parts
-from .stl import check_stl
+from .stl import binary_stl, check_stl
 from .texture_transform import uv_transforms
 
 __all__ = ["MAX_COORDINATE", "MAX_FILE_BYTES", "SUPPORTED_EXTENSIONS", "load_mesh"]
@@ -130,16 +132,11 @@ def _silenced():
 
 def _load(path: Path, label: str) -> RenderMesh:
     file_type = _file_type(path)
-    data = _read_bytes(path)
-    if not data:
-        raise BadFile("is empty (0 bytes)")
     notes: list[str] = []  # the load's warnings (a missing .mtl, dropped references)
-    data = check_obj(data, notes) if file_type == "obj" else _PRECHECKS[file_type](data)
-    if file_type in _GLTF_FORMATS:
-        data = triangulate_fans(data, file_type, path.parent)
-    scene = parse_file(data, file_type, path, notes)
-    transforms = uv_transforms(data, file_type, scene) if file_type in _GLTF_FORMATS else {}
+    scene, transforms = _parsed(path, file_type, notes)
     parts = scene_parts(scene, srgb=file_type not in _GLTF_FORMATS, uv_transforms=transforms)
+    del scene  # trimesh's other arrays and caches (and the file's bytes, which its load
+    gc.collect()  # record keeps) go before the mesh is merged; they sit in reference cycles
     if not parts:
         raise BadFile("contains no triangles (only points, lines or nothing); nothing to render")
     check_visible(parts)
@@ -147,6 +144,30 @@ def _load(path: Path, label: str) -> RenderMesh:
     if notes:  # before the ones merging found (textures, see .materials)
         mesh.extra["warnings"] = notes + list(mesh.extra.get("warnings", []))
     return mesh
+
+
+def _parsed(path: Path, file_type: str, notes: list[str]):
+    """The file checked and parsed: (trimesh scene, glTF UV transforms by geometry).
+
+    The file's bytes live only in here, so they are freed before the scene is flattened.
+    """
+    data = _read_bytes(path)
+    if not data:
+        raise BadFile("is empty (0 bytes)")
+    if file_type == "obj":
+        plain = read_plain_obj(data)
+        if plain is not None:  # the common large case, read without trimesh's text copies
+            del data
+            return parse_file(plain, file_type, path, notes), {}
+    data = check_obj(data, notes) if file_type == "obj" else _PRECHECKS[file_type](data)
+    if file_type == "stl" and (binary := binary_stl(data)) is not None:
+        del data  # read in place, not copied once more by trimesh
+        return parse_file(binary, file_type, path, notes), {}
+    if file_type in _GLTF_FORMATS:
+        data = triangulate_fans(data, file_type, path.parent)
+    scene = parse_file(data, file_type, path, notes)
+    transforms = uv_transforms(data, file_type, scene) if file_type in _GLTF_FORMATS else {}
+    return scene, transforms
 
 
 def _file_type(path: Path) -> str:

@@ -57,6 +57,12 @@ def decode_colors(colors, srgb: bool) -> np.ndarray:
     return unit
 
 
+def uniform_colors(color, count: int) -> np.ndarray:
+    """(count, 4) float64 of one colour, as a read-only view that takes no memory per vertex
+    (a large mesh without colours would otherwise carry 32 bytes per vertex of them)."""
+    return np.broadcast_to(np.asarray(color, dtype=np.float64), (count, 4))
+
+
 class SurfaceReader:
     """Colours, UVs and `Material`s of trimesh visuals, each material and image read once.
 
@@ -77,9 +83,9 @@ class SurfaceReader:
         if isinstance(visual, trimesh.visual.ColorVisuals) and visual.kind == "vertex":
             return decode_colors(visual.vertex_colors, self.srgb), None, Material()
         if not isinstance(visual, trimesh.visual.TextureVisuals):
-            return np.tile(DEFAULT_COLOR, (count, 1)), None, Material()
+            return uniform_colors(DEFAULT_COLOR, count), None, Material()
         material = self.material(visual.material)
-        colors = np.ones((count, 4))
+        colors = uniform_colors((1.0, 1.0, 1.0, 1.0), count)
         vertex_colors = visual.vertex_attributes.get("color")
         if vertex_colors is not None and len(vertex_colors) == count:
             colors = decode_colors(vertex_colors, self.srgb)

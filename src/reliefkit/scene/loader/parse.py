@@ -16,6 +16,8 @@ import trimesh
 
 from .badfile import BadFile, as_utf8, read_regular
 from .materials import begin_warnings, note_texture_problem
+from .plain_obj import PlainObj
+from .stl import BinaryStl
 
 
 class _RecordingResolver(trimesh.resolvers.FilePathResolver):
@@ -138,19 +140,24 @@ def _child_any_case(folder: Path, name: str) -> Path | None:
     return min((p for p in folder.iterdir() if p.name.lower() == name.lower()), default=None)
 
 
-def parse_file(data: bytes, file_type: str, path: Path,
+def parse_file(data: bytes | PlainObj | BinaryStl, file_type: str, path: Path,
                warnings_out: list[str] | None = None) -> trimesh.Scene:
     """Parse with trimesh quietly; what it raises, or logs as lost, becomes `BadFile`.
 
-    Problems that still leave a usable mesh (a missing .mtl) are appended to `warnings_out`.
+    `data` is the file's bytes, or the arrays of a plain OBJ (:mod:`.plain_obj`) or a binary
+    STL (:mod:`.stl`), which trimesh turns into its scene as it would the file's. Problems
+    that still leave a usable mesh (a missing .mtl) are appended to `warnings_out`.
     """
     resolver = _RecordingResolver(path)
     begin_warnings()  # a new load: notes a failed one may have left are forgotten
     try:
         with _quiet(resolver) as logged:
+            source = (data.scene_kwargs(resolver.file_name)
+                      if isinstance(data, (PlainObj, BinaryStl)) else io.BytesIO(data))
             scene = trimesh.load_scene(
-                io.BytesIO(data), file_type=file_type, resolver=resolver, process=False
+                source, file_type=file_type, resolver=resolver, process=False
             )
+            del source
     except MemoryError:
         raise BadFile(resolver.problem() or "ran out of memory while parsing it; is it corrupt, "
                       "or too large for this machine?") from None

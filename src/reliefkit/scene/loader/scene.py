@@ -27,6 +27,8 @@ from .normals import file_normals
 # draws nothing.
 _VISIBLE = 2.0**-23
 
+_BLOCK = 1 << 16  # triangles per block where a whole-mesh temporary would be large
+
 
 @dataclass(frozen=True)
 class Part:
@@ -34,8 +36,8 @@ class Part:
 
     positions: np.ndarray  # (V, 3) float64
     faces: np.ndarray  # (F, 3) int64, indices into this part
-    normals: np.ndarray  # (V, 3) float64 from the file; NaN rows where there are none
-    colors: np.ndarray  # (V, 4) float64 linear RGBA vertex colours
+    normals: np.ndarray | None  # (V, 3) float64 from the file (NaN rows: none); None: no row
+    colors: np.ndarray  # (V, 4) float64 linear RGBA vertex colours (a broadcast view if uniform)
     uvs: np.ndarray | None = None  # (V, 2) float64
     material: Material = field(default_factory=Material)
 
@@ -83,8 +85,7 @@ def _local_part(geometry, surfaces: SurfaceReader, where: str) -> Part | None:
     part = Part(positions, faces, file_normals(geometry), *surface)
     if is_face_colored(geometry.visual):
         face_colors = decode_colors(geometry.visual.face_colors, surfaces.srgb)
-        corner_colors = np.repeat(face_colors, 3, axis=0)
-        part = replace(_unshared(part), colors=corner_colors)
+        part = _unshared(part, np.repeat(face_colors, 3, axis=0))
     return part
 
 
@@ -92,7 +93,7 @@ def _check_magnitude(positions: np.ndarray, where: str) -> None:
     """Refuse coordinates beyond `MAX_COORDINATE` (finite ones; NaN/Inf are refused before)."""
     if positions.size == 0:
         return
-    big = float(np.abs(positions).max())
+    big = max(float(positions.max()), -float(positions.min()))  # no (V, 3) temporary
     if big > MAX_COORDINATE:
         count = int((np.abs(positions) > MAX_COORDINATE).any(axis=1).sum())
         raise BadFile(
@@ -114,10 +115,11 @@ def check_visible(parts: list[Part]) -> None:
         high = np.max([p.positions.max(axis=0) for p in parts], axis=0)
         threshold = (_VISIBLE * float(np.linalg.norm(high - low))) ** 2
         for part in parts:
-            a, b, c = (part.positions[part.faces[:, k]] for k in range(3))
-            doubled = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-            if (doubled > threshold).any():
-                return
+            for start in range(0, len(part.faces), _BLOCK):  # a few MB of temporaries each
+                a, b, c = (part.positions[part.faces[start:start + _BLOCK, k]] for k in range(3))
+                doubled = np.linalg.norm(np.cross(b - a, c - a), axis=1)
+                if (doubled > threshold).any():
+                    return
     raise BadFile(
         "has no triangle with a visible area (every face has zero area: collinear or "
         "coincident corners, or a scale of 0); nothing visible would be drawn")
@@ -127,14 +129,15 @@ def _vertices_have(count: int) -> str:
     return "1 vertex has" if count == 1 else f"{count} vertices have"
 
 
-def _unshared(part: Part) -> Part:
-    """The same triangles with three vertices of their own each (for per-face attributes)."""
+def _unshared(part: Part, corner_colors: np.ndarray) -> Part:
+    """The same triangles with three vertices of their own each, coloured per corner (for
+    per-face colours)."""
     corners = part.faces.reshape(-1)
     return Part(
         positions=part.positions[corners],
         faces=np.arange(len(corners), dtype=np.int64).reshape(-1, 3),
-        normals=part.normals[corners],
-        colors=part.colors[corners],
+        normals=None if part.normals is None else part.normals[corners],
+        colors=corner_colors,
         uvs=None if part.uvs is None else part.uvs[corners],
         material=part.material,
     )
@@ -150,7 +153,8 @@ def _placed(part: Part, matrix: np.ndarray) -> Part:
     det = np.linalg.det(linear)
     with np.errstate(all="ignore"):
         positions = part.positions @ linear.T + matrix[:3, 3]
-        normals = part.normals @ (np.sign(det) * _cofactor(linear)).T
+        normals = (None if part.normals is None
+                   else part.normals @ (np.sign(det) * _cofactor(linear)).T)
     bad = int((~np.isfinite(positions)).any(axis=1).sum())
     if bad:
         raise BadFile(f"{_vertices_have(bad)} NaN or Inf coordinates after the scene transforms")

@@ -1,0 +1,189 @@
+"""Plain OBJ files read with numpy: the common large case, in a few times the file's size.
+
+trimesh's OBJ reader and the record-by-record checks of :mod:`.obj` hold Python strings and
+match objects per line, 7 to 25 times the file in memory. A *plain* file (ASCII, every line
+empty, a comment, ``v x y z``, ``vn x y z`` or a triangle ``f`` whose corners are all ``v``
+or all ``v//vn`` with positive indices in range) is read here into exactly the arrays
+trimesh's reader builds from it, and `PlainObj.scene_kwargs` hands them to trimesh in its own
+keyword form. Anything else (materials, groups, UVs, polygons, relative or bad indices,
+odd numbers) returns None and takes the general way, with its checks and messages.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from trimesh.visual.texture import unmerge_faces
+
+_NEWLINE, _SPACE, _SLASH = ord("\n"), ord(" "), ord("/")
+_OTHER, _SKIPPED, _V, _VN, _F = range(5)  # line kinds
+
+
+def _byte_set(chars: bytes) -> np.ndarray:
+    table = np.zeros(256, bool)
+    table[list(chars)] = True
+    return table
+
+
+_NUMBER_BYTES = _byte_set(b"0123456789.eE+- \n")
+_CORNER_BYTES = _byte_set(b"0123456789/ \n")
+_DIGITS = _byte_set(b"0123456789")
+
+
+@dataclass
+class PlainObj:
+    """The arrays of a plain OBJ: positions, normals, and 0-based corners per triangle."""
+
+    vertices: np.ndarray  # (V, 3) float64
+    normals: np.ndarray | None  # (N, 3) float64, None without vn lines
+    faces: np.ndarray  # (F, 3) int64 into vertices
+    face_normals: np.ndarray | None  # (F, 3) int64 into normals, None for 'v' corners
+
+    def scene_kwargs(self, name: str) -> dict:
+        """What trimesh's `load_obj` returns for the file (process=False), geometry `name`.
+
+        The arrays are handed over: this object is empty afterwards.
+        """
+        v, vn, faces, faces_norm = self.vertices, self.normals, self.faces, self.face_normals
+        self.vertices = self.normals = self.faces = self.face_normals = None
+        mesh = {"file_type": "obj", "process": False}
+        if faces_norm is not None:
+            faces, mask_v, mask_vn = unmerge_faces(faces, faces_norm, maintain_faces=False)
+            mesh.update(faces=faces, vertices=v[mask_v].copy(), vertex_normals=vn[mask_vn])
+        else:
+            used = np.zeros(len(v), dtype=bool)
+            used[faces] = True
+            inverse = np.zeros(len(v), dtype=np.int64)
+            inverse[used] = np.arange(used.sum())
+            mesh.update(faces=inverse[faces], vertices=v[used].copy())
+        mesh["visual"] = None
+        return {"process": False, "geometry": {name: mesh},
+                "graph": [{"geometry": name, "frame_to": name}]}
+
+
+def read_plain_obj(data: bytes) -> PlainObj | None:
+    """The arrays of a plain OBJ file (see the module docstring), or None for any other."""
+    if not data.isascii() or any(b in data for b in (b"\r", b"\t", b"\\", b"\0", b"+e", b"-e")):
+        return None
+    text = np.frombuffer(data, np.uint8)
+    ends = np.flatnonzero(text == _NEWLINE)
+    if not data.endswith(b"\n"):
+        ends = np.append(ends, len(text))
+    starts = np.concatenate([[0], ends[:-1] + 1])
+    kinds = _line_kinds(text, starts, ends)
+    if (kinds == _OTHER).any() or not (kinds == _F).any():
+        return None
+    vertices = _numbers(text, starts, kinds == _V, 1)
+    normals = _numbers(text, starts, kinds == _VN, 2) if (kinds == _VN).any() else None
+    corners = _corners(text, starts, kinds == _F)
+    if vertices is None or corners is None or ((kinds == _VN).any() and normals is None):
+        return None
+    faces, face_normals = corners
+    if not _in_range(faces, len(vertices)):
+        return None
+    if face_normals is not None and (normals is None or not _in_range(face_normals,
+                                                                      len(normals))):
+        return None
+    return PlainObj(vertices, normals, faces - 1, None if face_normals is None
+                    else face_normals - 1)
+
+
+def _line_kinds(text: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Each line's kind: skipped (empty or a comment), v, vn, f or other."""
+    def byte(offset: int) -> np.ndarray:
+        at = np.minimum(starts + offset, len(text) - 1)
+        return np.where(starts + offset < ends, text[at], _NEWLINE)
+
+    first, second, third = byte(0), byte(1), byte(2)
+    kinds = np.full(len(starts), _OTHER, np.uint8)
+    kinds[(first == _NEWLINE) | (first == ord("#"))] = _SKIPPED
+    kinds[(first == ord("v")) & (second == _SPACE)] = _V
+    kinds[(first == ord("v")) & (second == ord("n")) & (third == _SPACE)] = _VN
+    kinds[(first == ord("f")) & (second == _SPACE)] = _F
+    return kinds
+
+
+def _contents(text: np.ndarray, starts: np.ndarray, chosen: np.ndarray, keyword: int) -> np.ndarray:
+    """The chosen lines with their newlines, the `keyword` bytes blanked to spaces."""
+    lengths = np.diff(np.append(starts, len(text)))  # each line with its newline
+    content = text[np.repeat(chosen, lengths)]
+    kept = lengths[chosen]
+    first = np.cumsum(kept) - kept  # where each chosen line starts in `content`
+    for k in range(keyword):
+        content[first + k] = _SPACE
+    return content
+
+
+def _tokens(content: np.ndarray, lines: int, per_line: int) -> np.ndarray | None:
+    """Where each whitespace-separated token starts, when every line has `per_line`."""
+    blank = _blank(content)
+    after_blank = np.concatenate([[True], blank[:-1]])
+    starts = np.flatnonzero(np.greater(after_blank, blank, out=after_blank))  # and not blank
+    ended = np.searchsorted(starts, np.flatnonzero(content == _NEWLINE))  # tokens before
+    if len(starts) != lines * per_line or (np.diff(ended, prepend=0) != per_line).any():
+        return None
+    return starts
+
+
+def _blank(content: np.ndarray) -> np.ndarray:
+    blank = content == _SPACE
+    blank |= content == _NEWLINE
+    return blank
+
+
+def _parsed(content: np.ndarray, dtype) -> np.ndarray:
+    with warnings.catch_warnings():  # numpy warns where it stops early; the count tells
+        warnings.simplefilter("ignore")
+        return np.fromstring(content.tobytes(), dtype=dtype, sep=" ")
+
+
+def _numbers(text, starts, chosen, keyword: int) -> np.ndarray | None:
+    """(n, 3) float64 of the chosen lines, each exactly three numbers; else None."""
+    content = _contents(text, starts, chosen, keyword)
+    lines = int(chosen.sum())
+    if not _NUMBER_BYTES[content].all() or _tokens(content, lines, 3) is None:
+        return None
+    values = _parsed(content, np.float64)
+    return values.reshape(lines, 3) if len(values) == 3 * lines else None
+
+
+def _corners(text, starts, chosen) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """1-based (F, 3) vertex and normal indices of triangles whose corners are all 'v' or
+    all 'v//vn'; None for anything else."""
+    content = _contents(text, starts, chosen, 1)
+    lines = int(chosen.sum())
+    if not _CORNER_BYTES[content].all():
+        return None
+    corners = _tokens(content, lines, 3)
+    if corners is None:
+        return None
+    slashes = np.flatnonzero(content == _SLASH)
+    if len(slashes) not in (0, 2 * len(corners)):
+        return None
+    fields = 1
+    if len(slashes):
+        per_corner = np.bincount(np.searchsorted(corners, slashes, side="right") - 1,
+                                 minlength=len(corners))
+        pairs = int((content[slashes[:-1] + 1] == _SLASH).sum())
+        blank = _blank(content)
+        before_blank = np.concatenate([blank[1:], [True]])
+        last = np.flatnonzero(np.greater(before_blank, blank, out=before_blank))
+        del blank, before_blank
+        if (per_corner != 2).any() or pairs != len(corners) \
+                or not _DIGITS[content[corners]].all() or not _DIGITS[content[last]].all():
+            return None
+        content[slashes] = _SPACE
+        fields = 2
+    values = _parsed(content, np.int64)
+    if len(values) != 3 * fields * lines:
+        return None
+    values = values.reshape(lines, 3 * fields)
+    if fields == 1:
+        return values, None
+    return np.ascontiguousarray(values[:, 0::2]), np.ascontiguousarray(values[:, 1::2])
+
+
+def _in_range(indices: np.ndarray, count: int) -> bool:
+    return bool(indices.size) and int(indices.min()) >= 1 and int(indices.max()) <= count
