@@ -3,7 +3,8 @@
 Parsing is trimesh's, quietly (:mod:`.parse`); this package adds what a renderer needs on top
 of it: a structural check per format before parsing (:mod:`.obj`, which also triangulates
 concave polygons with :mod:`.polygons`, :mod:`.ply`, :mod:`.stl`, :mod:`.off`, :mod:`.gltf`,
-with triangle fans rewritten as lists by :mod:`.fans`),
+with triangle fans rewritten as lists by :mod:`.fans`), large plain OBJ files and binary STL
+files read with numpy in a few times their size (:mod:`.plain_obj`, :mod:`.stl`),
 the scene flattened with its transforms applied (:mod:`.scene`), linear colours and every
 material with its texture (:mod:`.materials`, :mod:`.texture_transform`, :mod:`.merge`),
 usable normals (:mod:`.normals`), and one `MeshError` naming the file for any bad input.

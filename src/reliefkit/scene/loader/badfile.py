@@ -51,9 +51,10 @@ def read_regular(path: str | os.PathLike) -> bytes:
     except OSError as exc:
         raise BadFile(f"cannot read the file ({exc.strerror or exc})") from None
     try:
-        _check_stat(os.fstat(fd))
+        info = os.fstat(fd)
+        _check_stat(info)
         with os.fdopen(fd, "rb", closefd=False) as stream:
-            data = stream.read(MAX_FILE_BYTES + 1)
+            data = _read_capped(stream, info.st_size)
     except OSError as exc:
         raise BadFile(f"cannot read the file ({exc.strerror or exc})") from None
     finally:
@@ -61,6 +62,30 @@ def read_regular(path: str | os.PathLike) -> bytes:
     if len(data) > MAX_FILE_BYTES:
         raise BadFile(_too_large(len(data)))
     return data
+
+
+_CHUNK_BYTES = 1 << 20  # what is read at a time past the size the file reported
+
+
+def _read_capped(stream, size: int) -> bytes:
+    """Everything `stream` holds, up to `MAX_FILE_BYTES` plus one byte.
+
+    It asks for the reported `size` plus one byte (not the cap, whose buffer tracemalloc and
+    the allocator would count); a file that turns out longer (it grew, or reports 0 bytes
+    as /proc files do) is read on in chunks until its end or past the cap.
+    """
+    limit = MAX_FILE_BYTES + 1
+    data = stream.read(min(size + 1, limit))
+    if len(data) <= size or len(data) >= limit:  # its end (where reported, or before) or the cap
+        return data
+    chunks, total = [data], len(data)
+    while total < limit:
+        chunk = stream.read(min(_CHUNK_BYTES, limit - total))
+        if not chunk:
+            break
+        chunks.append(chunk)
+        total += len(chunk)
+    return b"".join(chunks)
 
 
 def _check_stat(info: os.stat_result) -> None:
