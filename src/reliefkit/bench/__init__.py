@@ -1,4 +1,5 @@
-"""Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique.
+"""Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique, or one of the
+core's own (`loading`: the memory of loading meshes).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper.
@@ -16,17 +17,28 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
     Without ``log`` the suite's step messages are its progress (`reliefkit.progress.activity`:
     ``bench NAME: ...`` lines on stderr, a spinner on a terminal).
     """
-    from ..core.technique import bench_suite
+    from ..errors import UsageError
     from ..progress import activity
 
-    suite = bench_suite(name)
+    table = suites()
+    if name not in table:
+        raise UsageError(f"unknown benchmark {name!r} (choose from {', '.join(table)})")
+    suite = table[name]
     if log is not None:
         return suite.run(quick, Path(out), log)
     with activity(f"bench {name}") as progress_log:
         return suite.run(quick, Path(out), progress_log)
 
 
-def suite_names() -> tuple[str, ...]:
-    from ..core.technique import bench_suites
+def suites() -> dict:
+    """Every suite by name: the core's, then each technique's (`core.technique.BenchSuite`)."""
+    from ..core.technique import BenchSuite, bench_suites
+    from . import loading
 
-    return tuple(bench_suites())
+    core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
+                                  loading.run_suite)}
+    return core | {name: suite for name, (_, suite) in bench_suites().items()}
+
+
+def suite_names() -> tuple[str, ...]:
+    return tuple(suites())

@@ -115,8 +115,8 @@ def _command(sub, name: str, summary: str, description: str):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from ..bench import suite_names
-    from ..core.technique import bakers, bench_suites, techniques
+    from ..bench import suite_names, suites
+    from ..core.technique import bakers, techniques
 
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
                      epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -165,7 +165,7 @@ def build_parser() -> argparse.ArgumentParser:
     names = suite_names()
     p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",
                  "Benchmarks measured side by side in one run: "
-                 + "; ".join(f"{n}: {s.summary}" for n, (_, s) in bench_suites().items()) + ".")
+                 + "; ".join(f"{n}: {s.summary}" for n, s in suites().items()) + ".")
     p.add_argument("name", choices=names, help="which benchmark")
     p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
     p.add_argument("--out", default="out/bench", help="folder for .md and .json results")

@@ -327,13 +327,35 @@ def _indices(a, vertex_count: int, name: str) -> np.ndarray:
 
 
 def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """Area-weighted vertex normals; vertices on no triangle get +y."""
-    p = np.asarray(positions, dtype=np.float64)
-    tri = p[np.asarray(indices, dtype=np.int64)]
-    face = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    idx = np.asarray(indices, dtype=np.int64).ravel()
-    n = np.stack([np.bincount(idx, weights=np.repeat(face[:, c], 3), minlength=len(p))
-                  for c in range(3)], axis=1)
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    out = np.where(length > 0, n / np.maximum(length, 1e-300), [0.0, 1.0, 0.0])
-    return out.astype(np.float32)
+    """Area-weighted unit vertex normals, float32; vertices on no triangle get +y.
+
+    Large meshes are why it works one coordinate and one block at a time: it holds no float64
+    copy of every triangle's corners, only one (F,) and one (V, 3) float64 array.
+    """
+    positions, faces = np.asarray(positions), np.asarray(indices, dtype=np.int64)
+    count = len(positions)
+    summed = np.zeros((count, 3))
+    for axis in range(3):
+        face = _face_normal_coordinate(positions, faces, axis)
+        for corner in range(3):
+            summed[:, axis] += np.bincount(faces[:, corner], weights=face, minlength=count)
+        del face
+    unit = np.empty((count, 3), np.float32)
+    for start in range(0, count, _BLOCK):
+        block = summed[start:start + _BLOCK]
+        length = np.linalg.norm(block, axis=1, keepdims=True)
+        unit[start:start + _BLOCK] = np.where(length > 0, block / np.maximum(length, 1e-300),
+                                              [0.0, 1.0, 0.0])
+    return unit
+
+
+def _face_normal_coordinate(positions: np.ndarray, faces: np.ndarray, axis: int) -> np.ndarray:
+    """Coordinate `axis` of each triangle's (b - a) x (c - a), in float64."""
+    i, j = (axis + 1) % 3, (axis + 2) % 3
+    out = np.empty(len(faces))
+    for start in range(0, len(faces), _BLOCK):
+        a, b, c = (positions[faces[start:start + _BLOCK, k]].astype(np.float64)
+                   for k in range(3))
+        u, v = b - a, c - a
+        out[start:start + _BLOCK] = u[:, i] * v[:, j] - u[:, j] * v[:, i]
+    return out

@@ -108,7 +108,7 @@ def _line_kinds(text: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.nd
 def _contents(text: np.ndarray, starts: np.ndarray, chosen: np.ndarray, keyword: int) -> np.ndarray:
     """The chosen lines with their newlines, the `keyword` bytes blanked to spaces."""
     lengths = np.diff(np.append(starts, len(text)))  # each line with its newline
-    content = text[np.repeat(chosen, lengths)]
+    content = _runs(text, starts, lengths, chosen)
     kept = lengths[chosen]
     first = np.cumsum(kept) - kept  # where each chosen line starts in `content`
     for k in range(keyword):
@@ -116,11 +116,25 @@ def _contents(text: np.ndarray, starts: np.ndarray, chosen: np.ndarray, keyword:
     return content
 
 
+def _runs(text: np.ndarray, starts: np.ndarray, lengths: np.ndarray,
+          chosen: np.ndarray) -> np.ndarray:
+    """The bytes of the chosen lines, copied run by run of consecutive chosen lines (files
+    group their records, so there are few runs) rather than through a file-sized mask."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], chosen.view(np.int8), [0]])))
+    first, last = edges[0::2], edges[1::2]  # runs of chosen lines [first, last)
+    if len(first) > 1024:
+        return text[np.repeat(chosen, lengths)]
+    ends = starts[last - 1] + lengths[last - 1]
+    return np.concatenate([text[a:b] for a, b in zip(starts[first], ends, strict=True)])
+
+
 def _tokens(content: np.ndarray, lines: int, per_line: int) -> np.ndarray | None:
     """Where each whitespace-separated token starts, when every line has `per_line`."""
     blank = _blank(content)
-    after_blank = np.concatenate([[True], blank[:-1]])
-    starts = np.flatnonzero(np.greater(after_blank, blank, out=after_blank))  # and not blank
+    starts = np.flatnonzero(blank[:-1] > blank[1:]) + 1  # a blank, then a non-blank
+    del blank
+    if len(content) and content[0] > _SPACE:
+        starts = np.concatenate([[0], starts])
     ended = np.searchsorted(starts, np.flatnonzero(content == _NEWLINE))  # tokens before
     if len(starts) != lines * per_line or (np.diff(ended, prepend=0) != per_line).any():
         return None
@@ -128,15 +142,20 @@ def _tokens(content: np.ndarray, lines: int, per_line: int) -> np.ndarray | None
 
 
 def _blank(content: np.ndarray) -> np.ndarray:
-    blank = content == _SPACE
-    blank |= content == _NEWLINE
-    return blank
+    """Spaces and newlines: the only bytes at or below a space in checked content."""
+    return content <= _SPACE
 
 
 def _parsed(content: np.ndarray, dtype) -> np.ndarray:
-    with warnings.catch_warnings():  # numpy warns where it stops early; the count tells
+    """The numbers of `content`; none (a count the callers refuse) where one cannot be read.
+
+    numpy stops early with a warning (older versions) or raises ValueError (2.x)."""
+    with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return np.fromstring(content.tobytes(), dtype=dtype, sep=" ")
+        try:
+            return np.fromstring(content.tobytes(), dtype=dtype, sep=" ")
+        except ValueError:
+            return np.empty(0, dtype)
 
 
 def _numbers(text, starts, chosen, keyword: int) -> np.ndarray | None:
@@ -168,9 +187,10 @@ def _corners(text, starts, chosen) -> tuple[np.ndarray, np.ndarray | None] | Non
                                  minlength=len(corners))
         pairs = int((content[slashes[:-1] + 1] == _SLASH).sum())
         blank = _blank(content)
-        before_blank = np.concatenate([blank[1:], [True]])
-        last = np.flatnonzero(np.greater(before_blank, blank, out=before_blank))
-        del blank, before_blank
+        last = np.flatnonzero(blank[:-1] < blank[1:])  # a token's last byte, then a blank
+        del blank
+        if content[-1] > _SPACE:
+            last = np.append(last, len(content) - 1)
         if (per_corner != 2).any() or pairs != len(corners) \
                 or not _DIGITS[content[corners]].all() or not _DIGITS[content[last]].all():
             return None
