@@ -140,3 +140,11 @@ def test_mask_draws_the_same_pixels_instrumented(gl, tmp_path):
     counted = render(mesh, CAMERA, count_iterations=True)
     np.testing.assert_array_equal(plain.mask, counted.mask)
     assert plain.mask.any() and not plain.mask.all()
+
+
+def test_a_fully_transparent_blend_material_covers_nothing(gl, tmp_path):
+    """d 0 draws nothing, so no pixel claims coverage, a point or a normal (the CLI's count
+    of covered pixels would otherwise report an invisible mesh as drawn)."""
+    frame = render(load_mesh(obj_quad(tmp_path, ["d 0"])), CAMERA)
+    assert not frame.mask.any() and np.isnan(frame.position).all()
+    np.testing.assert_array_equal(frame.color[..., 3], 0.0)

@@ -86,6 +86,16 @@ def test_obj_alpha_mode_from_d_and_tr(tmp_path, lines, mode, alpha):
     assert material.color[3] == pytest.approx(alpha)
 
 
+def test_obj_tr_1_as_meshlab_writes_it_is_opaque_with_a_warning(tmp_path):
+    """MeshLab writes 'Tr 1.000000' for opaque materials (trimesh's fuze.obj): read literally
+    the mesh would be invisible."""
+    mesh = load_mesh(obj_quad(tmp_path, "newmtl m\nKd 1 0 0\nTr 1.000000\n"))
+    (material,) = mesh.materials
+    assert material.alpha_mode == "OPAQUE" and material.color[3] == 1.0
+    (warning,) = mesh.extra["warnings"]
+    assert "'m'" in warning and "Tr 1" in warning and "opaque" in warning
+
+
 def test_obj_rgba_texture_alpha_is_dropped_when_only_d_is_given(tmp_path):
     image = np.full((2, 2, 4), 90, np.uint8)
     mtl = "newmtl m\nmap_Kd tex.png\nd 0.5\n"

@@ -104,8 +104,8 @@ def _light(args):
 
 def _warn_nothing_visible(what: str) -> None:
     """A picture with nothing in it is written, but never silently (exit status 0 still)."""
-    print(f"warning: {what} 0 pixels: nothing visible (check --view, --fov and the input's "
-          "bounds)", file=sys.stderr)
+    print(f"warning: {what} 0 pixels: nothing visible (check --view, --fov, the input's "
+          "bounds and its materials' opacity)", file=sys.stderr)
 
 
 def cmd_render(args) -> int:

@@ -52,6 +52,7 @@ void main() {
     base *= texture(u_texture, v_uv);
 #endif
     if (u_alpha_mode == 1 && base.a < u_alpha_cutoff) discard;
+    if (u_alpha_mode == 2 && base.a <= 0.0) discard;  // nothing there: no coverage, no AOVs
     if (u_alpha_mode != 2) base.a = 1.0;
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;  // two-sided: leaves and open meshes shade from both sides

@@ -4,7 +4,8 @@ sRGB-encoded 8-bit colours are decoded; glTF colours are linear by specification
 
 Alpha follows each format's rules. glTF: ``alphaMode`` (default OPAQUE: alpha ignored; MASK
 with ``alphaCutoff``, default 0.5; BLEND) becomes `Material.alpha_mode` / `alpha_cutoff`.
-OBJ/MTL: alpha comes only from ``d`` (or ``Tr`` = 1 - d, when there is no ``d``) and
+OBJ/MTL: alpha comes only from ``d`` (or ``Tr`` = 1 - d, when there is no ``d``; ``Tr 1``, which
+exporters such as MeshLab write for opaque materials, is read as opaque with a warning) and
 ``map_d``; a material with d = 1 and no map_d is OPAQUE (an RGBA ``map_Kd``'s alpha channel
 is unused), otherwise BLEND with the factor's alpha d, and the texture's alpha channel is
 kept only when ``map_d`` names the ``map_Kd`` image (a separate map_d image is not read: one
@@ -141,6 +142,11 @@ class SurfaceReader:
         if dissolve is None:
             transparency = _mtl_number(kwargs.get("tr"))
             dissolve = 1.0 if transparency is None else 1.0 - transparency
+            if transparency is not None and transparency >= 1.0:
+                dissolve = 1.0  # MeshLab and others write Tr as the opacity: Tr 1 is opaque
+                self.warnings.append(f"material '{name}': 'Tr {transparency:g}' would make it "
+                                     "invisible; read as opaque (some exporters write Tr as "
+                                     "the opacity; 'd 0' makes a material transparent)")
         map_d = kwargs.get("map_d")
         texture_alpha = False
         if map_d:
