@@ -14,6 +14,7 @@ from .scene.camera import Camera
 from .scene.light import DirectionalLight
 from .scene.loader import load_mesh
 from .scene.mesh import RenderMesh
+from .techniques.billboard import BillboardCloud, bake_billboard_cloud, build_billboard_cloud
 from .techniques.relief import (
     ReliefObject,
     ReliefTexture,
@@ -26,7 +27,8 @@ from .techniques.relief import (
 __all__ = [
     "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
     "bake", "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
-    "relief_from_heights", "ReliefTexture", "ReliefObject",
+    "relief_from_heights", "ReliefTexture", "ReliefObject", "build_billboard_cloud",
+    "bake_billboard_cloud", "BillboardCloud",
     "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
 ]
 __version__ = "0.1.0"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..colorspace import srgb_decode
 from ..errors import GPUError
 from .context import check_framebuffer_size, check_gl_error
 
@@ -148,3 +149,89 @@ def texture3d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "l
         tex.release()
         raise
     return tex
+
+
+MAX_TEXTURE_ARRAY_BYTES = 2 << 30  # refuse texture arrays above 2 GiB (checked before allocating)
+_DTYPES_ARRAY = {np.dtype(np.uint8): "f1", np.dtype(np.float32): "f4",
+                 np.dtype(np.float16): "f2"}
+
+
+def check_array_size(ctx, width: int, height: int, layers: int, what: str,
+                     nbytes: int | None = None) -> None:
+    """Refuse a texture array over GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS or the
+    byte cap, before anything is allocated."""
+    if min(width, height, layers) < 1:
+        raise GPUError(f"{what}: texture array size must be positive, got "
+                       f"{layers} x {width}x{height}")
+    _check_2d(ctx, width, height, what)
+    limit = int(ctx.info["GL_MAX_ARRAY_TEXTURE_LAYERS"])
+    if layers > limit:
+        raise GPUError(f"{what}: {layers} texture array layers exceed this GPU's limit of "
+                       f"{limit}; use fewer atlas pages (a larger page or texel size)")
+    if nbytes is not None and nbytes > MAX_TEXTURE_ARRAY_BYTES:
+        raise GPUError(f"{what}: a {layers} x {width}x{height} texture array needs "
+                       f"{nbytes / 2**30:.1f} GiB (limit {MAX_TEXTURE_ARRAY_BYTES / 2**30:.0f} "
+                       "GiB); use a smaller resolution")
+
+
+def texture_array(ctx, array: np.ndarray, *, what: str = "texture", srgb: bool = False,
+                  mipmaps: bool = False, filter: str = "linear"):
+    """Upload an (L, H, W) or (L, H, W, C<=4) array as a 2D texture array (``sampler2DArray``).
+
+    ``array[k, j, i]`` is the texel of layer k sampled at ``((i + 0.5) / W, (j + 0.5) / H)``:
+    row 0 of a layer is v = 0, as in `texture2d`. uint8 arrays become normalised textures,
+    float32 and float16 stay float. Sizes are checked before anything is allocated.
+
+    ``srgb`` takes (L, H, W, 4) uint8 sRGB colour with linear alpha and samples linear colour,
+    like `texture2d`'s GL_SRGB8_ALPHA8. moderngl cannot give a texture array an internal
+    format, so the texels are decoded on the CPU (a 256-entry table: exact) into float16;
+    filtering and mipmaps then average linear values as an sRGB texture would, at twice
+    the memory.
+    """
+    import moderngl
+
+    if filter not in ("linear", "nearest"):
+        raise GPUError(f"{what}: filter must be 'linear' or 'nearest', got {filter!r}")
+    arr = np.asarray(array)
+    if arr.ndim == 3:
+        arr = arr[..., None]
+    if arr.ndim != 4 or not 1 <= arr.shape[3] <= 4:
+        raise GPUError(f"{what}: a texture array needs an (L, H, W) or (L, H, W, 1..4) array, "
+                       f"got shape {np.shape(array)}")
+    if arr.dtype not in _DTYPES_ARRAY:
+        raise GPUError(f"{what}: unsupported texture array dtype {arr.dtype} "
+                       "(use uint8, float16 or float32)")
+    if srgb and (arr.dtype != np.uint8 or arr.shape[3] != 4):
+        raise GPUError(f"{what}: sRGB texture arrays must be (L, H, W, 4) uint8")
+    layers, height, width, comps = (int(s) for s in arr.shape)
+    itemsize = 2 if srgb else arr.dtype.itemsize
+    check_array_size(ctx, width, height, layers, what, nbytes=arr.size * itemsize)
+    if srgb:
+        arr = _srgb_to_linear_half(arr)
+    tex = ctx.texture_array((width, height, layers), comps, np.ascontiguousarray(arr).tobytes(),
+                            dtype=_DTYPES_ARRAY[arr.dtype])
+    try:
+        if filter == "nearest":
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        else:
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR if mipmaps else moderngl.LINEAR,
+                          moderngl.LINEAR)
+            if mipmaps:
+                tex.build_mipmaps()
+        tex.repeat_x = tex.repeat_y = False
+        check_gl_error(ctx, f"creating {what} ({layers} x {width}x{height}x{comps} "
+                            f"{np.asarray(array).dtype})")
+    except BaseException:
+        tex.release()
+        raise
+    return tex
+
+
+def _srgb_to_linear_half(rgba8: np.ndarray) -> np.ndarray:
+    """(..., 4) uint8 sRGB colour + linear alpha -> float16 linear colour + alpha."""
+    levels = np.arange(256) / 255.0
+    colour_table = srgb_decode(levels).astype(np.float16)
+    out = np.empty(rgba8.shape, np.float16)
+    out[..., :3] = colour_table[rgba8[..., :3]]
+    out[..., 3] = levels.astype(np.float16)[rgba8[..., 3]]
+    return out

@@ -3,6 +3,7 @@
 Adding a technique means one new package beside these and one entry here.
 """
 
+from .billboard import TECHNIQUE as BILLBOARD
 from .relief import TECHNIQUE as RELIEF
 
-TECHNIQUES = (RELIEF,)
+TECHNIQUES = (RELIEF, BILLBOARD)

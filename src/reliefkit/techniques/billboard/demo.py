@@ -1,0 +1,24 @@
+"""Billboard tiles of the demo sheet: the tree and the vehicle as billboard clouds."""
+
+from __future__ import annotations
+
+from ...core.technique import DemoTile
+
+
+def _baked(asset: str, kind: str, **params):
+    def make():
+        from ...bake import bake
+        from ...scene.assets import make_asset
+
+        return bake(make_asset(asset), kind, **params)
+
+    return make
+
+
+def demo_tiles() -> list[DemoTile]:
+    return [
+        DemoTile("tree: billboard cloud", "tree-bbc", _baked("tree", "billboard-cloud"),
+                 (20.0, 10.0, 2.4)),
+        DemoTile("vehicle: billboard cloud", "vehicle-bbc", _baked("vehicle", "billboard-cloud"),
+                 (40.0, 20.0, None)),
+    ]
