@@ -17,7 +17,7 @@ from .pictures import TILE_BACKGROUND
 from .units import format_bytes
 
 CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
-                "iterations_max")
+                "iterations_max", "bytes")
 
 
 def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
@@ -45,17 +45,18 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     advance(1, len(variants) + 1)
     rows, frames, errors = {}, {"mesh": truth}, {}
     for k, variant in enumerate(variants):
-        plain = render(representation, camera, light=light, **variant.options)
-        counted = render(representation, camera, light=light, count_iterations=True,
-                         **variant.options)
+        drawn = variant.derive(representation) if variant.derive else representation
+        plain = render(drawn, camera, light=light, **variant.options)
+        counted = render(drawn, camera, light=light, count_iterations=True, **variant.options)
         scores = metrics.compare(plain, truth, scene_size=mesh.radius)
         row = {key: scores[key] for key in ("psnr", "ssim", "iou", "position_mean_rel")}
         row |= {key: counted.stats.get(key, 0) for key in
                 ("iterations_mean", "iterations_max", "fragments")}
         row["covered"] = plain.stats["covered"]
+        row["bytes"] = sum(array_bytes(drawn).values())
         error_mask = None
         for metric in tech.compare_metrics:
-            extra, mask = metric.measure(plain, representation, camera)
+            extra, mask = metric.measure(plain, drawn, camera)
             row |= extra
             error_mask = mask if error_mask is None or mask is None else error_mask | mask
         rows[variant.name] = row
@@ -104,7 +105,8 @@ def metrics_markdown(result: dict, heading: str) -> str:
              "| variant | " + " | ".join(cols) + " |",
              "|---" * (len(cols) + 1) + "|"]
     for name, row in result["metrics"].items():
-        cells = [f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, ""))
+        cells = [format_bytes(row[c]) if c == "bytes" else
+                 f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, ""))
                  for c in cols]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

@@ -70,11 +70,15 @@ class CompareVariant:
     """One rendering of a representation beside the mesh in `compare` (a method, a mode).
 
     ``options`` are render options; the variant is skipped when ``available(rep)`` is False.
+    ``derive(rep)``, when given, makes what is drawn from the compared representation (the
+    flat billboard cloud inside a DMBBC, a shell from a volumetric one), so one bake can
+    stand for several representations of the same source.
     """
 
     name: str
     options: dict = field(default_factory=dict)
     available: Callable[[object], bool] = lambda rep: True
+    derive: Callable[[object], object] | None = None
 
 
 @dataclass(frozen=True)
