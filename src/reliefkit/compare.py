@@ -45,7 +45,7 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     advance(1, len(variants) + 1)
     rows, frames, errors = {}, {"mesh": truth}, {}
     for k, variant in enumerate(variants):
-        drawn = variant.derive(representation) if variant.derive else representation
+        drawn = variant.derive(representation, mesh) if variant.derive else representation
         plain = render(drawn, camera, light=light, **variant.options)
         counted = render(drawn, camera, light=light, count_iterations=True, **variant.options)
         scores = metrics.compare(plain, truth, scene_size=mesh.radius)

@@ -70,15 +70,15 @@ class CompareVariant:
     """One rendering of a representation beside the mesh in `compare` (a method, a mode).
 
     ``options`` are render options; the variant is skipped when ``available(rep)`` is False.
-    ``derive(rep)``, when given, makes what is drawn from the compared representation (the
-    flat billboard cloud inside a DMBBC, a shell from a volumetric one), so one bake can
-    stand for several representations of the same source.
+    ``derive(rep, mesh)``, when given, makes what is drawn from the compared representation
+    and its mesh (the flat billboard cloud inside a DMBBC, the other DMBBC variants baked
+    with the same parameters), so one comparison covers a family of representations.
     """
 
     name: str
     options: dict = field(default_factory=dict)
     available: Callable[[object], bool] = lambda rep: True
-    derive: Callable[[object], object] | None = None
+    derive: Callable[[object, object], object] | None = None
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,14 @@ import pytest
 from reliefkit.errors import UsageError
 from reliefkit.scene.assets import make_asset
 from reliefkit.scene.mesh import RenderMesh, vertex_normals
-from reliefkit.techniques.billboard.cloud import build_billboard_cloud
+from reliefkit.techniques.billboard.cloud import (
+    _diagonal,
+    _Faces,
+    _Grid,
+    _hemisphere_directions,
+    _Selector,
+    build_billboard_cloud,
+)
 
 
 def mesh_of(points, indices, name="test") -> RenderMesh:
@@ -205,3 +212,57 @@ def test_bad_parameters_are_usage_errors(kwargs, message):
     with pytest.raises(UsageError, match=message) as info:
         build_billboard_cloud(box(), **kwargs)
     assert "\n" not in str(info.value)
+
+
+def test_removing_faces_leaves_the_density_of_the_rest():
+    """Both ways of removing a plane's faces (subtracting them, or rebuilding from the rest
+    when that is fewer faces) give the density of the remaining faces alone."""
+    mesh = uv_sphere(12, 24)
+    diag = _diagonal(mesh)
+    faces = _Faces(mesh, 0.05 * diag)
+
+    def grid():
+        return _Grid(faces, _hemisphere_directions(0.1), 0.1, diag, 0.025 * diag, 10.0)
+
+    everything = np.arange(faces.count)
+    for cut in (faces.count // 4, 3 * faces.count // 4):     # subtract, then rebuild
+        removed, rest = everything[:cut], everything[cut:]
+        g = grid()
+        g.remove(removed, rest)
+        fresh = grid()
+        fresh.diff[:] = 0.0
+        fresh._update(rest, 1.0)
+        scale = np.abs(fresh.diff).max()
+        assert np.allclose(g.diff, fresh.diff, rtol=0, atol=1e-9 * scale)
+
+
+def test_the_rho_sweep_finds_the_highest_density_in_its_window():
+    """The windowed sweep against the penalized density evaluated face by face."""
+    mesh = make_asset("vehicle")
+    diag = _diagonal(mesh)
+    faces = _Faces(mesh, 0.05 * diag)
+    grid = _Grid(faces, _hemisphere_directions(0.2), 0.2, diag, 0.025 * diag, 10.0)
+    selector = _Selector(faces, grid)
+    live = np.flatnonzero(~faces.degenerate)
+    near = (faces.tri[live], faces.normal[live], faces.area[live])
+    eps = faces.eps
+
+    def density(normal, rho):
+        low, high = faces.extent(live, normal)
+        lo, hi = high - eps, low + eps
+        gain = np.where(lo < hi, faces.area[live] * np.abs(faces.normal[live] @ normal), 0.0)
+        band = ((lo > 0) & (np.maximum(lo - eps, 0) <= rho) & (rho < lo)) \
+            | ((hi < 0) & (hi < rho) & (rho <= np.minimum(hi + eps, 0)))
+        return float(gain @ ((lo <= rho) & (rho <= hi)) - 10.0 * gain @ band)
+
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        normal = rng.normal(size=3)
+        normal /= np.linalg.norm(normal)
+        centre = rng.uniform(-0.3, 0.3) * diag
+        window = (centre - 2 * eps, centre + eps)
+        value, rho = selector._best_rho(near, normal, window)
+        assert window[0] <= rho <= window[1]
+        assert value == pytest.approx(density(normal, rho), rel=1e-9, abs=1e-12)
+        samples = np.linspace(*window, 301)
+        assert max(density(normal, r) for r in samples) <= value + 1e-9 * abs(value) + 1e-12

@@ -44,11 +44,18 @@ def convex_hull_2d(points: np.ndarray) -> np.ndarray:
 
 
 def _drop_interior(pts: np.ndarray) -> np.ndarray:
-    """Points strictly inside the convex quadrilateral of the x/y extremes cannot be on the hull."""
-    quad = pts[[np.argmin(pts[:, 0]), np.argmin(pts[:, 1]),
-                np.argmax(pts[:, 0]), np.argmax(pts[:, 1])]]
+    """Points strictly inside the convex polygon of the extremes along 8 directions (45 degrees
+    apart, counter-clockwise) cannot be on the hull; an octagon leaves about a tenth of a
+    round cloud to the Python loop, a quadrilateral over a third."""
+    x, y = pts[:, 0], pts[:, 1]
+    keys = (-x, -x - y, -y, x - y, x, x + y, y, y - x)     # maximised in turn
+    corners = [int(np.argmax(k)) for k in keys]
+    corners = [c for i, c in enumerate(corners) if c != corners[i - 1]]   # drop repeats
+    if len(set(corners)) < 3:
+        return pts
+    polygon = pts[corners]
     inside = np.ones(len(pts), dtype=bool)
-    for a, b in zip(quad, np.roll(quad, -1, axis=0), strict=True):
+    for a, b in zip(polygon, np.roll(polygon, -1, axis=0), strict=True):
         inside &= _cross(a, b, pts) > 0
     return pts[~inside]  # unique + boolean mask keeps the sorted order
 
