@@ -14,7 +14,13 @@ from .scene.camera import Camera
 from .scene.light import DirectionalLight
 from .scene.loader import load_mesh
 from .scene.mesh import RenderMesh
-from .techniques.billboard import BillboardCloud, bake_billboard_cloud, build_billboard_cloud
+from .techniques.billboard import (
+    BillboardBoxes,
+    BillboardCloud,
+    bake_billboard_cloud,
+    bake_boxes,
+    build_billboard_cloud,
+)
 from .techniques.relief import (
     ReliefObject,
     ReliefTexture,
@@ -28,7 +34,7 @@ __all__ = [
     "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
     "bake", "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
     "relief_from_heights", "ReliefTexture", "ReliefObject", "build_billboard_cloud",
-    "bake_billboard_cloud", "BillboardCloud",
+    "bake_billboard_cloud", "bake_boxes", "BillboardCloud", "BillboardBoxes",
     "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
 ]
 __version__ = "0.1.0"

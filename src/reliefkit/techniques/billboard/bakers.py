@@ -1,4 +1,5 @@
-"""The billboard bakers and their typed parameters (the CLI's ``bake --as billboard-cloud``)."""
+"""The billboard bakers and their typed parameters (the CLI's ``bake --as billboard-cloud`` and
+``--as dmbbc``)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,8 @@ from dataclasses import dataclass
 
 from ...core.params import param
 from .bake import bake_billboard_cloud
+from .box_bake import SURFACES, bake_boxes
+from .boxes import VARIANTS
 
 
 def _epsilon():
@@ -33,3 +36,25 @@ class BillboardCloudParams:
 def bake_cloud(source, p: BillboardCloudParams, progress=None):
     return bake_billboard_cloud(source, epsilon=p.epsilon, max_planes=p.max_planes,
                                 texel_size=p.texel_size, progress=progress)
+
+
+@dataclass(frozen=True)
+class BillboardBoxesParams:
+    variant: str = param("volumetric", "how each box stores what is inside it (§3.3): a "
+                         "3D texture, one displacement per texel, or an interval",
+                         choices=VARIANTS)
+    epsilon: float = _epsilon()
+    max_planes: int | None = _max_planes()
+    texel_size: float | None = _texel_size()
+    thickness: float | None = param(None, "shell: the surface's thickness as a fraction of "
+                                    "the box depth (none: the standard deviation of the "
+                                    "displacements, the paper's suggestion)", kind="float",
+                                    lo=1e-6, hi=1.0)
+    surfaces: str = param("average", "several surfaces in one voxel or texel: average them "
+                          "or keep the one seen from outside", choices=SURFACES)
+
+
+def bake_dmbbc(source, p: BillboardBoxesParams, progress=None):
+    return bake_boxes(source, p.variant, epsilon=p.epsilon, max_planes=p.max_planes,
+                      texel_size=p.texel_size, thickness=p.thickness, surfaces=p.surfaces,
+                      progress=progress)

@@ -88,8 +88,10 @@ def _boxes_to_arrays(rep: BillboardBoxes) -> tuple[dict, dict]:
                    f"b{k}_normal": box.normal, f"b{k}_distance": box.distance,
                    f"b{k}_displacement": box.displacement}
     arrays["source_bounds"] = rep.source_bounds
-    params = dict(rep.params) | {"variant": rep.variant, "boxes": len(rep.boxes),
-                                 "thickness": rep.thickness, "cloud": cloud_params}
+    own = ("variant", "boxes", "thickness", "cloud")  # the codec's, written last
+    params = {k: v for k, v in rep.params.items() if k not in own}
+    params |= {"variant": rep.variant, "boxes": len(rep.boxes), "thickness": rep.thickness,
+               "cloud": cloud_params}
     return arrays, params
 
 

@@ -1,0 +1,374 @@
+"""Baking displacement-mapped billboard clouds (Mantler, Jeschke, Wimmer §3.3, §3.4.1).
+
+The planes are those of the flat billboard cloud of the same parameters (`build_billboard_cloud`,
+kept baked as `BillboardBoxes.cloud`). Each plane's box (`plane_box`: its rectangle, +-epsilon
+along its normal) gets W x H texels (the rectangle's resolution) and D voxels across, D about
+2 epsilon / texel size so voxels are about cubic (§3.3.1). Only the plane's own faces are
+voxelized into its box, by the core's GPU voxelizer in surface mode. From that grid:
+
+* volumetric (§3.3.1): the grid itself, one colour, normal and occupancy per voxel;
+* shell (§3.3.2): one displacement per texel column, its surface's colour and normal, and one
+  thickness for the whole cloud;
+* thick shell (§3.3.3): the lowest and highest occupied w per column, one colour and normal;
+
+and, for all three, a distance texture over the box's voxels for sphere tracing (§3.4.1).
+
+Choices (the paper leaves them open):
+
+* Occupancy: a voxel is occupied when ``VoxelGrid.surface > 0``, i.e. some sample line of
+  the voxelizer meets the surface inside the voxel. A higher threshold (say half covered)
+  would drop the voxels a sloped sheet only clips, and rays would leak through the sheet
+  between diagonal neighbours; the surface passing through a voxel at all is what §3.3.1's
+  "rasterizing the triangles into these voxels" marks.
+* ``surfaces="outside"``: the faces of a box are split by facing: those whose geometric
+  normal faces +w (the box's outside, where its plane's faces face; the plane is chosen
+  nearly tangent to the model) and those facing -w. Each half is voxelized separately; where
+  both occupy a voxel the +w one wins, so a thin double-sided sheet shows its outer side's
+  colour and normal instead of a mix (whose normal cancels). Column-wise (the shells) the
+  outside sample is the highest occupied voxel, the one seen first from the w = 1 side.
+  Solid-mode inside information is not used: a box holds a patch of the mesh, never closed.
+* Automatic shell thickness: the standard deviation of the acquired displacements over all
+  covered texels of all boxes (the paper: "over all acquired texel positions"; one global
+  value, as `BillboardBoxes` has one thickness), clamped to [1/D, 1] so a shell is at least
+  one voxel thick.
+* Distance: per voxel centre, the Euclidean distance to the nearest occupied voxel centre,
+  measured in units of the smallest of the three voxel sides, rounded down (a stored step
+  never exceeds the true one) and clamped at `MAX_DISTANCE`. For the shells, an occupied
+  voxel is a cell that overlaps the texel's interval in w.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...bake.voxelize import MAX_VOXELS, voxelize
+from ...colorspace import to_rgba8
+from ...errors import UsageError
+from ...scene.mesh import RenderMesh
+from .bake import bake_plan, plane_box
+from .boxes import MAX_DISTANCE, VARIANTS, BillboardBox, BillboardBoxes
+from .cloud import BillboardPlane, build_billboard_cloud
+
+SURFACES = ("average", "outside")
+#: Most voxels all boxes together may have (256 M: 2 GiB of volumetric colour, normal and
+#: distance; a shell keeps only its 256 MiB of distance texture but bakes the same grids).
+MAX_TOTAL_VOXELS = 1 << 28
+#: A voxel whose surface coverage exceeds this is occupied: any sample line meets the surface.
+OCCUPIED_ABOVE = 0.0
+_DISP_SCALE = 65535
+_EDGE = 1e-5  # box units: vertices are kept this far inside the box (half-open voxel bounds)
+_NOTHING_INSIDE = "no part of the mesh was found inside"
+
+
+@dataclass(eq=False)
+class _Voxels:
+    """One box's voxelized faces: occupancy (D, H, W) bool, linear straight-alpha colour
+    (D, H, W, 4) and unit world normal (D, H, W, 3), zero where unoccupied."""
+
+    occupied: np.ndarray
+    color: np.ndarray
+    normal: np.ndarray
+
+    @property
+    def depth(self) -> int:
+        return self.occupied.shape[0]
+
+
+@dataclass(eq=False)
+class _Maps:
+    """A box's maps before the distance texture: what `BillboardBox` stores, plus the
+    occupancy the distance is measured to (volumetric and thick shell) or None (the shell's
+    depends on the cloud-wide thickness)."""
+
+    color: np.ndarray
+    normal: np.ndarray
+    displacement: np.ndarray | None
+    occupied: np.ndarray | None
+
+
+def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float = 0.05,
+               max_planes: int | None = None, texel_size: float | None = None,
+               thickness: float | None = None, surfaces: str = "average", progress=None,
+               ctx=None) -> BillboardBoxes:
+    """The displacement-mapped billboard cloud of ``mesh`` in ``variant`` (one of `VARIANTS`).
+
+    ``epsilon``, ``max_planes`` and ``texel_size`` choose the planes as for the flat cloud
+    (`bake_billboard_cloud`). ``thickness`` (shell only) is the shell's interval width as a
+    fraction of the box depth, in (0, 1], or None for the automatic one (see the module).
+    ``surfaces`` is how samples of several surfaces in one voxel or column combine:
+    ``"average"`` (equal weights) or ``"outside"`` (the one seen from the box's outside).
+    ``progress(done, total)`` counts faces assigned to planes, then the flat cloud's planes
+    baked, then the boxes. Raises UsageError for bad options or work that would not fit.
+    """
+    _check_options(variant, thickness, surfaces)
+    faces = mesh.triangle_count
+    total = [faces]
+
+    def report(done):
+        if progress:
+            progress(done, total[0])
+
+    plan = build_billboard_cloud(mesh, epsilon, max_planes, texel_size,
+                                 progress=lambda done, _: report(done))
+    depth = max(1, round(2 * plan.epsilon / plan.texel_size))
+    _check_size(plan.planes, depth, plan.texel_size)
+    count = len(plan.planes)
+    total[0] = faces + 2 * count
+    cloud = bake_plan(mesh, plan, progress=lambda k: report(faces + k), ctx=ctx)
+
+    transforms, maps = [], []
+    for k, plane in enumerate(plan.planes):
+        box_to_world = plane_box(plane, plan.epsilon)
+        voxels = _box_voxels(mesh, plane, box_to_world, depth, surfaces, ctx)
+        transforms.append(box_to_world)
+        maps.append(_variant_maps(voxels, variant, surfaces))
+        report(faces + count + k + 1)
+
+    shell = None
+    if variant == "shell":
+        shell = _auto_thickness(maps, depth) if thickness is None else float(thickness)
+        for m in maps:
+            m.occupied = _shell_occupancy(m, shell, depth)
+    boxes = [BillboardBox(box_to_world=t, color=m.color, normal=m.normal,
+                          distance=_distance(m.occupied, t), displacement=m.displacement)
+             for t, m in zip(transforms, maps, strict=True)]
+    params = {"variant": variant, "epsilon": plan.epsilon_fraction,
+              "texel_size": plan.texel_size, "voxels_across": depth,
+              "thickness": shell, "thickness_auto": variant == "shell" and thickness is None,
+              "surfaces": surfaces, "source": mesh.name, "generation": plan.summary()}
+    if max_planes is not None:
+        params["max_planes"] = max_planes
+    return BillboardBoxes(variant=variant, boxes=boxes, cloud=cloud, thickness=shell,
+                          source_bounds=mesh.bounds, params=params)
+
+
+# -- options and limits -----------------------------------------------------------------
+
+def _check_options(variant, thickness, surfaces) -> None:
+    if variant not in VARIANTS:
+        raise UsageError(f"variant must be one of {', '.join(VARIANTS)}, got {variant!r}")
+    if surfaces not in SURFACES:
+        raise UsageError(f"surfaces must be one of {', '.join(SURFACES)}, got {surfaces!r}")
+    if thickness is None:
+        return
+    if variant != "shell":
+        raise UsageError(f"thickness applies only to the shell variant, not {variant!r}")
+    if isinstance(thickness, bool) or not isinstance(thickness, (int, float, np.number)) \
+            or not 0 < float(thickness) <= 1:
+        raise UsageError(f"thickness must be a number in (0, 1] (a fraction of the box "
+                         f"depth) or None for automatic, got {thickness!r}")
+
+
+def _check_size(planes: tuple[BillboardPlane, ...], depth: int, texel: float) -> None:
+    """Refuse, before anything is allocated, boxes the voxelizer or memory cannot hold."""
+    sizes = [w * h * depth for w, h in (p.resolution for p in planes)]
+    hint = f"at a texel size of {texel:.3g}; bake with a larger --texel-size"
+    if max(sizes) > MAX_VOXELS:
+        raise UsageError(f"a billboard box needs {max(sizes):,} voxels, more than the "
+                         f"voxelizer's {MAX_VOXELS:,}, {hint}")
+    if sum(sizes) > MAX_TOTAL_VOXELS:
+        raise UsageError(f"the {len(planes)} billboard boxes need {sum(sizes):,} voxels, more "
+                         f"than {MAX_TOTAL_VOXELS:,}, {hint}")
+
+
+# -- voxelizing a box -------------------------------------------------------------------
+
+def _box_voxels(mesh: RenderMesh, plane: BillboardPlane, box_to_world: np.ndarray,
+                depth: int, surfaces: str, ctx) -> _Voxels:
+    """The plane's faces voxelized into its box; with ``"outside"`` the +w-facing faces win
+    every voxel they share with -w-facing ones."""
+    w, h = plane.resolution
+    resolution = (w, h, depth)
+    faces = np.asarray(plane.faces)
+    if surfaces == "average":
+        return _voxelized(mesh, faces, box_to_world, resolution, ctx)
+    corners = mesh.world_positions[mesh.indices[faces]]
+    facing = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    front = facing @ plane.normal >= 0
+    outer = _voxelized(mesh, faces[front], box_to_world, resolution, ctx)
+    inner = _voxelized(mesh, faces[~front], box_to_world, resolution, ctx)
+    take = outer.occupied[..., None]
+    return _Voxels(outer.occupied | inner.occupied,
+                   np.where(take, outer.color, inner.color),
+                   np.where(take, outer.normal, inner.normal))
+
+
+def _voxelized(mesh: RenderMesh, faces: np.ndarray, box_to_world: np.ndarray,
+               resolution: tuple[int, int, int], ctx) -> _Voxels:
+    """Surface voxels of ``faces``; an empty grid when they miss every sample line (a sliver
+    or a fully transparent patch: its box stays empty rather than failing the bake)."""
+    w, h, d = resolution
+    empty = _Voxels(np.zeros((d, h, w), bool), np.zeros((d, h, w, 4), np.float32),
+                    np.zeros((d, h, w, 3), np.float32))
+    if len(faces) == 0:
+        return empty
+    try:
+        grid = voxelize(_inside_box(mesh, faces, box_to_world), box_to_world, resolution,
+                        mode="surface", ctx=ctx)
+    except UsageError as error:
+        if _NOTHING_INSIDE in str(error):
+            return empty
+        raise
+    occupied = grid.surface > OCCUPIED_ABOVE
+    voxels = _Voxels(occupied, np.where(occupied[..., None], grid.color, 0.0),
+                     np.where(occupied[..., None], grid.normal, 0.0))
+    _repair_non_finite(voxels)
+    return voxels
+
+
+def _repair_non_finite(voxels: _Voxels) -> None:
+    """Occupied voxels whose colour or normal came back NaN copy the nearest sound voxel.
+
+    The voxelizer on llvmpipe can return NaN attributes for a few crossings of triangles
+    seen almost edge-on (one NaN fragment spoils the voxel's whole sum); their occupancy is
+    still right, so only the attributes are borrowed from the neighbourhood."""
+    from scipy.ndimage import distance_transform_edt
+
+    sound = np.isfinite(voxels.color).all(-1) & np.isfinite(voxels.normal).all(-1)
+    bad = ~sound
+    if not bad.any():
+        return
+    good = voxels.occupied & sound
+    if not good.any():
+        voxels.color[bad], voxels.normal[bad] = 0.0, 0.0
+        return
+    nearest = distance_transform_edt(~good, return_distances=False, return_indices=True)
+    source = tuple(index[bad] for index in nearest)
+    voxels.color[bad] = voxels.color[source]
+    voxels.normal[bad] = voxels.normal[source]
+
+
+def _inside_box(mesh: RenderMesh, faces: np.ndarray, box_to_world: np.ndarray) -> RenderMesh:
+    """The faces as a compact mesh with every vertex moved just inside the box: the faces
+    lie within epsilon of the plane only up to rounding, and the voxelizer's half-open
+    bounds would drop a face exactly on the far side (or at u = 1 or v = 1)."""
+    indices = mesh.indices[faces]
+    used, local = np.unique(indices, return_inverse=True)
+    to_box = np.linalg.inv(box_to_world)
+    world = mesh.world_positions[used]
+    uvw = world @ to_box[:3, :3].T + to_box[:3, 3]
+    outside = ((uvw < _EDGE) | (uvw > 1 - _EDGE)).any(axis=1)
+    clamped = np.clip(uvw[outside], _EDGE, 1 - _EDGE)
+    world[outside] = clamped @ box_to_world[:3, :3].T + box_to_world[:3, 3]
+    return RenderMesh(world - mesh.origin, local.reshape(-1, 3), mesh.normals[used],
+                      mesh.colors[used], None if mesh.uvs is None else mesh.uvs[used],
+                      name=mesh.name, materials=mesh.materials, material=mesh.material[faces],
+                      origin=mesh.origin)
+
+
+# -- the variants -----------------------------------------------------------------------
+
+def _variant_maps(voxels: _Voxels, variant: str, surfaces: str) -> _Maps:
+    if variant == "volumetric":
+        return _Maps(_encode_color(voxels.color, voxels.occupied),
+                     _encode_normal(voxels.normal), None, voxels.occupied)
+    covered = voxels.occupied.any(axis=0)
+    lowest, highest = _column_extremes(voxels.occupied)
+    color, normal = _column_attributes(voxels, highest if surfaces == "outside" else None)
+    d = voxels.depth
+    if variant == "shell":
+        if surfaces == "outside":
+            w = (highest + 0.5) / d
+        else:
+            centres = (np.arange(d) + 0.5) / d
+            count = np.maximum(voxels.occupied.sum(axis=0), 1)
+            w = np.tensordot(centres, voxels.occupied.astype(np.float64), axes=1) / count
+        displacement = _encode_w(np.where(covered, w, 0.0))[..., None]
+        return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement, None)
+    interval = np.stack([np.where(covered, lowest / d, 0.0),
+                         np.where(covered, (highest + 1) / d, 0.0)], axis=-1)
+    displacement = _encode_w(interval)
+    return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement,
+                 _interval_occupancy(displacement, covered, d))
+
+
+def _column_extremes(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(H, W) indices of the lowest and highest occupied voxel of each column (0 if none)."""
+    d = occupied.shape[0]
+    lowest = np.argmax(occupied, axis=0)
+    highest = d - 1 - np.argmax(occupied[::-1], axis=0)
+    return lowest, highest
+
+
+def _column_attributes(voxels: _Voxels, pick: np.ndarray | None):
+    """(H, W, 4) colour and (H, W, 3) unit normal per column: of the voxel ``pick`` (the
+    outside one), or the equal-weight mean over the column's occupied voxels."""
+    if pick is not None:
+        index = pick[None, ..., None]
+        color = np.take_along_axis(voxels.color, index, axis=0)[0]
+        normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
+        return color, normal
+    count = voxels.occupied.sum(axis=0)[..., None].astype(np.float32)
+    color = np.divide(voxels.color.sum(axis=0), count, out=np.zeros(count.shape[:2] + (4,),
+                      np.float32), where=count > 0)
+    return color, _unit(voxels.normal.sum(axis=0))
+
+
+def _auto_thickness(maps: list[_Maps], depth: int) -> float:
+    """The standard deviation of the stored displacements of every covered texel of every
+    box, clamped to [one voxel, the whole box]."""
+    values = np.concatenate([m.displacement[..., 0][m.color[..., 3] >= 128] for m in maps])
+    spread = float(np.std(values / _DISP_SCALE)) if values.size else 0.0
+    return min(max(spread, 1.0 / depth), 1.0)
+
+
+def _shell_occupancy(maps: _Maps, thickness: float, depth: int) -> np.ndarray:
+    """The cells the shell's intervals [d - t/2, d + t/2] (within [0, 1]) overlap."""
+    d = maps.displacement[..., 0] / _DISP_SCALE
+    interval = np.stack([np.clip(d - thickness / 2, 0, 1), np.clip(d + thickness / 2, 0, 1)],
+                        axis=-1)
+    return _interval_occupancy(interval * _DISP_SCALE, maps.color[..., 3] >= 128, depth)
+
+
+def _interval_occupancy(interval: np.ndarray, covered: np.ndarray, depth: int) -> np.ndarray:
+    """(D, H, W): cell k of a covered column is occupied when [k/D, (k+1)/D] overlaps its
+    interval (given in units of 1/65535) by more than the encoding's rounding."""
+    lo, hi = (interval[..., i].astype(np.float64) / _DISP_SCALE for i in (0, 1))
+    tol = 1.0 / _DISP_SCALE
+    k = np.arange(depth, dtype=np.float64)[:, None, None]
+    return covered[None] & (k / depth < hi[None] - tol) & ((k + 1) / depth > lo[None] + tol)
+
+
+# -- encodings and the distance texture -------------------------------------------------
+
+def _encode_color(linear: np.ndarray, occupied: np.ndarray) -> np.ndarray:
+    """sRGB uint8 colour with alpha 255 where occupied, 0 elsewhere."""
+    rgba = np.concatenate([linear[..., :3], occupied[..., None].astype(np.float32)], axis=-1)
+    return to_rgba8(rgba)
+
+
+def _unit(vectors: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(vectors, axis=-1, keepdims=True)
+    return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-6)
+
+
+def _encode_normal(normal: np.ndarray) -> np.ndarray:
+    """(n + 1) / 2 * 255 as uint8 (a zero normal, opposite samples cancelled, is 128)."""
+    return np.round((np.clip(normal, -1.0, 1.0) + 1.0) * 127.5).astype(np.uint8)
+
+
+def _encode_w(w: np.ndarray) -> np.ndarray:
+    return np.round(np.clip(w, 0.0, 1.0) * _DISP_SCALE).astype(np.uint16)
+
+
+def _distance(occupied: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
+    """(D, H, W) uint8: from each voxel centre to the nearest occupied voxel centre, in
+    units of the smallest voxel side, rounded down, clamped at MAX_DISTANCE (all of it
+    where the box is empty)."""
+    from scipy.ndimage import distance_transform_edt
+
+    if not occupied.any():
+        return np.full(occupied.shape, MAX_DISTANCE, np.uint8)
+    sides = voxel_sides(box_to_world, occupied.shape)
+    distance = distance_transform_edt(~occupied, sampling=sides / sides.min())
+    return np.minimum(np.floor(distance + 1e-6), MAX_DISTANCE).astype(np.uint8)
+
+
+def voxel_sides(box_to_world: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
+    """World lengths of a (D, H, W) grid's voxel sides, in array order (w, v, u)."""
+    lengths = np.linalg.norm(np.asarray(box_to_world)[:3, :3], axis=0)
+    d, h, w = shape
+    return np.array([lengths[2] / d, lengths[1] / h, lengths[0] / w])
+
