@@ -266,3 +266,34 @@ def test_the_rho_sweep_finds_the_highest_density_in_its_window():
         assert value == pytest.approx(density(normal, rho), rel=1e-9, abs=1e-12)
         samples = np.linspace(*window, 301)
         assert max(density(normal, r) for r in samples) <= value + 1e-9 * abs(value) + 1e-12
+
+
+@pytest.mark.parametrize("shape", ["disc", "square", "circle", "segment", "grid"])
+def test_the_convex_hull_keeps_exactly_the_hull_vertices(shape):
+    """The interior filter never drops a hull vertex: the hull matches qhull's."""
+    from scipy.spatial import ConvexHull
+
+    from reliefkit.techniques.billboard.rectangles import convex_hull_2d
+
+    rng = np.random.default_rng(7)
+    if shape == "disc":
+        r, a = np.sqrt(rng.uniform(size=4000)), rng.uniform(0, 2 * np.pi, 4000)
+        pts = np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+    elif shape == "square":
+        pts = rng.uniform(-1, 1, (4000, 2))
+    elif shape == "circle":
+        a = rng.uniform(0, 2 * np.pi, 500)
+        pts = np.stack([np.cos(a), np.sin(a)], axis=1)
+    elif shape == "segment":
+        pts = np.outer(rng.uniform(size=50), [2.0, 1.0])
+    else:
+        pts = np.stack(np.meshgrid(np.arange(7.0), np.arange(5.0)), axis=-1).reshape(-1, 2)
+    hull = convex_hull_2d(pts)
+    if shape == "segment":
+        assert len(hull) == 2 and set(map(tuple, hull)) == {tuple(pts.min(0)), tuple(pts.max(0))}
+        return
+    expected = pts[ConvexHull(pts).vertices]
+    assert set(map(tuple, hull)) == set(map(tuple, expected))
+    turn = [(b - a)[0] * (c - b)[1] - (b - a)[1] * (c - b)[0] for a, b, c in
+            zip(hull, np.roll(hull, -1, 0), np.roll(hull, -2, 0), strict=True)]
+    assert min(turn) > 0                       # counter-clockwise, no collinear vertices

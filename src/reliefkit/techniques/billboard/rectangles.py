@@ -49,9 +49,9 @@ def _drop_interior(pts: np.ndarray) -> np.ndarray:
     round cloud to the Python loop, a quadrilateral over a third."""
     x, y = pts[:, 0], pts[:, 1]
     keys = (-x, -x - y, -y, x - y, x, x + y, y, y - x)     # maximised in turn
-    corners = [int(np.argmax(k)) for k in keys]
-    corners = [c for i, c in enumerate(corners) if c != corners[i - 1]]   # drop repeats
-    if len(set(corners)) < 3:
+    extremes = [int(np.argmax(k)) for k in keys]
+    corners = [c for i, c in enumerate(extremes) if c != extremes[i - 1]]  # drop repeats
+    if len(set(corners)) < 3:    # a repeated corner would make a zero edge, nothing inside
         return pts
     polygon = pts[corners]
     inside = np.ones(len(pts), dtype=bool)
