@@ -60,7 +60,9 @@ from ...gl.shaders import program
 from ...gl.textures import check_3d_size, texture2d, texture3d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from ...render.proxy import box_planes, convex_proxy
+from ...scene.camera import Camera
 from .boxes import BillboardBox, BillboardBoxes
+from .lod import flatten_factor
 
 PROGRAM = "billboard:boxes.glsl"
 MARCHES = ("sphere", "uniform", "exact")
@@ -87,6 +89,11 @@ class BoxRenderOptions:
                            lo=0.0, hi=1.0)
     max_iterations: int = param(0, "bound on every march (0: from the box's resolution)",
                                 lo=0, hi=16384)
+    lod: str = param("off", "auto: flatten the boxes with distance and draw the flat "
+                     "billboard cloud beyond the distance where epsilon is under a pixel "
+                     "(§3.4.2)", choices=("off", "auto"))
+    transition: float = param(0.5, "lod auto: flattening starts at this fraction of the "
+                              "switch distance", lo=0.0, hi=0.999)
 
 
 def scale_w(factor: float) -> np.ndarray:
@@ -173,10 +180,10 @@ class _BoxPart:
     """One box's GL objects: textures, proxy buffers, its fixed uniforms."""
 
     def __init__(self, ctx, prog, box: BillboardBox, variant: str, opts, thickness):
-        self.box_to_world = drawn_box_to_world(box, opts.flatten)
-        self.proxy = convex_proxy(box_planes(invert_box(self.box_to_world)),
-                                  near=self.box_to_world[:3, 3]
-                                  + self.box_to_world[:3, :3] @ [0.5, 0.5, 0.5])
+        self.box = box
+        full = np.asarray(box.box_to_world, np.float64)  # contains every flattening of it
+        self.proxy = convex_proxy(box_planes(invert_box(full)),
+                                  near=full[:3, 3] + full[:3, :3] @ [0.5, 0.5, 0.5])
         self.textures, self.vao, self.vbo, self.ibo = {}, None, None, None
         try:
             self.textures = box_textures(ctx, box, variant)
@@ -202,9 +209,10 @@ class _BoxPart:
         eye_z = np.c_[corners, np.ones(len(corners))] @ camera.view[2]
         return bool(eye_z.max() > -camera.near * 1.001)
 
-    def box_uniforms(self, camera) -> dict:
-        """The box transforms in the camera's relative world space (float64 products)."""
-        relative = translation(-np.asarray(camera.origin, np.float64)) @ self.box_to_world
+    def box_uniforms(self, camera, flatten: float) -> dict:
+        """The box transforms, flattened, in the camera's relative world space (float64)."""
+        drawn = drawn_box_to_world(self.box, flatten)
+        relative = translation(-np.asarray(camera.origin, np.float64)) @ drawn
         return {"u_box_to_world": relative, "u_world_to_box": invert_box(relative)}
 
     def release(self) -> None:
@@ -231,23 +239,41 @@ class BillboardBoxesDrawable:
             VARIANT_DEFINES[boxes.variant]: True, f"MARCH_{opts.march.upper()}": True,
             "COUNT_ITERATIONS": instrument})
         self.parts: list[_BoxPart] = []
+        self.cloud = None  # the flat cloud, drawn beyond the switch distance (lod auto)
+        self.drawn = {}
         try:
             for box in boxes.boxes:
                 self.parts.append(_BoxPart(ctx, self.prog, box, boxes.variant, opts,
                                            boxes.thickness))
+            if opts.lod == "auto":
+                from .render import BillboardCloudDrawable
+
+                self.cloud = BillboardCloudDrawable(ctx, boxes.cloud, instrument=instrument)
         except BaseException:
             self.release()
             raise
         check_gl_error(ctx, "uploading billboard boxes")
 
     def draw(self, camera, light) -> None:
+        flatten = self.options.flatten
+        if self.cloud is not None and isinstance(camera, Camera):
+            flatten *= flatten_factor(camera, self.boxes.epsilon, self.boxes.center,
+                                      self.options.transition)
+        self.drawn = {"lod": "boxes", "flatten": flatten}
+        if self.cloud is not None and flatten <= 0.0:
+            self.drawn["lod"] = "billboard cloud"
+            self.cloud.draw(camera, light)
+            return
+        self._draw_boxes(camera, light, flatten)
+
+    def _draw_boxes(self, camera, light, flatten: float) -> None:
         import moderngl
 
         set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms())
         self.ctx.enable(moderngl.CULL_FACE)
         try:
             for part in self.parts:
-                set_uniforms(self.prog, part.uniforms | part.box_uniforms(camera)
+                set_uniforms(self.prog, part.uniforms | part.box_uniforms(camera, flatten)
                              | model_offset(camera, part.proxy.origin))
                 for unit, (name, tex) in enumerate(part.textures.items()):
                     tex.use(unit)
@@ -259,11 +285,15 @@ class BillboardBoxesDrawable:
 
     def finish(self, frame) -> None:
         frame.stats["boxes"] = len(self.parts)
+        frame.stats |= self.drawn
 
     def release(self) -> None:
         for part in self.parts:
             part.release()
         self.parts = []
+        if self.cloud is not None:
+            self.cloud.release()
+            self.cloud = None
 
 
 def drawable_spec() -> DrawableSpec:

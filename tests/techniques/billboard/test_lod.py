@@ -1,0 +1,62 @@
+"""Blending a DMBBC into its billboard cloud with distance (§3.4.2): the switch distance is
+where epsilon covers one pixel, the boxes flatten linearly before it, the cloud is drawn
+beyond it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from reliefkit.render import render
+from reliefkit.scene.camera import Camera
+from reliefkit.techniques.billboard.lod import flatten_factor, switch_distance
+
+
+def test_at_the_switch_distance_epsilon_spans_one_pixel():
+    camera = Camera.orbit((0, 0, 0), 0, 0, 10.0, fov_deg=40, size=(300, 200))
+    epsilon = 0.07
+    d = switch_distance(camera, epsilon)
+    at = Camera.orbit((0, 0, 0), 0, 0, d, fov_deg=40, size=(300, 200), near=d / 100, far=2 * d)
+    from reliefkit.core.transforms import transform_points
+
+    clip = transform_points(at.proj @ at.view, np.array([[0, 0, 0], [0, epsilon, 0.0]]))
+    pixels = (clip[1, 1] - clip[0, 1]) / 2 * at.size[1]
+    assert pixels == pytest.approx(1.0, rel=1e-9)
+
+
+def test_the_boxes_flatten_linearly_between_the_transition_and_the_switch():
+    camera = Camera.orbit((0, 0, 0), 0, 0, 1.0, size=(256, 256))
+    switch = switch_distance(camera, 0.1)
+    factor = [flatten_factor(Camera.orbit((0, 0, 0), 0, 0, k * switch, size=(256, 256)),
+                             0.1, (0, 0, 0), 0.5) for k in (0.2, 0.5, 0.625, 0.75, 1.0, 1.5)]
+    np.testing.assert_allclose(factor, [1.0, 1.0, 0.75, 0.5, 0.0, 0.0], atol=1e-12)
+    ortho = Camera(eye=(0, 0, 5), target=(0, 0, 0), ortho_height=1.0, size=(100, 100))
+    assert flatten_factor(ortho, 0.05, (0, 0, 0), 0.5) == 1.0   # pixel 0.02 < epsilon
+    assert flatten_factor(ortho, 0.005, (0, 0, 0), 0.5) == 0.0
+
+
+def test_lod_auto_draws_the_boxes_near_and_the_cloud_far(gl):
+    from reliefkit.techniques.billboard import TECHNIQUE
+
+    boxes = TECHNIQUE.samples()["dmbbc"]
+    near = Camera.orbit((0, 0, 0), 30, 20, 4.0, size=(160, 160))  # switch at 11
+    frame = render(boxes, near, lod="auto")
+    assert frame.stats["lod"] == "boxes" and frame.stats["flatten"] == 1.0
+    assert (frame.mask == render(boxes, near).mask).all()
+    d = 1.2 * switch_distance(near, boxes.epsilon)
+    far = Camera.orbit((0, 0, 0), 30, 20, d, size=(160, 160), near=d / 100, far=2 * d)
+    frame = render(boxes, far, lod="auto")
+    assert frame.stats["lod"] == "billboard cloud"
+    np.testing.assert_array_equal(frame.color, render(boxes.cloud, far).color)
+
+
+def test_flattening_keeps_the_footprint_and_flattened_boxes_look_like_the_cloud(gl):
+    """Seen along its normal, a flattened box covers what the cloud's rectangle shows."""
+    from reliefkit.techniques.billboard import TECHNIQUE
+
+    boxes = TECHNIQUE.samples()["dmbbc"]
+    camera = Camera(eye=(0.0, 0.0, 6.0), target=(0.0, 0.0, 0.0), size=(64, 64), fov_deg=30)
+    flat = render(boxes, camera, flatten=0.001)
+    cloud = render(boxes.cloud, camera)
+    both = flat.mask & cloud.mask
+    assert both.sum() >= 0.95 * max(flat.mask.sum(), cloud.mask.sum())
