@@ -1,4 +1,5 @@
-"""Billboard tiles of the demo sheet: the tree and the vehicle as billboard clouds."""
+"""Billboard tiles of the demo sheet: the tree and the vehicle as billboard clouds and as
+volumetric displacement-mapped billboard clouds with the same planes."""
 
 from __future__ import annotations
 
@@ -19,6 +20,10 @@ def demo_tiles() -> list[DemoTile]:
     return [
         DemoTile("tree: billboard cloud", "tree-bbc", _baked("tree", "billboard-cloud"),
                  (20.0, 10.0, 2.4)),
+        DemoTile("tree: volumetric DMBBC", "tree-dmbbc", _baked("tree", "dmbbc"),
+                 (20.0, 10.0, 2.4)),
         DemoTile("vehicle: billboard cloud", "vehicle-bbc", _baked("vehicle", "billboard-cloud"),
+                 (40.0, 20.0, None)),
+        DemoTile("vehicle: volumetric DMBBC", "vehicle-dmbbc", _baked("vehicle", "dmbbc"),
                  (40.0, 20.0, None)),
     ]
