@@ -41,8 +41,8 @@ def test_the_byte_cap_counts_what_is_uploaded(monkeypatch):
 
 
 @pytest.mark.parametrize("array, match", [
-    (np.zeros((4, 4, 4, 5), np.uint8), "needs an \\(L, H, W\\)"),
-    (np.zeros((4, 4), np.uint8), "needs an \\(L, H, W\\)"),
+    (np.zeros((4, 4, 4, 5), np.uint8), "needs an array of shape \\(L, H, W\\)"),
+    (np.zeros((4, 4), np.uint8), "needs an array of shape \\(L, H, W\\)"),
     (np.zeros((1, 4, 4, 4), np.int64), "unsupported texture array dtype"),
     (np.zeros((1, 4, 4, 3), np.uint8), "sRGB texture arrays must be"),
     (np.zeros((0, 4, 4, 4), np.uint8), "size must be positive"),

@@ -114,6 +114,22 @@ def check_3d_size(ctx, width: int, height: int, depth: int, what: str,
                        "use a smaller resolution or fewer channels")
 
 
+def _stacked(array, filter: str, what: str, noun: str, shape: str, dtypes) -> np.ndarray:
+    """A stack of 2D images as (N, H, W, C), checked: filter name, shape, dtype."""
+    if filter not in ("linear", "nearest"):
+        raise GPUError(f"{what}: filter must be 'linear' or 'nearest', got {filter!r}")
+    arr = np.asarray(array)
+    if arr.ndim == 3:
+        arr = arr[..., None]
+    if arr.ndim != 4 or not 1 <= arr.shape[3] <= 4:
+        raise GPUError(f"{what}: {noun} needs an array of shape {shape} or {shape[:-1]}, "
+                       f"1..4), got {np.shape(array)}")
+    if arr.dtype not in dtypes:
+        raise GPUError(f"{what}: unsupported {noun.split(' ', 1)[1]} dtype {arr.dtype} "
+                       "(use uint8, float16 or float32)")
+    return arr
+
+
 def texture3d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "linear",
               repeat: bool = False):
     """Upload a (D, H, W) or (D, H, W, C<=4) array indexed [w, v, u] as a 3D texture.
@@ -125,17 +141,7 @@ def texture3d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "l
     """
     import moderngl
 
-    if filter not in ("linear", "nearest"):
-        raise GPUError(f"{what}: filter must be 'linear' or 'nearest', got {filter!r}")
-    arr = np.asarray(array)
-    if arr.ndim == 3:
-        arr = arr[..., None]
-    if arr.ndim != 4 or not 1 <= arr.shape[3] <= 4:
-        raise GPUError(f"{what}: a 3D texture needs a (D, H, W) or (D, H, W, 1..4) array, "
-                       f"got shape {np.shape(array)}")
-    if arr.dtype not in _DTYPES_3D:
-        raise GPUError(f"{what}: unsupported 3D texture dtype {arr.dtype} "
-                       "(use uint8, float16 or float32)")
+    arr = _stacked(array, filter, what, "a 3D texture", "(D, H, W)", _DTYPES_3D)
     depth, height, width, comps = (int(s) for s in arr.shape)
     check_3d_size(ctx, width, height, depth, what, nbytes=arr.size * arr.dtype.itemsize)
     data = np.ascontiguousarray(arr).tobytes()
@@ -190,17 +196,7 @@ def texture_array(ctx, array: np.ndarray, *, what: str = "texture", srgb: bool =
     """
     import moderngl
 
-    if filter not in ("linear", "nearest"):
-        raise GPUError(f"{what}: filter must be 'linear' or 'nearest', got {filter!r}")
-    arr = np.asarray(array)
-    if arr.ndim == 3:
-        arr = arr[..., None]
-    if arr.ndim != 4 or not 1 <= arr.shape[3] <= 4:
-        raise GPUError(f"{what}: a texture array needs an (L, H, W) or (L, H, W, 1..4) array, "
-                       f"got shape {np.shape(array)}")
-    if arr.dtype not in _DTYPES_ARRAY:
-        raise GPUError(f"{what}: unsupported texture array dtype {arr.dtype} "
-                       "(use uint8, float16 or float32)")
+    arr = _stacked(array, filter, what, "a texture array", "(L, H, W)", _DTYPES_ARRAY)
     if srgb and (arr.dtype != np.uint8 or arr.shape[3] != 4):
         raise GPUError(f"{what}: sRGB texture arrays must be (L, H, W, 4) uint8")
     layers, height, width, comps = (int(s) for s in arr.shape)

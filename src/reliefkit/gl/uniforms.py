@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.transforms import translation
+from ..core.transforms import invert_box, translation
 
 
 def set_uniforms(prog, values: dict) -> None:
@@ -43,3 +43,11 @@ def model_offset(camera, origin) -> dict:
     (float64 world point) to place it in the camera's relative world space."""
     offset = np.asarray(origin, dtype=np.float64) - np.asarray(camera.origin, dtype=np.float64)
     return {"u_model_offset": tuple(float(x) for x in offset)}
+
+
+def box_uniforms(camera, box_to_world) -> dict:
+    """``u_box_to_world`` and ``u_world_to_box`` of a box in the camera's relative world
+    space (`camera_uniforms`), composed and inverted in float64 about the box."""
+    relative = translation(-np.asarray(camera.origin, np.float64)) @ np.asarray(
+        box_to_world, np.float64)
+    return {"u_box_to_world": relative, "u_world_to_box": invert_box(relative)}

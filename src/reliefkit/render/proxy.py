@@ -31,6 +31,15 @@ class Proxy:
         return self.positions.astype(np.float64) + self.origin
 
 
+def cull_face(proxy: Proxy, camera) -> str:
+    """The faces to cull when drawing ``proxy``: "back", or "front" when it reaches in front
+    of the near plane (the camera inside or close), where its front faces would be clipped;
+    shaders that build each pixel's ray from the window position draw its back faces then."""
+    corners = proxy.world_positions
+    eye_z = np.c_[corners, np.ones(len(corners))] @ np.asarray(camera.view)[2]
+    return "front" if eye_z.max() > -camera.near * 1.001 else "back"
+
+
 def box_planes(world_to_box: np.ndarray) -> np.ndarray:
     """The six planes of the unit cube pulled back to world space (rows a, b, c, d)."""
     m = np.asarray(world_to_box, dtype=np.float64)

@@ -53,13 +53,13 @@ import numpy as np
 
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
-from ...core.transforms import invert_box, translation
+from ...core.transforms import invert_box
 from ...errors import UsageError
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
 from ...gl.textures import check_3d_size, texture2d, texture3d
-from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from ...render.proxy import box_planes, convex_proxy
+from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
+from ...render.proxy import box_planes, convex_proxy, cull_face
 from ...scene.camera import Camera
 from .boxes import BillboardBox, BillboardBoxes
 from .lod import flatten_factor
@@ -202,18 +202,9 @@ class _BoxPart:
             "u_max_iterations": opts.max_iterations or automatic_iterations(
                 box.resolution, opts.march, variant, opts.samples, min_step)}
 
-    def reaches_near_plane(self, camera) -> bool:
-        """Does the proxy extend in front of the near plane (camera inside or close)? Then
-        its back faces are drawn instead of the clipped front ones."""
-        corners = self.proxy.world_positions
-        eye_z = np.c_[corners, np.ones(len(corners))] @ camera.view[2]
-        return bool(eye_z.max() > -camera.near * 1.001)
-
     def box_uniforms(self, camera, flatten: float) -> dict:
-        """The box transforms, flattened, in the camera's relative world space (float64)."""
-        drawn = drawn_box_to_world(self.box, flatten)
-        relative = translation(-np.asarray(camera.origin, np.float64)) @ drawn
-        return {"u_box_to_world": relative, "u_world_to_box": invert_box(relative)}
+        """The box transforms, flattened, in the camera's relative world space."""
+        return box_uniforms(camera, drawn_box_to_world(self.box, flatten))
 
     def release(self) -> None:
         for obj in (self.vao, self.vbo, self.ibo, *self.textures.values()):
@@ -278,7 +269,7 @@ class BillboardBoxesDrawable:
                 for unit, (name, tex) in enumerate(part.textures.items()):
                     tex.use(unit)
                     set_uniforms(self.prog, {name: unit})
-                self.ctx.cull_face = "front" if part.reaches_near_plane(camera) else "back"
+                self.ctx.cull_face = cull_face(part.proxy, camera)
                 part.vao.render()
         finally:
             self.ctx.disable(moderngl.CULL_FACE)

@@ -7,14 +7,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.params import param
-from ...core.transforms import translation
 from ...errors import UsageError
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
 from ...gl.textures import texture2d
-from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
+from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
-from ...render.proxy import aabb_planes, box_planes, convex_proxy
+from ...render.proxy import aabb_planes, box_planes, convex_proxy, cull_face
 from .representation import ReliefObject, ReliefTexture
 
 METHODS = ("binary", "exact", "robust")
@@ -99,34 +98,19 @@ class ReliefDrawable:
         }
         check_gl_error(ctx, "uploading a relief texture")
 
-    def reaches_near_plane(self, camera) -> bool:
-        """Does the proxy extend in front of the near plane (camera inside or close)?
-
-        Then its front faces would be clipped and the back faces are drawn instead; the
-        shader builds the ray from the window position, not from the face it was drawn for.
-        """
-        corners = self.proxy.world_positions
-        eye_z = np.c_[corners, np.ones(len(corners))] @ camera.view[2]
-        return bool(eye_z.max() > -camera.near * 1.001)
-
     def draw(self, camera, light) -> None:
         import moderngl
 
-        set_uniforms(self.prog, self.uniforms | self._box_uniforms(camera)
+        set_uniforms(self.prog, self.uniforms | box_uniforms(camera, self.relief.box_to_world)
                      | camera_uniforms(camera) | model_offset(camera, self.proxy.origin)
                      | light.uniforms())
         for unit, (name, tex) in enumerate(self.textures.items()):
             tex.use(unit)
             set_uniforms(self.prog, {name: unit})
         self.ctx.enable(moderngl.CULL_FACE)
-        self.ctx.cull_face = "front" if self.reaches_near_plane(camera) else "back"
+        self.ctx.cull_face = cull_face(self.proxy, camera)
         self.vao.render()
         self.ctx.disable(moderngl.CULL_FACE)
-
-    def _box_uniforms(self, camera) -> dict:
-        """The box transforms in the camera's relative world space (float64 products)."""
-        relative = translation(-np.asarray(camera.origin)) @ self.relief.box_to_world
-        return {"u_box_to_world": relative, "u_world_to_box": np.linalg.inv(relative)}
 
     def finish(self, frame) -> None:
         """Depth AOV from the hit positions (in conservative mode the Z-buffer holds the box)."""
