@@ -13,7 +13,9 @@ def set_uniforms(prog, values: dict) -> None:
         if name not in prog:
             continue
         if isinstance(value, np.ndarray) and value.shape == (4, 4):
-            prog[name].write(value.T.astype(np.float32).tobytes())  # GL is column-major
+            with np.errstate(under="ignore"):  # entries like 1e-49 (rounding) become 0
+                matrix = value.T.astype(np.float32)
+            prog[name].write(matrix.tobytes())  # GL is column-major
         else:
             prog[name].value = value
 

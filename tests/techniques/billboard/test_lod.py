@@ -60,3 +60,29 @@ def test_flattening_keeps_the_footprint_and_flattened_boxes_look_like_the_cloud(
     cloud = render(boxes.cloud, camera)
     both = flat.mask & cloud.mask
     assert both.sum() >= 0.95 * max(flat.mask.sum(), cloud.mask.sum())
+
+
+def test_just_before_the_switch_the_boxes_show_the_clouds_own_filtered_colours(gl):
+    """The handoff: as the boxes flatten their colour turns into the cloud's (same atlas, same
+    mip level), so the switch to the cloud changes little. The reference is the cloud drawn
+    from the same camera."""
+    from reliefkit.scene.assets import make_asset
+    from reliefkit.techniques.billboard.box_bake import bake_boxes
+
+    mesh = make_asset("vehicle")  # colours that vary within a voxel's footprint
+    lo, hi = mesh.bounds
+    boxes = bake_boxes(mesh, "volumetric", texel_size=float(np.linalg.norm(hi - lo)) / 96)
+    probe = Camera.orbit(boxes.center, 30, 20, 1.0, size=(256, 256))
+    d = 0.999 * switch_distance(probe, boxes.epsilon)
+    camera = Camera.orbit(boxes.center, 30, 20, d, size=(256, 256), near=d / 100, far=2 * d)
+    lod = render(boxes, camera, lod="auto")
+    assert lod.stats["lod"] == "boxes" and lod.stats["flatten"] < 0.01
+    plain = render(boxes, camera, flatten=lod.stats["flatten"])  # flattened, no handoff
+    cloud = render(boxes.cloud, camera)
+    both = lod.mask & cloud.mask
+    assert both.sum() > 50
+    handed = np.abs(lod.color[both] - cloud.color[both]).max(axis=-1)
+    kept = np.abs(plain.color[both] - cloud.color[both]).max(axis=-1)
+    print(f"median colour difference to the cloud: {np.median(handed):.4f} with the handoff, "
+          f"{np.median(kept):.4f} without")
+    assert np.median(handed) < 0.01 and np.median(handed) < 0.5 * np.median(kept)

@@ -233,9 +233,11 @@ class BillboardBoxesDrawable:
         self.cloud = None  # the flat cloud, drawn beyond the switch distance (lod auto)
         self.drawn = {}
         try:
-            for box in boxes.boxes:
+            for k, box in enumerate(boxes.boxes):
                 self.parts.append(_BoxPart(ctx, self.prog, box, boxes.variant, opts,
                                            boxes.thickness))
+                self.parts[-1].uniforms |= _atlas_uniforms(boxes.cloud, k)
+                self.parts[-1].log2_texel = _log2_texel(boxes.cloud, k)
             if opts.lod == "auto":
                 from .render import BillboardCloudDrawable
 
@@ -246,26 +248,43 @@ class BillboardBoxesDrawable:
         check_gl_error(ctx, "uploading billboard boxes")
 
     def draw(self, camera, light) -> None:
-        flatten = self.options.flatten
+        lod = 1.0
         if self.cloud is not None and isinstance(camera, Camera):
-            flatten *= flatten_factor(camera, self.boxes.epsilon, self.boxes.center,
-                                      self.options.transition)
+            lod = flatten_factor(camera, self.boxes.epsilon, self.boxes.center,
+                                 self.options.transition)
+        flatten = self.options.flatten * lod
         self.drawn = {"lod": "boxes", "flatten": flatten}
         if self.cloud is not None and flatten <= 0.0:
             self.drawn["lod"] = "billboard cloud"
             self.cloud.draw(camera, light)
             return
-        self._draw_boxes(camera, light, flatten)
+        self._draw_boxes(camera, light, flatten, handoff=1.0 - lod)
 
-    def _draw_boxes(self, camera, light, flatten: float) -> None:
+    def _handoff_uniforms(self, camera, handoff: float) -> dict:
+        """What the shader needs to fade into the cloud's own filtered colour and normal."""
+        values = {"u_handoff": float(handoff), "u_bbc_color": _CLOUD_COLOR_UNIT,
+                  "u_bbc_normal": _CLOUD_NORMAL_UNIT}
+        if handoff > 0.0:
+            self.cloud.color.use(_CLOUD_COLOR_UNIT)
+            self.cloud.normal.use(_CLOUD_NORMAL_UNIT)
+            values["u_pixel_world"] = (2.0 * camera.ortho_height / camera.size[1]
+                                       if camera.orthographic else 0.0)
+        return values
+
+    def _draw_boxes(self, camera, light, flatten: float, handoff: float = 0.0) -> None:
         import moderngl
 
-        set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms())
+        set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms()
+                     | self._handoff_uniforms(camera, handoff))
+        pixel_scale = 0.0
+        if handoff > 0.0 and not camera.orthographic:
+            pixel_scale = 2.0 * math.tan(math.radians(camera.fov_deg) / 2) / camera.size[1]
         self.ctx.enable(moderngl.CULL_FACE)
         try:
             for part in self.parts:
                 set_uniforms(self.prog, part.uniforms | part.box_uniforms(camera, flatten)
-                             | model_offset(camera, part.proxy.origin))
+                             | model_offset(camera, part.proxy.origin)
+                             | {"u_texel_lod": (part.log2_texel, pixel_scale)})
                 for unit, (name, tex) in enumerate(part.textures.items()):
                     tex.use(unit)
                     set_uniforms(self.prog, {name: unit})
@@ -285,6 +304,22 @@ class BillboardBoxesDrawable:
         if self.cloud is not None:
             self.cloud.release()
             self.cloud = None
+
+
+_CLOUD_COLOR_UNIT, _CLOUD_NORMAL_UNIT = 4, 5  # after a box's own (at most 4) textures
+
+
+def _atlas_uniforms(cloud, k: int) -> dict:
+    """Where box k's rectangle lies in the cloud's atlas (box u, v = the rectangle's s, t)."""
+    page, x, y, w, h = (float(v) for v in cloud.rects[k])
+    height, width = cloud.color.shape[1:3]
+    return {"u_atlas_rect": (x / width, y / height, w / width, h / height),
+            "u_atlas_page": page}
+
+
+def _log2_texel(cloud, k: int) -> float:
+    """log2 of rectangle k's texel size in the world (its mip level 0 footprint)."""
+    return math.log2(float(np.linalg.norm(cloud.u_axes[k])) / float(cloud.rects[k][3]))
 
 
 def drawable_spec() -> DrawableSpec:

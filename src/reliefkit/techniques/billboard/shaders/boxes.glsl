@@ -15,6 +15,9 @@ void main() {
 #endif
 
 #if defined FRAGMENT_SHADER
+#if defined GL_ES
+precision highp sampler2DArray;
+#endif
 #include "core:include/camera.glsl"
 #include "core:include/raybox.glsl"
 #include "core:include/shading.glsl"
@@ -24,6 +27,28 @@ void main() {
 #include "include/box_march.glsl"
 uniform mat4 u_world_to_box;  // relative to the camera's origin (box_render.py)
 uniform mat4 u_box_to_world;
+// Handing over to the billboard cloud (lod auto, §3.4.2): as the box flattens, its colour and
+// normal turn into the cloud's, filtered as the cloud filters them, so the switch to the cloud
+// at zero depth changes (almost) nothing. u_handoff = 1 - the flatten factor; 0 otherwise.
+uniform float u_handoff;
+uniform sampler2DArray u_bbc_color;   // the cloud's atlases (render.py: linear colour, normal)
+uniform sampler2DArray u_bbc_normal;
+uniform vec4 u_atlas_rect;            // this box's rectangle in the atlas: x, y, w, h (0..1)
+uniform float u_atlas_page;
+uniform vec2 u_texel_lod;             // (log2 of the cloud's texel, pixel size per distance)
+uniform float u_pixel_world;          // orthographic cameras: one pixel's world size
+
+// The cloud's colour and normal at box point (u, v) of hit `world`, at the mip level of the
+// pixel's footprint on the rectangle there, stretched by the obliquity as the hardware's
+// choice for the cloud's quad is (its longer axis).
+void cloud_sample(vec2 uv, vec3 world, out vec4 color, out vec3 normal) {
+    float pixel = u_orthographic ? u_pixel_world : distance(u_eye, world) * u_texel_lod.y;
+    float slant = abs(dot(normalize(u_box_to_world[2].xyz), towards_eye(world)));
+    float lod = max(log2(pixel / max(slant, 1e-3)) - u_texel_lod.x, 0.0);
+    vec3 at = vec3(u_atlas_rect.xy + uv * u_atlas_rect.zw, u_atlas_page);
+    color = textureLod(u_bbc_color, at, lod);
+    normal = textureLod(u_bbc_normal, at, lod).rgb * 2.0 - 1.0;
+}
 
 vec3 to_world(vec3 box) {
     vec4 w = u_box_to_world * vec4(box, 1.0);
@@ -49,11 +74,21 @@ void main() {
         discard;
 #endif
     }
-    vec3 hit = to_world(clamp((o + s_hit * d) / res, 0.0, 1.0));
+    vec3 box_hit = clamp((o + s_hit * d) / res, 0.0, 1.0);
+    vec3 hit = to_world(box_hit);
+    vec3 base = cell_color(cell).rgb;
     vec3 n = cell_normal(cell);
+    if (u_handoff > 0.0) {
+        vec4 cloud_color;
+        vec3 cloud_normal;
+        cloud_sample(box_hit.xy, hit, cloud_color, cloud_normal);
+        base = mix(base, cloud_color.rgb, u_handoff);
+        vec3 blended = mix(n, cloud_normal, u_handoff);
+        n = dot(blended, blended) > 1e-12 ? normalize(blended) : n;
+    }
     vec3 to_eye = towards_eye(hit);
     if (dot(n, to_eye) < 0.0) n = -n;  // two-sided, like the ground-truth mesh
-    write_frame(vec4(shade_phong(cell_color(cell).rgb, n, to_eye, 1.0), 1.0), hit, n);
+    write_frame(vec4(shade_phong(base, n, to_eye, 1.0), 1.0), hit, n);
     write_iterations(iters, 0, true);
     gl_FragDepth = window_depth(hit);
 }
