@@ -8,7 +8,7 @@ The public API re-exported by `reliefkit`: `build_billboard_cloud`, `bake_billbo
 
 from __future__ import annotations
 
-from ...core.technique import Baker, CompareMetric, CompareVariant, Technique
+from ...core.technique import Baker, BenchSuite, CompareMetric, CompareVariant, Technique
 from . import box_render, render
 from .bake import bake_billboard_cloud
 from .bakers import BillboardBoxesParams, BillboardCloudParams, bake_cloud, bake_dmbbc
@@ -57,6 +57,12 @@ def _compare_variants() -> tuple[CompareVariant, ...]:
                                   lambda rep, v=variant: boxes(rep) and rep.variant != v,
                                   _other_variant(variant)) for variant in VARIANTS)
     return (flat, *marches, *others)
+
+
+def _bench(quick, out, log):
+    from .bench import run_suite
+
+    return run_suite(quick, out, log)
 
 
 def _demo_tiles():
@@ -130,6 +136,9 @@ TECHNIQUE = Technique(
     compare_variants=_compare_variants(),
     compare_metrics=(CompareMetric("wrong hits", _box_wrong_hits,
                                    ("wrong_hit_fraction", "wrong_pixels")),),
+    bench_suites=(BenchSuite("billboard", "Tables 1-2 and Fig. 6 of the DMBBC paper: BBC vs "
+                             "DMBBC vs the mesh, sphere vs uniform marches, the lod switch",
+                             _bench),),
     demo_tiles=_demo_tiles,
     programs=render.PROGRAMS + box_render.PROGRAMS,
     samples=_samples,
