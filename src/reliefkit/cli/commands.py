@@ -78,6 +78,8 @@ def cmd_bake(args) -> int:
     parts = ", ".join(f"{name} {format_bytes(n)}" for name, n in sizes.items())
     print(f"wrote {args.output}: {format_bytes(sum(sizes.values()))} of arrays ({parts}), "
           f"{format_bytes(Path(args.output).stat().st_size)} on disk")
+    for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
+        print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
 
 

@@ -132,6 +132,19 @@ class BillboardBoxes:
         total["billboard_cloud"] = sum(self.cloud.memory_bytes().values())
         return total
 
+    def bake_report(self) -> list[str]:
+        """What `reliefkit bake` says of fresh boxes: their variant and memory (Table 2)."""
+        from ...units import format_bytes
+
+        memory = self.memory_bytes()
+        maps = ", ".join(f"{name} {format_bytes(memory[name])}"
+                         for name in ("color", "normal", "distance", "displacement")
+                         if memory[name])
+        across = sorted({b.resolution[2] for b in self.boxes})
+        thickness = f", thickness {self.thickness:.3g}" if self.thickness is not None else ""
+        return [f"dmbbc {self.variant}: {len(self.boxes)} boxes, {'/'.join(map(str, across))} "
+                f"voxels across{thickness}; {maps}"] + self.cloud.bake_report()
+
     def summary(self) -> dict:
         lo, hi = self.bounds
         return {"kind": "dmbbc", "variant": self.variant, "boxes": len(self.boxes),

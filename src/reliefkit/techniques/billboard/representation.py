@@ -121,6 +121,19 @@ class BillboardCloud:
             total += alpha.size
         return empty / total
 
+    def bake_report(self) -> list[str]:
+        """What `reliefkit bake` says of a fresh cloud: planes, faces, skipped, empty texels."""
+        gen = self.params.get("generation", {})
+        faces = gen.get("faces_per_plane", [])
+        lines = [f"billboard cloud: {self.count} planes (faces per plane: "
+                 f"{', '.join(map(str, faces))}), {gen.get('skipped', 0)} faces skipped, "
+                 f"{100 * self.empty_texel_fraction():.1f}% of the rectangles' texels empty, "
+                 f"planes found in {gen.get('seconds', 0):.2f} s"]
+        if gen.get("skipped"):
+            lines.append(f"warning: {gen['skipped']} faces have no plane: "
+                         f"{gen.get('skipped_reason')}")
+        return lines
+
     def summary(self) -> dict:
         lo, hi = self.bounds
         pages, height, width = self.color.shape[:3]
