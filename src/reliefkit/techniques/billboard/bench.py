@@ -343,10 +343,10 @@ def change_detail(a, b) -> dict:
 def dolly(name, mesh, reps: dict, cfg: BenchConfig) -> dict:
     """The camera from 0.3x to 1.5x the switch distance in geometric steps: the change
     between consecutive frames of the DMBBC (lod auto, transition 0.5) and of the BBC alone
-    (the motion), and at the switch the same camera's boxes flattened to the minimum
-    (what the frame before drew) against the BBC (the pop without motion)."""
+    (the motion), and just inside the switch distance the boxes (flattened to almost nothing,
+    their colours handed over to the BBC's) against the BBC from the same camera (the pop
+    without motion)."""
     from ...render import render
-    from .box_render import MIN_FLATTEN
 
     vol = reps["volumetric"]
     switch = switch_radii(mesh, vol, cfg.size)
@@ -366,11 +366,14 @@ def dolly(name, mesh, reps: dict, cfg: BenchConfig) -> dict:
            "switch_step": switched, "switch_change": None, "switch_motion": None,
            "switch_static": None, "covered_at_switch": None}
     if switched is not None:
-        camera = camera_at(mesh, cfg.azimuths[0], float(steps[switched]), cfg.size, cfg)
-        before = render(vol, camera, march="sphere", flatten=MIN_FLATTEN)
+        # the pop without motion: just inside the switch distance, where lod auto still draws
+        # the boxes (flattened to almost nothing, colours handed over), against the BBC there
+        camera = camera_at(mesh, cfg.azimuths[0], 0.999 * switch, cfg.size, cfg)
+        before = render(vol, camera, march="sphere", lod="auto", transition=0.5)
+        after = render(reps["bbc"], camera)
         out |= {"switch_change": dm[switched - 1], "switch_motion": bb[switched - 1],
-                "switch_static": changed_fraction(before, boxes[switched]),
-                "switch_static_detail": change_detail(before, boxes[switched]),
+                "switch_static": changed_fraction(before, after),
+                "switch_static_detail": change_detail(before, after),
                 "covered_at_switch": int(boxes[switched].mask.sum()),
                 "switch_at_radii": float(steps[switched])}
     return out
@@ -548,8 +551,9 @@ def markdown(results: dict) -> str:
               "Changed pixels: any sRGB8 channel (or the coverage) differs by more than "
               f"{CHANGE_THRESHOLD}/255, over the pixels either frame covers. 'switch' is the "
               "step where the DMBBC's lod turns to the BBC; 'motion' the BBC's own change at "
-              "that step; 'no motion' the same camera's boxes flattened to the minimum (what "
-              "the previous frame drew) against the BBC.", "",
+              "that step; 'no motion' the boxes just inside the switch distance (lod auto: "
+              "flattened to almost nothing, colours handed over to the BBC's) against the "
+              "BBC from the same camera.", "",
               "| asset | switch at | frames (x per step) | DMBBC max | BBC max | switch | "
               "motion | no motion | no motion: coverage flips, median / p90 diff | covered px |",
               "|---" * 10 + "|"]
