@@ -587,6 +587,7 @@ def plot(results: dict, path: Path) -> bool:
         return False
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     assets = list(dict.fromkeys(r["asset"] for r in results["fig6"]))
     fig, axes = plt.subplots(1, len(assets), figsize=(4.2 * len(assets), 3.8), squeeze=False)
@@ -598,6 +599,8 @@ def plot(results: dict, path: Path) -> bool:
         ax.axvline(rows[0]["switch_radii"], color="gray", ls="--", lw=1, label="switch")
         ax.set(xscale="log", xlabel="distance (bounding radii)", ylabel="frame ms",
                title=f"Fig. 6: {name}")
+        ax.set_xticks([1.5, 3, 6, 12, 25, 50], ["1.5", "3", "6", "12", "25", "50"])
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.legend(fontsize=7)
     fig.tight_layout()
     with atomic_path(path) as tmp:
