@@ -86,3 +86,23 @@ def test_just_before_the_switch_the_boxes_show_the_clouds_own_filtered_colours(g
     print(f"median colour difference to the cloud: {np.median(handed):.4f} with the handoff, "
           f"{np.median(kept):.4f} without")
     assert np.median(handed) < 0.01 and np.median(handed) < 0.5 * np.median(kept)
+    # and the coverage is the cloud's, pixel for pixel, so the switch flips no pixel
+    np.testing.assert_array_equal(lod.mask, cloud.mask)
+    assert (plain.mask != cloud.mask).any()  # which the boxes' own coverage would
+
+
+def test_pixels_hand_over_to_the_cloud_in_proportion(gl):
+    """Halfway through the transition about half the pixels show the cloud (a stable
+    per-pixel threshold below the handoff)."""
+    from reliefkit.techniques.billboard import TECHNIQUE
+
+    boxes = TECHNIQUE.samples()["dmbbc"]
+    probe = Camera(eye=(0.0, 0.0, 1.0), target=(0.0, 0.0, 0.0), size=(160, 160), fov_deg=30)
+    d = 0.75 * switch_distance(probe, boxes.epsilon)  # handoff 0.5 with transition 0.5
+    camera = Camera(eye=(0.0, 0.0, d), target=(0.0, 0.0, 0.0), size=(160, 160), fov_deg=30,
+                    near=d / 100, far=2 * d)
+    lod, cloud = render(boxes, camera, lod="auto"), render(boxes.cloud, camera)
+    assert lod.stats["flatten"] == pytest.approx(0.5)
+    both = lod.mask & cloud.mask
+    same = (np.abs(lod.color - cloud.color).max(axis=-1) < 1e-6) & both
+    assert 0.3 < same.sum() / both.sum() < 0.7

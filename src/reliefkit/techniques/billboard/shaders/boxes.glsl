@@ -28,8 +28,12 @@ precision highp sampler2DArray;
 uniform mat4 u_world_to_box;  // relative to the camera's origin (box_render.py)
 uniform mat4 u_box_to_world;
 // Handing over to the billboard cloud (lod auto, §3.4.2): as the box flattens, its colour and
-// normal turn into the cloud's, filtered as the cloud filters them, so the switch to the cloud
-// at zero depth changes (almost) nothing. u_handoff = 1 - the flatten factor; 0 otherwise.
+// normal turn into the cloud's, filtered as the cloud filters them, and pixel by pixel (a
+// stable per-pixel threshold below u_handoff) its coverage becomes the cloud's: the ray's
+// crossing of the rectangle (w = 0.5) where the cloud's alpha test passes. At zero depth every
+// pixel draws what the cloud draws, so the switch to it changes (almost) nothing, and each
+// frame of the transition changes only its share of the pixels that differ.
+// u_handoff = 1 - the flatten factor; 0 otherwise.
 uniform float u_handoff;
 uniform sampler2DArray u_bbc_color;   // the cloud's atlases (render.py: linear colour, normal)
 uniform sampler2DArray u_bbc_normal;
@@ -50,6 +54,28 @@ void cloud_sample(vec2 uv, vec3 world, out vec4 color, out vec3 normal) {
     normal = textureLod(u_bbc_normal, at, lod).rgb * 2.0 - 1.0;
 }
 
+// A pixel's own threshold in [0, 1): an integer hash of its window position, the same in
+// every frame, so the pixels handed over only grow as u_handoff does.
+float pixel_threshold() {
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint h = p.x * 1973u + p.y * 9277u + 26699u;
+    h = (h ^ (h >> 13u)) * 1274126177u;
+    h ^= h >> 16u;
+    return float(h & 65535u) / 65536.0;
+}
+
+// Where the box segment a + s (b - a) crosses the rectangle (w = 0.5) and the cloud's
+// coverage there passes its alpha test (at the base level, as the cloud tests it).
+bool cloud_hit(vec3 a, vec3 ab, out float s_hit) {
+    s_hit = 0.0;
+    if (ab.z == 0.0) return false;
+    s_hit = (0.5 - a.z) / ab.z;
+    if (s_hit < 0.0 || s_hit > 1.0) return false;
+    vec2 uv = clamp(a.xy + s_hit * ab.xy, 0.0, 1.0);
+    vec3 at = vec3(u_atlas_rect.xy + uv * u_atlas_rect.zw, u_atlas_page);
+    return textureLod(u_bbc_color, at, 0.0).a >= 0.5;
+}
+
 vec3 to_world(vec3 box) {
     vec4 w = u_box_to_world * vec4(box, 1.0);
     return w.xyz / w.w;
@@ -64,9 +90,11 @@ void main() {
     vec3 o = a * res, d = (b - a) * res;   // voxel coordinates
     if (dot(d, d) == 0.0) discard;
     float s_hit;
-    ivec3 cell;
-    int iters;
-    if (!march(o, d, s_hit, cell, iters)) {
+    ivec3 cell = ivec3(0);
+    int iters = 1;
+    bool shows_cloud = u_handoff > 0.0 && pixel_threshold() < u_handoff;
+    bool found = shows_cloud ? cloud_hit(a, b - a, s_hit) : march(o, d, s_hit, cell, iters);
+    if (!found) {
 #if defined COUNT_ITERATIONS
         write_counted_miss(iters);  // count the work of a miss without drawing it
         return;
@@ -82,12 +110,16 @@ void main() {
         vec4 cloud_color;
         vec3 cloud_normal;
         cloud_sample(box_hit.xy, hit, cloud_color, cloud_normal);
-        base = mix(base, cloud_color.rgb, u_handoff);
-        vec3 blended = mix(n, cloud_normal, u_handoff);
+        float weight = shows_cloud ? 1.0 : u_handoff;
+        base = mix(base, cloud_color.rgb, weight);
+        vec3 blended = mix(n, cloud_normal, weight);
         n = dot(blended, blended) > 1e-12 ? normalize(blended) : n;
     }
     vec3 to_eye = towards_eye(hit);
-    if (dot(n, to_eye) < 0.0) n = -n;  // two-sided, like the ground-truth mesh
+    // two-sided like the ground-truth mesh; a pixel showing the cloud flips as the cloud's quad
+    // does, by the side of the rectangle it is seen from
+    vec3 facing = shows_cloud ? u_box_to_world[2].xyz : n;
+    if (dot(facing, to_eye) < 0.0) n = -n;
     write_frame(vec4(shade_phong(base, n, to_eye, 1.0), 1.0), hit, n);
     write_iterations(iters, 0, true);
     gl_FragDepth = window_depth(hit);
