@@ -237,7 +237,6 @@ class BillboardBoxesDrawable:
                 self.parts.append(_BoxPart(ctx, self.prog, box, boxes.variant, opts,
                                            boxes.thickness))
                 self.parts[-1].uniforms |= _atlas_uniforms(boxes.cloud, k)
-                self.parts[-1].log2_texel = _log2_texel(boxes.cloud, k)
             if opts.lod == "auto":
                 from .render import BillboardCloudDrawable
 
@@ -267,8 +266,6 @@ class BillboardBoxesDrawable:
         if handoff > 0.0:
             self.cloud.color.use(_CLOUD_COLOR_UNIT)
             self.cloud.normal.use(_CLOUD_NORMAL_UNIT)
-            values["u_pixel_world"] = (2.0 * camera.ortho_height / camera.size[1]
-                                       if camera.orthographic else 0.0)
         return values
 
     def _draw_boxes(self, camera, light, flatten: float, handoff: float = 0.0) -> None:
@@ -276,15 +273,11 @@ class BillboardBoxesDrawable:
 
         set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms()
                      | self._handoff_uniforms(camera, handoff))
-        pixel_scale = 0.0
-        if handoff > 0.0 and not camera.orthographic:
-            pixel_scale = 2.0 * math.tan(math.radians(camera.fov_deg) / 2) / camera.size[1]
         self.ctx.enable(moderngl.CULL_FACE)
         try:
             for part in self.parts:
                 set_uniforms(self.prog, part.uniforms | part.box_uniforms(camera, flatten)
-                             | model_offset(camera, part.proxy.origin)
-                             | {"u_texel_lod": (part.log2_texel, pixel_scale)})
+                             | model_offset(camera, part.proxy.origin))
                 for unit, (name, tex) in enumerate(part.textures.items()):
                     tex.use(unit)
                     set_uniforms(self.prog, {name: unit})
@@ -315,11 +308,6 @@ def _atlas_uniforms(cloud, k: int) -> dict:
     height, width = cloud.color.shape[1:3]
     return {"u_atlas_rect": (x / width, y / height, w / width, h / height),
             "u_atlas_page": page}
-
-
-def _log2_texel(cloud, k: int) -> float:
-    """log2 of rectangle k's texel size in the world (its mip level 0 footprint)."""
-    return math.log2(float(np.linalg.norm(cloud.u_axes[k])) / float(cloud.rects[k][3]))
 
 
 def drawable_spec() -> DrawableSpec:

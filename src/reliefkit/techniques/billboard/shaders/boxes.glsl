@@ -39,19 +39,27 @@ uniform sampler2DArray u_bbc_color;   // the cloud's atlases (render.py: linear 
 uniform sampler2DArray u_bbc_normal;
 uniform vec4 u_atlas_rect;            // this box's rectangle in the atlas: x, y, w, h (0..1)
 uniform float u_atlas_page;
-uniform vec2 u_texel_lod;             // (log2 of the cloud's texel, pixel size per distance)
-uniform float u_pixel_world;          // orthographic cameras: one pixel's world size
 
-// The cloud's colour and normal at box point (u, v) of hit `world`, at the mip level of the
-// pixel's footprint on the rectangle there, stretched by the obliquity as the hardware's
-// choice for the cloud's quad is (its longer axis).
-void cloud_sample(vec2 uv, vec3 world, out vec4 color, out vec3 normal) {
-    float pixel = u_orthographic ? u_pixel_world : distance(u_eye, world) * u_texel_lod.y;
-    float slant = abs(dot(normalize(u_box_to_world[2].xyz), towards_eye(world)));
-    float lod = max(log2(pixel / max(slant, 1e-3)) - u_texel_lod.x, 0.0);
+// Where the pixel's ray at window NDC `ndc` crosses the rectangle (w = 0.5), in (u, v).
+vec2 rectangle_uv(vec2 ndc) {
+    vec4 n = u_world_to_box * vec4(unproject(ndc, -1.0), 1.0);
+    vec4 f = u_world_to_box * vec4(unproject(ndc, 1.0), 1.0);
+    vec3 a = n.xyz / n.w, b = f.xyz / f.w;
+    float s = abs(b.z - a.z) > 1e-30 ? (0.5 - a.z) / (b.z - a.z) : 0.0;
+    return mix(a.xy, b.xy, s);
+}
+
+// The cloud's colour and normal at box point (u, v), filtered as the cloud's quad is: the
+// gradients are the rectangle coordinates' change to the next pixel right and up, computed
+// exactly (the hardware takes them from the quad's own fragments), so the mip level matches.
+void cloud_sample(vec2 uv, out vec4 color, out vec3 normal) {
+    vec2 ndc = fragment_ndc(), pixel = 2.0 / u_viewport;
+    vec2 here = rectangle_uv(ndc);
+    vec2 dx = (rectangle_uv(ndc + vec2(pixel.x, 0.0)) - here) * u_atlas_rect.zw;
+    vec2 dy = (rectangle_uv(ndc + vec2(0.0, pixel.y)) - here) * u_atlas_rect.zw;
     vec3 at = vec3(u_atlas_rect.xy + uv * u_atlas_rect.zw, u_atlas_page);
-    color = textureLod(u_bbc_color, at, lod);
-    normal = textureLod(u_bbc_normal, at, lod).rgb * 2.0 - 1.0;
+    color = textureGrad(u_bbc_color, at, dx, dy);
+    normal = textureGrad(u_bbc_normal, at, dx, dy).rgb * 2.0 - 1.0;
 }
 
 // A pixel's own threshold in [0, 1): an integer hash of its window position, the same in
@@ -109,7 +117,7 @@ void main() {
     if (u_handoff > 0.0) {
         vec4 cloud_color;
         vec3 cloud_normal;
-        cloud_sample(box_hit.xy, hit, cloud_color, cloud_normal);
+        cloud_sample(box_hit.xy, cloud_color, cloud_normal);
         float weight = shows_cloud ? 1.0 : u_handoff;
         base = mix(base, cloud_color.rgb, weight);
         vec3 blended = mix(n, cloud_normal, weight);
