@@ -64,8 +64,9 @@ def test_flattening_keeps_the_footprint_and_flattened_boxes_look_like_the_cloud(
 
 def test_just_before_the_switch_the_boxes_show_the_clouds_own_filtered_colours(gl):
     """The handoff: as the boxes flatten their colour turns into the cloud's (same atlas, same
-    mip level), so the switch to the cloud changes little. The reference is the cloud drawn
-    from the same camera."""
+    gradients), so the switch to the cloud changes at most 1% of the pixels by more than
+    2/255 (the issue's target, without the motion). The reference is the cloud drawn from the
+    same camera."""
     from reliefkit.scene.assets import make_asset
     from reliefkit.techniques.billboard.box_bake import bake_boxes
 
@@ -85,7 +86,7 @@ def test_just_before_the_switch_the_boxes_show_the_clouds_own_filtered_colours(g
     kept = np.abs(plain.color[both] - cloud.color[both]).max(axis=-1)
     print(f"median colour difference to the cloud: {np.median(handed):.4f} with the handoff, "
           f"{np.median(kept):.4f} without")
-    assert np.median(handed) < 0.01 and np.median(handed) < 0.5 * np.median(kept)
+    assert (handed > 2 / 255).mean() <= 0.01 and np.median(kept) > 0.01
     # and the coverage is the cloud's, pixel for pixel, so the switch flips no pixel
     np.testing.assert_array_equal(lod.mask, cloud.mask)
     assert (plain.mask != cloud.mask).any()  # which the boxes' own coverage would
