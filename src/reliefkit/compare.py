@@ -56,7 +56,8 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
         row["bytes"] = sum(array_bytes(drawn).values())
         error_mask = None
         for metric in tech.compare_metrics:
-            extra, mask = metric.measure(plain, drawn, camera)
+            extra, mask = (metric.measure(plain, drawn, camera, truth) if metric.against_mesh
+                           else metric.measure(plain, drawn, camera))
             row |= extra
             error_mask = mask if error_mask is None or mask is None else error_mask | mask
         rows[variant.name] = row

@@ -87,11 +87,14 @@ class CompareMetric:
 
     ``scores`` is a dict of JSON numbers (merged into the variant's row; ``columns`` name the
     ones shown in the table); ``error_mask`` (H, W) bool or None is drawn red in the sheet.
+    With ``against_mesh`` it is called ``measure(frame, rep, camera, mesh_frame)``: the
+    mesh's own Frame from the same camera is its reference.
     """
 
     name: str
     measure: Callable
     columns: tuple[str, ...] = ()
+    against_mesh: bool = False
 
 
 @dataclass(frozen=True)

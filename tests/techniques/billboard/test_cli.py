@@ -54,5 +54,6 @@ def test_compare_as_dmbbc_scores_the_cloud_and_every_variant(gl, tmp_path):
                          "thick-shell"}
     assert rows["exact"]["wrong_hit_fraction"] == 0.0
     assert all(0 < row["iou"] <= 1 and row["psnr"] > 0 for row in rows.values())
+    assert all(row["depth_error_voxels"] >= 0 for row in rows.values())
     # the compared (volumetric) boxes carry their cloud; the shells are far smaller
     assert rows["sphere"]["bytes"] > rows["shell"]["bytes"] > rows["billboard cloud"]["bytes"]

@@ -30,6 +30,20 @@ def _box_wrong_hits(frame, rep, camera):
              "wrong_pixels": wrong["wrong_pixels"]}, wrong["wrong"])
 
 
+def _depth_error(frame, rep, camera, mesh_frame):
+    """Mean distance between the representation's and the mesh's surface point per pixel both
+    cover, in voxels (texels) of the bake: how far the BBC's flat rectangles and the DMBBC's
+    boxes put the surface."""
+    import numpy as np
+
+    both = frame.mask & mesh_frame.mask
+    texel = rep.params.get("texel_size")
+    if not both.any() or not texel:
+        return {}, None
+    gap = np.linalg.norm(frame.position[both] - mesh_frame.position[both], axis=-1)
+    return {"depth_error_voxels": float(gap.mean() / texel)}, None
+
+
 def _other_variant(variant: str):
     """A DMBBC of ``variant`` baked from the mesh with the compared one's parameters."""
     def derive(rep, mesh):
@@ -135,7 +149,9 @@ TECHNIQUE = Technique(
     drawables=(render.drawable_spec(), box_render.drawable_spec()),
     compare_variants=_compare_variants(),
     compare_metrics=(CompareMetric("wrong hits", _box_wrong_hits,
-                                   ("wrong_hit_fraction", "wrong_pixels")),),
+                                   ("wrong_hit_fraction", "wrong_pixels")),
+                     CompareMetric("depth error", _depth_error, ("depth_error_voxels",),
+                                   against_mesh=True)),
     bench_suites=(BenchSuite("billboard", "Tables 1-2 and Fig. 6 of the DMBBC paper: BBC vs "
                              "DMBBC vs the mesh, sphere vs uniform marches, the lod switch",
                              _bench),),
