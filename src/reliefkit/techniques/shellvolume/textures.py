@@ -1,0 +1,291 @@
+"""Procedural 3D textures of the semi-transparent 3D texture paper's Figure 1 (Dufort,
+Leblanc & Poulin 2005): fur, clouds, ellipsoids, absorption, chain and rocks.
+
+Conventions (DESIGN.md, "3D textures"): ``rgba`` has shape (D, H, W, 4) indexed [w, v, u],
+float32, straight linear RGB, and its alpha is opacity per unit of object-space length: a
+segment of length L through a voxel has opacity ``1 - (1 - alpha)^L`` (the paper's §4.3
+correction). w = 0 is the base (the mesh surface), w = 1 the top of the shell.
+
+``normal`` (D, H, W, 3) holds unit vectors with components (u, v, w), computed from the
+density (alpha) gradient by central differences in voxel units, pointing from dense towards
+empty (``-grad``); where the gradient vanishes the normal is +w.
+
+Every maker is deterministic given ``seed``; noise is tileable in u and v (wrapped filters).
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy import ndimage
+
+from ...errors import UsageError
+
+#: Largest voxel count ``load_texture_npy`` accepts (256^3 voxels).
+MAX_VOXELS = 256**3
+
+
+@dataclass(frozen=True, eq=False)
+class VolumeTexture:
+    """A 3D texture: ``rgba`` (D,H,W,4), ``normal`` (D,H,W,3), both float32."""
+
+    rgba: np.ndarray
+    normal: np.ndarray
+    name: str
+    tile: tuple[int, int] = (1, 1)
+
+    def __post_init__(self) -> None:
+        if self.rgba.ndim != 4 or self.rgba.shape[3] != 4 or self.rgba.dtype != np.float32:
+            got = f"{self.rgba.dtype} {self.rgba.shape}"
+            raise UsageError(f"texture rgba must be float32 (D, H, W, 4), got {got}")
+        if self.normal.shape != self.rgba.shape[:3] + (3,) or self.normal.dtype != np.float32:
+            got = f"{self.normal.dtype} {self.normal.shape}"
+            raise UsageError(f"texture normal must be float32 (D, H, W, 3), got {got}")
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """(D, H, W)."""
+        return self.rgba.shape[:3]
+
+
+def density_normals(alpha: np.ndarray) -> np.ndarray:
+    """Unit normals (u, v, w components) of a (D,H,W) density: ``-grad / |grad|``, +w where 0."""
+    alpha = np.asarray(alpha, dtype=np.float64)
+    d, h, w = alpha.shape
+    grads = []
+    for axis, size in ((2, w), (1, h), (0, d)):
+        if size < 2:
+            grads.append(np.zeros_like(alpha))
+        else:
+            grads.append(np.gradient(alpha, axis=axis))
+    n = -np.stack(grads, axis=-1)
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    flat = length[..., 0] < 1e-9
+    n = np.where(length > 1e-9, n / np.maximum(length, 1e-12), 0.0)
+    n[flat] = (0.0, 0.0, 1.0)
+    return n.astype(np.float32)
+
+
+def _grid(size):
+    """Texel-centre coordinates in [0,1]: (w, v, u) arrays of shape (D, H, W)."""
+    width, height, depth = _check_size(size)
+    w = (np.arange(depth) + 0.5) / depth
+    v = (np.arange(height) + 0.5) / height
+    u = (np.arange(width) + 0.5) / width
+    return np.meshgrid(w, v, u, indexing="ij")
+
+
+def _check_size(size):
+    if len(size) != 3 or any(int(s) != s or s < 1 for s in size):
+        raise UsageError(f"texture size must be three positive integers (W, H, D), got {size!r}")
+    if np.prod([int(s) for s in size]) > MAX_VOXELS:
+        raise UsageError(f"texture size {size!r} exceeds {MAX_VOXELS} voxels; use a smaller size")
+    return tuple(int(s) for s in size)
+
+
+def _noise(rng, shape, sigma, wrap_w=False):
+    """Smooth noise in [0,1]: Gaussian-filtered white noise, wrapped in u and v."""
+    field = rng.random(shape)
+    modes = ["wrap"] * field.ndim
+    if field.ndim == 3 and not wrap_w:
+        modes[0] = "reflect"
+    field = ndimage.gaussian_filter(field, sigma, mode=modes)
+    lo, hi = field.min(), field.max()
+    return (field - lo) / (hi - lo) if hi > lo else np.zeros_like(field)
+
+
+def _fbm(rng, shape, sigmas=(8.0, 4.0, 2.0, 1.0)):
+    total = np.zeros(shape)
+    weight = 0.0
+    for k, s in enumerate(sigmas):
+        amp = 0.5**k
+        total += amp * _noise(rng, shape, [max(s * n / max(shape), 0.5) for n in shape])
+        weight += amp
+    return total / weight
+
+
+def _wrapped(d):
+    """Periodic difference in [-0.5, 0.5)."""
+    return d - np.round(d)
+
+
+def _make(name, rgb, alpha, tile=(1, 1)):
+    rgba = np.concatenate([np.clip(rgb, 0, 1), np.clip(alpha, 0, 1)[..., None]], axis=-1)
+    return VolumeTexture(rgba.astype(np.float32), density_normals(alpha), name, tile)
+
+
+def make_fur(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """Brown strands rising from w = 0, each thinning to nothing at w = 1, bending slightly."""
+    rng = np.random.default_rng(seed)
+    w, v, u = _grid(size)
+    count = 48
+    alpha = np.zeros(w.shape)
+    rgb = np.zeros(w.shape + (3,))
+    base_radius = 0.045
+    for _ in range(count):
+        u0, v0 = rng.random(2)
+        bend = rng.normal(0, 0.08, 2)
+        shade = rng.uniform(0.7, 1.1)
+        du = _wrapped(u - (u0 + bend[0] * w**2))
+        dv = _wrapped(v - (v0 + bend[1] * w**2))
+        inside = np.hypot(du, dv) < base_radius * (1.0 - w)
+        alpha[inside] = 1.0
+        rgb[inside] = np.array([0.45, 0.27, 0.12]) * shade
+    return _make("fur", rgb, alpha)
+
+
+def make_clouds(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """An opaque Earth-like base at w = 0 (blue oceans, green-brown land) under fbm clouds."""
+    rng = np.random.default_rng(seed)
+    w, v, u = _grid(size)
+    depth, height, width = w.shape
+    land = _fbm(rng, (height, width))
+    ocean = land < 0.5
+    ground = np.where(ocean[..., None], [0.05, 0.15, 0.55],
+                      np.where((land > 0.7)[..., None], [0.45, 0.35, 0.2], [0.15, 0.45, 0.12]))
+    density = _fbm(rng, w.shape)
+    profile = np.clip((w - 0.4) / 0.2, 0, 1) * np.clip((1.0 - w) / 0.15, 0, 1)
+    alpha = np.clip((density - 0.45) * 3.0, 0, 0.9) * profile
+    rgb = np.full(w.shape + (3,), 0.95)
+    alpha[0] = 1.0
+    rgb[0] = ground
+    return _make("clouds", rgb, alpha)
+
+
+def make_ellipsoids(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """A few opaque coloured ellipsoids in a red semi-transparent medium (alpha 0.3)."""
+    rng = np.random.default_rng(seed)
+    w, v, u = _grid(size)
+    alpha = np.full(w.shape, 0.3)
+    rgb = np.zeros(w.shape + (3,))
+    rgb[...] = (0.8, 0.1, 0.1)
+    for _ in range(4):
+        c = rng.uniform([0, 0, 0.3], [1, 1, 0.7])
+        axes = rng.uniform([0.1, 0.1, 0.15], [0.2, 0.2, 0.3])
+        r2 = (_wrapped(u - c[0]) / axes[0]) ** 2 + (_wrapped(v - c[1]) / axes[1]) ** 2
+        r2 = r2 + ((w - c[2]) / axes[2]) ** 2
+        inside = r2 < 1.0
+        alpha[inside] = 1.0
+        rgb[inside] = rng.uniform(0.2, 0.9, 3)
+    return _make("ellipsoids", rgb, alpha)
+
+
+def make_absorption(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """A uniform green absorbing medium of constant opacity (alpha 0.5 per unit length)."""
+    w, _, _ = _grid(size)
+    rgb = np.broadcast_to(np.array([0.1, 0.7, 0.2]), w.shape + (3,))
+    return _make("absorption", rgb, np.full(w.shape, 0.5))
+
+
+def make_chain(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """An opaque metal chain along u: interlocking tori, alternately in the u-w and u-v planes.
+
+    The geometry is measured in voxels (so tori stay round); the chain wraps around u.
+    ``seed`` only varies the metal's shade.
+    """
+    rng = np.random.default_rng(seed)
+    width, height, depth = _check_size(size)
+    z, y, x = np.meshgrid(np.arange(depth) + 0.5, np.arange(height) + 0.5,
+                          np.arange(width) + 0.5, indexing="ij")
+    links = 4
+    pitch = width / links
+    major = 0.55 * pitch
+    minor = min(0.16 * pitch, 0.2 * depth)
+    major = min(major, depth / 2 - minor - 0.5)
+    alpha = np.zeros(x.shape)
+    for k in range(links):
+        dx = (x - (k + 0.5) * pitch + width / 2) % width - width / 2
+        dy, dz = y - height / 2, z - depth / 2
+        a, b, axis = (dx, dz, dy) if k % 2 == 0 else (dx, dy, dz)
+        ring = np.hypot(np.hypot(a, b) - major, axis)
+        alpha[ring < minor] = 1.0
+    shade = rng.uniform(0.6, 0.8)
+    rgb = np.broadcast_to(np.array([shade, shade, shade * 1.05]), x.shape + (3,))
+    return _make("chain", rgb, alpha)
+
+
+def make_rocks(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """Opaque bumpy grey rocks on an opaque brown ground of noisy height."""
+    rng = np.random.default_rng(seed)
+    w, v, u = _grid(size)
+    depth, height, width = w.shape
+    ground_h = 0.08 + 0.12 * _fbm(rng, (height, width))
+    ground = w < ground_h
+    bumps = _fbm(rng, w.shape, sigmas=(2.0, 1.0))
+    alpha = ground.astype(float)
+    rgb = np.zeros(w.shape + (3,))
+    rgb[ground] = (0.35, 0.25, 0.15)
+    for _ in range(5):
+        c = rng.uniform([0, 0, 0.1], [1, 1, 0.25])
+        r = rng.uniform(0.12, 0.22)
+        dist = np.sqrt(_wrapped(u - c[0]) ** 2 + _wrapped(v - c[1]) ** 2 + ((w - c[2]) * 0.8) ** 2)
+        inside = dist / r + 0.5 * (bumps - 0.5) < 1.0
+        alpha[inside] = 1.0
+        rgb[inside] = rng.uniform(0.4, 0.6) * np.array([1.0, 0.97, 0.92])
+    return _make("rocks", rgb, alpha)
+
+
+TEXTURES = {
+    "fur": make_fur,
+    "clouds": make_clouds,
+    "ellipsoids": make_ellipsoids,
+    "absorption": make_absorption,
+    "chain": make_chain,
+    "rocks": make_rocks,
+}
+
+
+def load_texture_npy(path, name: str | None = None) -> VolumeTexture:
+    """Read a (D, H, W, 4) float RGBA volume from an .npy file (no pickles), validated.
+
+    The header is checked before any array memory is allocated: a regular file, a 4-D shape
+    ending in 4 of at most ``MAX_VOXELS`` voxels, float32/float64, C order, and a file size
+    that matches. Values must be finite, colour >= 0, alpha in [0, 1].
+    """
+    path = Path(path)
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        reason = exc.strerror
+        raise UsageError(f"cannot open texture {path}: {reason}; use a regular .npy") from None
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):
+        os.close(fd)
+        raise UsageError(f"texture {path} is not a regular file; give a .npy file")
+    with os.fdopen(fd, "rb") as f:
+        try:
+            version = np.lib.format.read_magic(f)
+            if version == (1, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
+            elif version == (2, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
+            else:
+                raise ValueError(f"unsupported .npy version {version}")
+        except ValueError as exc:
+            raise UsageError(f"texture {path} is not a valid .npy file ({exc})") from None
+        if len(shape) != 4 or shape[3] != 4 or min(shape) < 1:
+            raise UsageError(f"texture {path} has shape {shape}; expected (D, H, W, 4)")
+        voxels = int(shape[0]) * int(shape[1]) * int(shape[2])
+        if voxels > MAX_VOXELS:
+            raise UsageError(f"texture {path} claims {voxels} voxels, over the {MAX_VOXELS} limit")
+        if dtype not in (np.dtype("<f4"), np.dtype("<f8")) or fortran:
+            order = " (Fortran order)" if fortran else ""
+            raise UsageError(f"texture {path} has dtype {dtype}{order}; "
+                             "expected little-endian float32/float64 in C order")
+        count = voxels * 4
+        if info.st_size - f.tell() != count * dtype.itemsize:
+            raise UsageError(f"texture {path} is truncated or has trailing data for shape {shape}")
+        data = np.fromfile(f, dtype=dtype, count=count)
+    rgba = data.reshape(shape).astype(np.float32)
+    if not np.isfinite(rgba).all():
+        raise UsageError(f"texture {path} contains NaN or Inf values")
+    if (rgba[..., 3] < 0).any() or (rgba[..., 3] > 1).any():
+        raise UsageError(f"texture {path} has alpha outside [0, 1]")
+    if (rgba[..., :3] < 0).any():
+        raise UsageError(f"texture {path} has negative colour values")
+    return VolumeTexture(rgba, density_normals(rgba[..., 3]), name or path.stem)
