@@ -14,6 +14,7 @@ import numpy as np
 
 from ..core.technique import DrawableSpec, ProgramVariant
 from ..gl.context import check_gl_error
+from ..gl.objects import GLObjects
 from ..gl.shaders import program
 from ..gl.textures import texture2d
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
@@ -44,26 +45,21 @@ class _Draw:
     count: int
 
 
-class MeshDrawable:
+class MeshDrawable(GLObjects):
     """GPU buffers of a RenderMesh, drawable many times (turntables, benchmarks)."""
 
     def __init__(self, ctx, mesh: RenderMesh, options=None, instrument: bool = False):
         self.ctx, self.mesh = ctx, mesh
         self.extra_attachments = 1 if instrument else 0
-        self._objects: list = []
-        try:
-            self._upload(instrument)
-        except BaseException:
-            self.release()
-            raise
+        self._upload_owned(lambda: self._upload(instrument))
 
     def _upload(self, instrument: bool) -> None:
         ctx, mesh = self.ctx, self.mesh
         groups = mesh.material_groups()
         uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2))
         interleaved = np.hstack([mesh.positions, mesh.normals, mesh.colors, uvs])
-        vbo = self._keep(ctx.buffer(interleaved.astype(np.float32).tobytes()))
-        ibo = self._keep(ctx.buffer(np.concatenate([c.ravel() for _, c in groups]).tobytes()))
+        vbo = self.keep(ctx.buffer(interleaved.astype(np.float32).tobytes()))
+        ibo = self.keep(ctx.buffer(np.concatenate([c.ravel() for _, c in groups]).tobytes()))
         vertex_arrays: dict[bool, tuple] = {}  # textured or not -> (program, vertex array)
         textures: dict[int, object] = {}  # one upload per distinct image
         self.draws: list[_Draw] = []
@@ -78,7 +74,7 @@ class MeshDrawable:
             if textured:
                 key = id(material.texture)
                 if key not in textures:
-                    textures[key] = self._keep(texture2d(
+                    textures[key] = self.keep(texture2d(
                         ctx, material.texture, what=f"{mesh.name} texture", srgb=True,
                         mipmaps=True, repeat=True))
                 texture = textures[key]
@@ -88,15 +84,11 @@ class MeshDrawable:
         self.programs = [prog for prog, _ in vertex_arrays.values()]
         check_gl_error(ctx, f"uploading mesh {mesh.name}")
 
-    def _keep(self, obj):
-        self._objects.append(obj)
-        return obj
-
     def _vertex_array(self, prog, vbo, ibo):
         attributes = [name for name, _ in _LAYOUT if name in prog]
         fmt = " ".join(f"{n}f" if name in prog else f"{n}x4" for name, n in _LAYOUT)
-        return self._keep(self.ctx.vertex_array(prog, [(vbo, fmt, *attributes)], ibo,
-                                                index_element_size=4))
+        return self.keep(self.ctx.vertex_array(prog, [(vbo, fmt, *attributes)], ibo,
+                                               index_element_size=4))
 
     def draw(self, camera, light: DirectionalLight) -> None:
         shared = camera_uniforms(camera) | model_offset(camera, self.mesh.origin) | light.uniforms()
@@ -111,10 +103,6 @@ class MeshDrawable:
     def finish(self, frame) -> None:
         frame.stats["triangles"] = frame.stats.get("triangles", 0) + self.mesh.triangle_count
 
-    def release(self) -> None:
-        for obj in reversed(self._objects):
-            obj.release()
-        self._objects.clear()
 
 
 def material_uniforms(material: Material) -> dict:

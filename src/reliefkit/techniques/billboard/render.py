@@ -16,6 +16,7 @@ import numpy as np
 
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...gl.context import check_gl_error
+from ...gl.objects import GLObjects
 from ...gl.shaders import program
 from ...gl.textures import texture_array
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
@@ -60,38 +61,29 @@ def quad_indices(count: int) -> np.ndarray:
     return (_QUAD_TRIANGLES[None] + 4 * np.arange(count, dtype=np.uint32)[:, None]).ravel()
 
 
-class BillboardCloudDrawable:
+class BillboardCloudDrawable(GLObjects):
     """GPU buffers and atlases of one BillboardCloud, drawable many times."""
 
     def __init__(self, ctx, cloud: BillboardCloud, options=None, instrument: bool = False):
         self.ctx, self.cloud = ctx, cloud
         self.origin = cloud.center  # float64: the quads are stored relative to it
         self.extra_attachments = 1 if instrument else 0
-        self._objects: list = []
-        try:
-            self._upload(instrument)
-        except BaseException:
-            self.release()
-            raise
+        self._upload_owned(lambda: self._upload(instrument))
 
     def _upload(self, instrument: bool) -> None:
         ctx, cloud = self.ctx, self.cloud
         # the atlases first: their sizes are checked against the GPU's limits before anything
-        self.color = self._keep(texture_array(ctx, cloud.color, what="billboard colour atlas",
+        self.color = self.keep(texture_array(ctx, cloud.color, what="billboard colour atlas",
                                               srgb=True, mipmaps=True))
-        self.normal = self._keep(texture_array(ctx, cloud.normal,
+        self.normal = self.keep(texture_array(ctx, cloud.normal,
                                                what="billboard normal atlas", mipmaps=True))
         self.prog = program(ctx, PROGRAM, {"COUNT_ITERATIONS": instrument})
-        vbo = self._keep(ctx.buffer(quad_vertices(cloud, self.origin).tobytes()))
-        ibo = self._keep(ctx.buffer(quad_indices(cloud.count).tobytes()))
-        self.vao = self._keep(ctx.vertex_array(
+        vbo = self.keep(ctx.buffer(quad_vertices(cloud, self.origin).tobytes()))
+        ibo = self.keep(ctx.buffer(quad_indices(cloud.count).tobytes()))
+        self.vao = self.keep(ctx.vertex_array(
             self.prog, [(vbo, "3f 3f 3f", "in_position", "in_atlas", "in_plane_normal")],
             ibo, index_element_size=4))
         check_gl_error(ctx, f"uploading a billboard cloud of {cloud.count} rectangles")
-
-    def _keep(self, obj):
-        self._objects.append(obj)
-        return obj
 
     def draw(self, camera, light) -> None:
         set_uniforms(self.prog, camera_uniforms(camera) | model_offset(camera, self.origin)
@@ -103,11 +95,6 @@ class BillboardCloudDrawable:
 
     def finish(self, frame) -> None:
         frame.stats["rectangles"] = frame.stats.get("rectangles", 0) + self.cloud.count
-
-    def release(self) -> None:
-        for obj in reversed(self._objects):
-            obj.release()
-        self._objects.clear()
 
 
 def drawable_spec() -> DrawableSpec:
