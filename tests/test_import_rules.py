@@ -52,8 +52,17 @@ def technique_of_path(path: Path) -> str | None:
     return rel[1] if rel[0] == "techniques" and len(rel) > 2 else None
 
 
+def core_words() -> set[str]:
+    """The core's own data vocabulary (the fields of a mesh and its materials): a technique
+    option of the same name (``--texture``) does not make the word the technique's."""
+    from reliefkit.scene.mesh import Material, RenderMesh
+
+    return set(RenderMesh.__annotations__) | set(Material.__annotations__)
+
+
 def declared_names():
-    """What each technique owns: identifiers (its classes) and strings (kinds, options...)."""
+    """What each technique owns: identifiers (its classes) and strings (kinds, options...),
+    less the core's own words."""
     identifiers, strings = set(), set()
     for tech in load_all():
         strings |= {tech.name, *tech.kinds, *(b.name for b in tech.bakers)}
@@ -66,7 +75,7 @@ def declared_names():
             strings |= {opt.name for opt in b.options}
         for d in tech.drawables:
             strings |= {opt.name for opt in d.option_list}
-    return identifiers, strings
+    return identifiers, strings - core_words()
 
 
 def names_used(path: Path) -> tuple[set[str], set[str]]:

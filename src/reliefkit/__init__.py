@@ -29,12 +29,14 @@ from .techniques.relief import (
     bake_relief_frustum,
     relief_from_heights,
 )
+from .techniques.shellvolume import TexturedShell, VolumeTexture, build_shell, visibility_order
 
 __all__ = [
     "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
     "bake", "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
     "relief_from_heights", "ReliefTexture", "ReliefObject", "build_billboard_cloud",
     "bake_billboard_cloud", "bake_boxes", "BillboardCloud", "BillboardBoxes",
+    "build_shell", "visibility_order", "VolumeTexture", "TexturedShell",
     "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
 ]
 __version__ = "0.1.0"

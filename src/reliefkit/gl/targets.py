@@ -188,6 +188,15 @@ def _multisampled_color(ctx, size, opaque: Callable[[], None], samples: int) -> 
     return np.concatenate([rgb, mean[..., 3:4]], axis=-1).astype(np.float32)
 
 
+def use_transparent_blending(ctx, extra_flags: int = 0) -> None:
+    """The transparent pass's state: depth test, and colour composited front to back with
+    the *under* operator (premultiplied sources); ``extra_flags`` such as face culling."""
+    import moderngl
+
+    ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND | extra_flags)
+    ctx.blend_func = moderngl.ONE_MINUS_DST_ALPHA, moderngl.ONE
+
+
 class _Owned:
     """A lone texture in the list of framebuffers to release (it has no attachments)."""
 
@@ -217,8 +226,7 @@ def _transparent_pass(ctx, opaque_fbo, draws, made) -> tuple:
     fbo.viewport = (0, 0, width, height)
     for draw in draws:
         fbo.use()
-        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
-        ctx.blend_func = moderngl.ONE_MINUS_DST_ALPHA, moderngl.ONE
+        use_transparent_blending(ctx)
         front.use(FRONT_OPACITY_UNIT)
         draw()
         ctx.disable(moderngl.BLEND)

@@ -8,10 +8,14 @@ from ..core.transforms import invert_box, translation
 
 
 def set_uniforms(prog, values: dict) -> None:
-    """Set the uniforms a program actually uses (the compiler drops unused ones)."""
+    """Set the uniforms a program actually uses (the compiler drops unused ones, and may
+    shorten an array to the entries used: a list value is cut to the array's length)."""
     for name, value in values.items():
         if name not in prog:
             continue
+        if isinstance(value, list):
+            length = prog[name].array_length
+            value = value[:length] if length > 1 else value[0]
         if isinstance(value, np.ndarray) and value.shape == (4, 4):
             with np.errstate(under="ignore"):  # entries like 1e-49 (rounding) become 0
                 matrix = value.T.astype(np.float32)

@@ -1,5 +1,65 @@
-"""Shell volumes (Dufort, Leblanc & Poulin 2005): a 3D texture tiled in a layer of prisms
-extruded from a mesh, each prism split into three tetrahedra.
+"""Semi-transparent 3D textures on a shell of tetrahedra (Dufort, Leblanc & Poulin 2005): a
+mesh extruded into prisms, each split into three tetrahedra, filled with a tiled 3D texture,
+sorted per frame (SXMPVO) and ray-marched per tetrahedron.
 
-Not a registered technique yet; `shell.build_shell` builds the shell's geometry (issue 10).
+The public API re-exported by `reliefkit`: `build_shell`, `VolumeTexture`,
+`visibility_order`, `TexturedShell`.
 """
+
+from __future__ import annotations
+
+from ...core.technique import Baker, Technique
+from . import render
+from .bakers import ShellVolumeParams, bake_shell
+from .codec import CODECS
+from .order import visibility_order
+from .representation import TexturedShell
+from .shell import ShellVolume, build_shell
+from .textures import TEXTURES, VolumeTexture
+
+
+def _samples() -> dict:
+    """Ellipsoids in a medium over a 4 x 4 grid of the xz plane, for the contract tests."""
+    import numpy as np
+
+    from ...scene.mesh import RenderMesh
+    from .textures import make_ellipsoids
+
+    n = 5
+    x, z = np.meshgrid(np.linspace(-1, 1, n), np.linspace(1, -1, n))
+    positions = np.column_stack([x.ravel(), np.zeros(n * n), z.ravel()])
+    uvs = np.column_stack([(x.ravel() + 1) / 2, (1 - z.ravel()) / 2])
+    quads = [(j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i)
+             for j in range(n - 1) for i in range(n - 1)]
+    faces = [(a, b, c) for a, b, c, _ in quads] + [(a, c, d) for a, _, c, d in quads]
+    base = RenderMesh(positions, faces, np.tile((0.0, 1.0, 0.0), (n * n, 1)),
+                      np.ones((n * n, 4)), uvs, name="grid")
+    texture = make_ellipsoids(size=(8, 8, 4)).tiled((2, 2))
+    return {"shell-volume": TexturedShell(base, 0.3, texture, {"source": "sample"})}
+
+
+TECHNIQUE = Technique(
+    name="shellvolume",
+    summary="semi-transparent 3D textures in a shell of tetrahedra, sorted and ray-marched",
+    package=__name__,
+    codecs=CODECS,
+    representations=(TexturedShell,),
+    bakers=(Baker("shell-volume", "a 3D texture (fur, clouds, ellipsoids, absorption, chain, "
+                  "rocks, a .npy, a voxelized mesh) tiled in a shell extruded from the mesh",
+                  ShellVolumeParams, bake_shell),),
+    drawables=(render.drawable_spec(),),
+    programs=render.PROGRAMS,
+    samples=_samples,
+    cli_examples={
+        "bake": ["reliefkit bake demo:sphere --as shell-volume --texture fur --thickness 0.15 "
+                 "--tile 4,2 -o fur.rk",
+                 "reliefkit bake model.obj --as shell-volume --texture clouds.npy "
+                 "--thickness 0.02 -o clouds.rk"],
+        "render": ["reliefkit render fur.rk --samples 16 --shadows -o fur.png",
+                   "reliefkit render fur.rk --sort centroid --unlit --aovs f.npz -o fur.png",
+                   "reliefkit render fur.rk --animate 24 -o fur.gif"],
+    },
+)
+
+__all__ = ["TECHNIQUE", "TEXTURES", "ShellVolume", "TexturedShell", "VolumeTexture",
+           "build_shell", "visibility_order"]

@@ -31,12 +31,15 @@ MAX_VOXELS = 256**3
 
 @dataclass(frozen=True, eq=False)
 class VolumeTexture:
-    """A 3D texture: ``rgba`` (D,H,W,4), ``normal`` (D,H,W,3), both float32."""
+    """A 3D texture: ``rgba`` (D,H,W,4), ``normal`` (D,H,W,3), both float32; ``tile`` (U, V)
+    repetitions over the base's uvs; optional ``glow`` (D,H,W) float32 >= 0, light emitted per
+    unit of object-space length in units of the voxel's colour (the paper's glow, §5.3)."""
 
     rgba: np.ndarray
     normal: np.ndarray
     name: str
     tile: tuple[int, int] = (1, 1)
+    glow: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.rgba.ndim != 4 or self.rgba.shape[3] != 4 or self.rgba.dtype != np.float32:
@@ -45,11 +48,33 @@ class VolumeTexture:
         if self.normal.shape != self.rgba.shape[:3] + (3,) or self.normal.dtype != np.float32:
             got = f"{self.normal.dtype} {self.normal.shape}"
             raise UsageError(f"texture normal must be float32 (D, H, W, 3), got {got}")
+        if self.glow is not None and (self.glow.shape != self.rgba.shape[:3]
+                                      or self.glow.dtype != np.float32):
+            got = f"{self.glow.dtype} {self.glow.shape}"
+            raise UsageError(f"texture glow must be float32 (D, H, W), got {got}")
+        tile = tuple(self.tile)
+        if len(tile) != 2 or not all(isinstance(t, int | np.integer) and 1 <= t <= 4096
+                                     for t in tile):
+            raise UsageError(f"texture tile must be two whole numbers in 1..4096, got "
+                             f"{self.tile!r}")
 
     @property
     def shape(self) -> tuple[int, int, int]:
         """(D, H, W)."""
         return self.rgba.shape[:3]
+
+    @property
+    def opaque(self) -> bool:
+        """Every voxel empty (alpha 0) or solid (alpha 1), and nothing glows: drawn with
+        the depth test, without sorting."""
+        alpha = self.rgba[..., 3]
+        return self.glow is None and bool(np.all((alpha == 0) | (alpha == 1)))
+
+    def tiled(self, tile) -> VolumeTexture:
+        """The same texture repeated ``tile`` (U, V) times over the uvs."""
+        from dataclasses import replace
+
+        return replace(self, tile=tuple(int(t) for t in tile))
 
 
 def density_normals(alpha: np.ndarray) -> np.ndarray:
@@ -227,6 +252,39 @@ def make_rocks(size=(32, 32, 16), seed=0) -> VolumeTexture:
         alpha[inside] = 1.0
         rgb[inside] = rng.uniform(0.4, 0.6) * np.array([1.0, 0.97, 0.92])
     return _make("rocks", rgb, alpha)
+
+
+def texture_from_mesh(mesh, size=(32, 32, 16), progress=None) -> VolumeTexture:
+    """A mesh voxelized by the core voxelizer into an opaque texture (the paper's "texture of
+    a tree", Color plate E): its box fills the tile, x along u, -z along v, +y up along w
+    (a right-handed frame, so the voxelizer's facing keeps its sign).
+
+    Voxels the surface (or, for a closed mesh, the interior) covers at least half are solid
+    (alpha 1) with the mesh's colour; normals are the mesh's, in voxel units.
+    """
+    from ...bake.voxelize import voxelize
+
+    width, height, depth = _check_size(size)
+    lo, hi = (np.asarray(b, np.float64) for b in mesh.bounds)
+    extent = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1e-30))
+    box = np.eye(4)
+    box[:3, 0] = (extent[0], 0, 0)   # u <- x
+    box[:3, 1] = (0, 0, -extent[2])  # v <- -z
+    box[:3, 2] = (0, extent[1], 0)   # w <- y (up)
+    box[:3, 3] = (lo[0], lo[1], hi[2])
+    closed = all(part.get("closed") for part in mesh.extra.get("parts", [])) and \
+        bool(mesh.extra.get("parts"))
+    grid = voxelize(mesh, box, (width, height, depth), mode="solid" if closed else "surface",
+                    progress=progress)
+    solid = grid.occupancy >= 0.5
+    rgb = np.where(solid[..., None], np.nan_to_num(grid.color[..., :3]), 0.0)
+    world = np.nan_to_num(grid.normal)
+    voxel = extent[[0, 2, 1]] / (width, height, depth)
+    n = world[..., [0, 2, 1]] * (1.0, -1.0, 1.0) * voxel  # components in voxel units
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    n = np.where(length > 1e-12, n / np.maximum(length, 1e-12), (0.0, 0.0, 1.0))
+    rgba = np.concatenate([rgb, solid[..., None]], axis=-1).astype(np.float32)
+    return VolumeTexture(rgba, n.astype(np.float32), mesh.name)
 
 
 TEXTURES = {

@@ -1,0 +1,58 @@
+"""The shell-volume baker and its typed parameters (``bake --as shell-volume``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core.params import param
+from ...errors import UsageError
+from .representation import TexturedShell
+from .textures import TEXTURES, load_texture_npy, texture_from_mesh
+
+DEFAULT_THICKNESS = 0.05  # of the base's bounding-box diagonal, when --thickness is not given
+
+
+@dataclass(frozen=True)
+class ShellVolumeParams:
+    texture: str = param("fur", "the 3D texture: " + ", ".join(TEXTURES) + ", a FILE.npy "
+                         "(D, H, W, 4) float RGBA, or a mesh (FILE or demo:NAME) voxelized "
+                         "into one")
+    thickness: float | None = param(None, "shell thickness in the mesh's own units (none: "
+                                    f"{DEFAULT_THICKNESS:g} of its bounding-box diagonal)",
+                                    kind="float", lo=1e-12)
+    tile: tuple = param((1.0, 1.0), "how many times the texture repeats over the uvs, U,V",
+                        kind="floats", count=2, lo=1, hi=4096)
+    texture_size: tuple = param((32.0, 32.0, 16.0), "W,H,D voxels of a generated or "
+                                "voxelized texture", kind="floats", count=3, lo=2, hi=256)
+
+
+def make_texture(spec: str, size, progress=None):
+    """The texture ``spec`` names (see `ShellVolumeParams.texture`) at ``size`` (W, H, D)."""
+    size = tuple(int(round(s)) for s in size)
+    if spec in TEXTURES:
+        return TEXTURES[spec](size=size)
+    if spec.lower().endswith(".npy"):
+        return load_texture_npy(spec)
+    from ...io.inputs import load_input
+    from ...scene.mesh import RenderMesh
+
+    mesh = load_input(spec)
+    if not isinstance(mesh, RenderMesh):
+        raise UsageError(f"--texture {spec}: expected one of {', '.join(TEXTURES)}, a .npy "
+                         "volume or a mesh to voxelize")
+    return texture_from_mesh(mesh, size, progress=progress)
+
+
+def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
+    for t in p.tile:
+        if t != int(t):
+            raise UsageError(f"--tile takes whole numbers, got {p.tile[0]:g},{p.tile[1]:g}")
+    texture = make_texture(p.texture, p.texture_size, progress).tiled(
+        (int(p.tile[0]), int(p.tile[1])))
+    lo, hi = source.bounds
+    thickness = p.thickness if p.thickness is not None else \
+        DEFAULT_THICKNESS * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
+    return TexturedShell(source, thickness, texture,
+                         {"source": source.name, "thickness_given": p.thickness})

@@ -1,0 +1,80 @@
+"""The .rk kind ``shell-volume``: the base mesh, its per-vertex thickness and the 3D texture.
+
+Arrays: ``positions`` float64 (V, 3) world, ``indices`` int32 (F, 3), ``normals`` float32
+(V, 3), ``uvs`` float32 (V, 2), ``thickness`` float64 (V,), ``texture_rgba`` float32
+(D, H, W, 4), ``texture_normal`` float32 (D, H, W, 3), optional ``texture_glow`` float32
+(D, H, W); params ``texture`` (its name) and ``tile`` [U, V]. The shell's tetrahedra are
+rebuilt from these when the file is read (nothing else is precomputed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import FormatError, MeshError, UsageError
+from ...io.rk import ArraySpec, Codec
+from .representation import TexturedShell
+from .textures import MAX_VOXELS, VolumeTexture
+
+MAX_BASE_VERTICES = 1 << 22
+MAX_BASE_TRIANGLES = 1 << 22
+
+ARRAYS = {
+    "positions": ArraySpec(("float64",), ndim=2, trailing=(3,), finite=True),
+    "indices": ArraySpec(("int32",), ndim=2, trailing=(3,)),
+    "normals": ArraySpec(("float32",), ndim=2, trailing=(3,), finite=True),
+    "uvs": ArraySpec(("float32",), ndim=2, trailing=(2,), finite=True),
+    "thickness": ArraySpec(("float64",), ndim=1, finite=True),
+    "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True),
+    "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True),
+    "texture_glow": ArraySpec(("float32",), ndim=3, required=False, finite=True),
+}
+
+
+def _to_arrays(rep: TexturedShell) -> tuple[dict, dict]:
+    base, tex = rep.base, rep.texture
+    arrays = {"positions": base.world_positions, "indices": base.indices.astype(np.int32),
+              "normals": base.normals, "uvs": base.uvs, "thickness": rep.thickness,
+              "texture_rgba": tex.rgba, "texture_normal": tex.normal,
+              "texture_glow": tex.glow}
+    own = ("texture", "tile")
+    params = {k: v for k, v in rep.params.items() if k not in own}
+    return arrays, params | {"texture": tex.name, "tile": list(tex.tile)}
+
+
+def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
+    from ...scene.mesh import RenderMesh
+
+    params = dict(params)
+    name, tile = params.pop("texture", None), params.pop("tile", None)
+    if not isinstance(name, str):
+        raise FormatError(f"shell-volume param 'texture' must be a name, got {name!r}")
+    if not (isinstance(tile, list) and len(tile) == 2
+            and all(isinstance(t, int) and not isinstance(t, bool) for t in tile)):
+        raise FormatError(f"shell-volume param 'tile' must be two whole numbers, got {tile!r}")
+    positions = arrays["positions"]
+    count = len(positions)
+    if count > MAX_BASE_VERTICES or len(arrays["indices"]) > MAX_BASE_TRIANGLES:
+        raise FormatError(f"a shell's base has at most {MAX_BASE_VERTICES} vertices and "
+                          f"{MAX_BASE_TRIANGLES} triangles")
+    for key in ("normals", "uvs", "thickness"):
+        if len(arrays[key]) != count:
+            raise FormatError(f"shell-volume array '{key}' has {len(arrays[key])} rows, the "
+                              f"base has {count} vertices")
+    rgba = arrays["texture_rgba"]
+    if int(np.prod(rgba.shape[:3])) > MAX_VOXELS:
+        raise FormatError(f"a shell's texture has at most {MAX_VOXELS} voxels, got "
+                          f"{rgba.shape[:3]}")
+    try:
+        texture = VolumeTexture(rgba, arrays["texture_normal"], name, tuple(tile),
+                                arrays.get("texture_glow"))
+        colors = np.broadcast_to(np.float32(0.8), (count, 4))
+        base = RenderMesh(positions, arrays["indices"], arrays["normals"], colors,
+                          arrays["uvs"], name=params.get("source", "shell base"))
+        return TexturedShell(base, arrays["thickness"], texture, params)
+    except (UsageError, MeshError, ValueError) as exc:
+        raise FormatError(f"invalid shell volume: {exc}") from None
+
+
+CODECS = (Codec(kind="shell-volume", cls=TexturedShell, arrays=ARRAYS, to_arrays=_to_arrays,
+                from_arrays=_from_arrays, version=1),)

@@ -1,0 +1,88 @@
+"""`TexturedShell`: a base mesh, its shell of tetrahedra and the 3D texture the shell holds
+(the representation of the ``shell-volume`` kind).
+
+Nothing is precomputed beyond the shell itself (the paper's point, §6): the tetrahedra are
+built from the base mesh when the representation is made (and again, from the deformed base,
+for each frame of an animation); the visibility order is computed per frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import UsageError
+from .shell import ShellVolume, build_shell
+from .textures import VolumeTexture
+
+#: Deformation of an animated base (`TexturedShell.shell_at`): vertices move along their
+#: normals by this fraction of the shell's thickness, as a wave over the surface.
+WAVE_AMPLITUDE = 0.6
+
+
+@dataclass(eq=False)
+class TexturedShell:
+    """A shell of thickness ``thickness`` (per base vertex, world units) over ``base`` (a
+    RenderMesh with uvs), filled with ``texture`` tiled ``texture.tile`` times over the uvs.
+
+    ``shell`` is built at construction (`build_shell`), so a bad base or thickness is refused
+    here, with the reason.
+    """
+
+    base: object
+    thickness: np.ndarray
+    texture: VolumeTexture
+    params: dict = field(default_factory=dict)
+    shell: ShellVolume = field(init=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.texture, VolumeTexture):
+            raise UsageError(f"a textured shell needs a VolumeTexture, got "
+                             f"{type(self.texture).__name__}")
+        self.thickness = np.broadcast_to(np.asarray(self.thickness, np.float64),
+                                         (len(self.base.positions),)).copy()
+        self.shell = build_shell(self.base, self.thickness)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) world box of the shell (base and tops)."""
+        p = self.shell.positions
+        return np.array([p.min(axis=0), p.max(axis=0)])
+
+    @property
+    def tetrahedron_count(self) -> int:
+        return len(self.shell.tets)
+
+    @property
+    def opaque(self) -> bool:
+        """Whether the texture is opaque (every voxel empty or a solid): drawn depth-tested,
+        without sorting (§4, the tree of Color plate E)."""
+        return self.texture.opaque
+
+    def shell_at(self, time: float | None) -> ShellVolume:
+        """The shell at animation ``time`` (None: at rest): the base deformed by a wave along
+        its normals, the shell rebuilt from it (nothing else precomputed)."""
+        if time is None:
+            return self.shell
+        base = self.base
+        p = base.world_positions
+        extent = float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) or 1.0
+        phase = 2 * np.pi * (time + 1.5 * (p[:, 0] + 0.7 * p[:, 1] + 0.4 * p[:, 2]) / extent)
+        offset = (WAVE_AMPLITUDE * self.thickness * np.sin(phase))[:, None] * \
+            np.asarray(base.normals, np.float64)
+        from ...scene.mesh import RenderMesh
+
+        moved = RenderMesh(p + offset, base.indices, base.normals, base.colors, base.uvs,
+                           name=base.name)
+        return build_shell(moved, self.thickness)
+
+    def bake_report(self) -> list[str]:
+        """What `reliefkit bake` says of a fresh shell."""
+        s = self.shell.summary()
+        d, h, w = self.texture.shape
+        kind = "opaque" if self.opaque else "semi-transparent"
+        return [f"shell volume: {s['prisms']} prisms, {s['tetrahedra']} tetrahedra, thickness "
+                f"{s['thickness'][0]:.4g}..{s['thickness'][1]:.4g}; texture "
+                f"'{self.texture.name}' {w}x{h}x{d} ({kind}), tiled "
+                f"{self.texture.tile[0]}x{self.texture.tile[1]}"]

@@ -1,0 +1,75 @@
+// The 3D texture and its mip pyramid (filtering.py, §5.2), one sampler per level (up to
+// MAX_LEVELS; the levels differ in size, and a 3D texture's levels cannot be uploaded one
+// by one through moderngl). Colour + alpha per unit length in u_color<l>, the density normal
+// (u, v, w components, voxel units) + glow in u_normal<l>. Lookups use textureLod(.., 0.0)
+// so they are valid in any control flow; two levels are blended by hand.
+#define MAX_LEVELS 4
+uniform highp sampler3D u_color0;
+uniform highp sampler3D u_color1;
+uniform highp sampler3D u_color2;
+uniform highp sampler3D u_color3;
+uniform highp sampler3D u_normal0;
+uniform highp sampler3D u_normal1;
+uniform highp sampler3D u_normal2;
+uniform highp sampler3D u_normal3;
+uniform int u_levels;          // levels present
+uniform vec3 u_level_size[MAX_LEVELS];  // (W, H, D) voxels of each level per tile
+uniform bool u_mip;            // pick the level from the screen footprint (else level 0)
+
+vec4 color_level(int level, vec3 s) {
+    if (level == 0) return textureLod(u_color0, s, 0.0);
+    if (level == 1) return textureLod(u_color1, s, 0.0);
+    if (level == 2) return textureLod(u_color2, s, 0.0);
+    return textureLod(u_color3, s, 0.0);
+}
+
+vec4 normal_level(int level, vec3 s) {
+    if (level == 0) return textureLod(u_normal0, s, 0.0);
+    if (level == 1) return textureLod(u_normal1, s, 0.0);
+    if (level == 2) return textureLod(u_normal2, s, 0.0);
+    return textureLod(u_normal3, s, 0.0);
+}
+
+// The level of detail of a segment entering at lookup coordinate `s`: log2 of the pixel's
+// footprint in level-0 texels along u and v (w is filtered by the pyramid's layering, not
+// by the screen). Call in uniform control flow (it takes derivatives).
+float volume_lod(vec3 s) {
+    vec2 texels = s.xy * u_level_size[0].xy;
+    vec2 dx = dFdx(texels), dy = dFdy(texels);
+    float footprint = max(length(dx), length(dy));
+    float top = float(u_levels - 1);
+    return u_mip ? clamp(log2(max(footprint, 1e-8)), 0.0, top) : 0.0;
+}
+
+struct VolumeSample {
+    vec4 rgba;      // straight colour, alpha per unit length
+    vec3 normal;    // voxel units of level `level` (tet_normal converts it)
+    float glow;
+    vec3 size;      // voxels per tile of that level
+};
+
+// Trilinear within the two levels around `lod`, linear between them.
+VolumeSample volume_sample(vec3 s, float lod) {
+    int lo = int(floor(lod));
+    int hi = min(lo + 1, u_levels - 1);
+    float f = lod - float(lo);
+    vec4 c = color_level(lo, s);
+    vec4 n = normal_level(lo, s);
+    if (f > 0.0 && hi != lo) {
+        c = mix(c, color_level(hi, s), f);
+        n = mix(n, normal_level(hi, s), f);
+    }
+    return VolumeSample(c, n.xyz, n.w, u_level_size[f > 0.5 ? hi : lo]);
+}
+
+// Opacity of a sample of object-space length dt (§4.3): 1 - (1 - alpha)^dt.
+float sample_opacity(float alpha, float dt) {
+    return 1.0 - pow(max(1.0 - clamp(alpha, 0.0, 1.0), 0.0), dt);
+}
+
+// Its optical depth -ln(1 - opacity); a solid voxel (alpha 1) stops the ray whatever dt is.
+#define SOLID_OPTICAL_DEPTH 1e20
+float sample_optical_depth(float alpha, float dt) {
+    float a = clamp(alpha, 0.0, 1.0);
+    return a >= 1.0 ? SOLID_OPTICAL_DEPTH : -dt * log(1.0 - a);
+}
