@@ -53,11 +53,13 @@ def technique_of_path(path: Path) -> str | None:
 
 
 def core_words() -> set[str]:
-    """The core's own data vocabulary (the fields of a mesh and its materials): a technique
-    option of the same name (``--texture``) does not make the word the technique's."""
+    """The core's own vocabulary (the fields of a mesh and its materials, the animation
+    time): a technique option of the same name (``--texture``) does not make the word the
+    technique's."""
+    from reliefkit.core.params import ANIMATION_TIME
     from reliefkit.scene.mesh import Material, RenderMesh
 
-    return set(RenderMesh.__annotations__) | set(Material.__annotations__)
+    return set(RenderMesh.__annotations__) | set(Material.__annotations__) | {ANIMATION_TIME}
 
 
 def declared_names():

@@ -131,6 +131,8 @@ def cmd_render(args) -> int:
     if args.turntable is not None:
         return _render_turntable(args, framing_bounds(obj), draw, el, dist, size, background)
     camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
+    if args.animate is not None:
+        return _render_animation(args, obj, camera, draw, background)
     frame = draw(camera)
     frame.save(args.output, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
@@ -146,16 +148,24 @@ def cmd_render(args) -> int:
 
 
 def _check_render_outputs(args) -> None:
-    """The output names fit what is written; per-frame outputs do not go with --turntable."""
+    """The output names fit what is written; per-frame outputs do not go with --turntable
+    or --animate."""
     suffix = Path(args.output).suffix.lower()
-    if args.turntable is not None:
+    if args.turntable is not None and args.animate is not None:
+        raise UsageError("--turntable and --animate both write a GIF: give one of them")
+    sequence = "--turntable" if args.turntable is not None else \
+        "--animate" if args.animate is not None else None
+    if sequence:
+        count = args.turntable if args.turntable is not None else args.animate
+        if not 1 <= count <= 1000:
+            raise UsageError(f"{sequence} takes 1..1000 frames, got {count}")
         if suffix != ".gif":
-            raise UsageError("--turntable writes an animated .gif: name the output *.gif")
+            raise UsageError(f"{sequence} writes an animated .gif: name the output *.gif")
         given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
                  if value]
         if given:
             raise UsageError(f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not "
-                             "apply to --turntable (one frame's arrays and counters): render "
+                             f"apply to {sequence} (one frame's arrays and counters): render "
                              "a single --view for them")
     elif suffix != ".png":
         raise UsageError(f"output must be a .png file, got {args.output}")
@@ -191,6 +201,29 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
         many = len(empty) > 1
         _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
                               f"cover{'' if many else 's'}")
+    return 0
+
+
+def _render_animation(args, obj, camera, draw, background) -> int:
+    """``args.animate`` frames of ``obj``'s animation (its ``time`` render option) into a GIF."""
+    from ..core.params import ANIMATION_TIME
+    from ..pictures import TILE_BACKGROUND, save_gif
+    from ..progress import progress_bar
+    from ..render import render_options
+
+    if ANIMATION_TIME not in {opt.name for opt in render_options(obj)}:
+        raise UsageError(f"--animate: {args.input} ({type(obj).__name__}) has no animation "
+                         "(no --time option); use --turntable for views around it")
+    if given_options(args).get(ANIMATION_TIME) is not None:
+        raise UsageError("--animate sets the time of each frame itself: leave out --time")
+    frames = []
+    with progress_bar("animate", args.animate) as advance:
+        for k in range(args.animate):
+            frames.append(draw(camera, **{ANIMATION_TIME: k / args.animate}).rgba8(
+                background or TILE_BACKGROUND))
+            advance(k + 1)
+    save_gif(frames, args.output)
+    print(f"wrote {args.output} ({len(frames)} frames)")
     return 0
 
 

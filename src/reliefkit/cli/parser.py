@@ -128,13 +128,17 @@ def build_parser() -> argparse.ArgumentParser:
                  "Render a mesh (ground truth) or an .rk representation.")
     p.add_argument("input", help="mesh file, .rk file or demo:NAME")
     _add_view_args(p)
-    p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable)")
+    p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable or "
+                                                   "--animate)")
     p.add_argument("--aovs", metavar="OUT.npz",
                    help="also write color, mask, depth, position, normal, view, proj, viewport")
     p.add_argument("--stats", metavar="OUT.json",
                    help="also write the frame's counters: covered pixels, fragments and loop "
                         "iterations per pixel (mean, max) where the renderer counts them")
     p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
+    p.add_argument("--animate", type=int, metavar="N",
+                   help="N frames of the input's animation, times 0, 1/N, ... (GIF; for "
+                        "inputs with a --time option, such as shell volumes)")
     add_flag(p, "--background", dash_value=True, default="transparent",
               metavar="transparent|LEVEL",
               help="'transparent' or a grey level 0..1 to composite over (default: "

@@ -21,6 +21,10 @@ from ..errors import UsageError
 
 KINDS = ("bool", "int", "float", "str", "floats")
 
+#: The render option an animated representation declares: its time, period 1
+#: (``reliefkit render --animate N`` draws times 0, 1/N, ...).
+ANIMATION_TIME = "time"
+
 
 def param(default, help: str, *, choices: tuple | None = None, lo: float | None = None,
           hi: float | None = None, kind: str | None = None, count: int | None = None):

@@ -1,5 +1,6 @@
-"""Visibility order of shell tetrahedra against a brute-force ray reference: on every pixel
-ray, the tetrahedra it crosses, by exact float64 entry distance, must come in that order."""
+"""Visibility order of shell tetrahedra against a brute-force ray reference
+(`order_check.ordering_violations`): on every pixel ray, the tetrahedra it crosses, by exact
+float64 entry distance, must come in that order."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from reliefkit.techniques.shellvolume.order import (
     topological_order,
     visibility_order,
 )
+from reliefkit.techniques.shellvolume.order_check import OrderCheck, ordering_violations
 from reliefkit.techniques.shellvolume.shell import build_shell
 
 
@@ -45,6 +47,27 @@ def torus_mesh():
     return RenderMesh(p, faces, vertex_normals(p, faces), np.ones((len(p), 4)), uvs)
 
 
+def dented_sphere_mesh(subdivisions=2, direction=(0.3, 0.5, 0.8), cap_deg=55.0, depth=0.6):
+    """The unit sphere with a smooth crater around `direction` (a concave region: rays
+    across the crater leave the shell and re-enter it)."""
+    sphere = sphere_mesh(subdivisions)
+    unit, faces = np.asarray(sphere.positions, dtype=np.float64), np.asarray(sphere.indices)
+    axis = np.asarray(direction, dtype=np.float64) / np.linalg.norm(direction)
+    cap = np.cos(np.radians(cap_deg))
+    s = np.clip((unit @ axis - cap) / (1.0 - cap), 0.0, 1.0)
+    p = unit * (1.0 - depth * s * s * (3.0 - 2.0 * s))[:, None]  # smoothstep push inwards
+    return RenderMesh(p, faces, vertex_normals(p, faces), np.ones((len(p), 4)), sphere.uvs)
+
+
+def two_spheres_mesh(subdivisions=1):
+    """Two separate spheres along z (one behind the other seen from near the z axis)."""
+    sphere = sphere_mesh(subdivisions)
+    unit, faces = np.asarray(sphere.positions, dtype=np.float64), np.asarray(sphere.indices)
+    p = np.vstack([unit * 0.6 + [0.0, 0.0, 1.0], unit * 0.45 + [0.15, 0.1, -1.0]])
+    return RenderMesh(p, np.vstack([faces, faces + len(unit)]), np.vstack([unit, unit]),
+                      np.ones((len(p), 4)), np.vstack([sphere.uvs, sphere.uvs]))
+
+
 @pytest.fixture(scope="module")
 def sphere_shell():
     return build_shell(sphere_mesh(), 0.15)
@@ -55,39 +78,10 @@ def torus_shell():
     return build_shell(torus_mesh(), 0.08)
 
 
-def crossings(shell, origins, dirs, chunk=256):
-    """Per ray, the tetrahedra it crosses (positive length) sorted by entry distance."""
-    normals, offsets = shell.planes[..., :3], shell.planes[..., 3]
-    tol = 1e-9
-    out = []
-    for lo in range(0, len(origins), chunk):
-        o, d = origins[lo:lo + chunk], dirs[lo:lo + chunk]
-        num = np.einsum("tfi,ri->rtf", normals, o) + offsets  # > 0: outside that plane
-        den = np.einsum("tfi,ri->rtf", normals, d)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = -num / den
-        enter = np.where(den < 0, t, -np.inf).max(axis=2)
-        leave = np.where(den > 0, t, np.inf).min(axis=2)
-        parallel_out = ((den == 0) & (num > 0)).any(axis=2)
-        crossed = (leave - enter > tol) & ~parallel_out
-        for r in range(len(o)):
-            hit = np.nonzero(crossed[r])[0]
-            out.append(hit[np.argsort(enter[r, hit], kind="stable")])
-    return out
-
-
 def violations(shell, camera, order):
-    """Ray constraints (consecutive crossed tetrahedra) the order breaks, and their total."""
-    origins, dirs = (a.reshape(-1, 3) for a in camera.pixel_rays())
-    position = np.empty(len(order), np.int64)
-    position[order] = np.arange(len(order))
-    bad = total = 0
-    for hits in crossings(shell, origins, dirs):
-        if len(hits) > 1:
-            pos = position[hits]
-            bad += int((pos[1:] < pos[:-1]).sum())
-            total += len(hits) - 1
-    return bad, total
+    """(violated, total) consecutive-crossing constraints of `camera`'s pixel rays."""
+    check = ordering_violations(shell, camera, order)
+    return check.violations, check.pairs
 
 
 def views(distance=4.0, ortho=False):
@@ -204,3 +198,82 @@ def test_gap_relations_are_needed_when_ties_break_badly(torus_shell):
         fixed, _ = violations(torus_shell, camera, order)
         print(f"adversarial ties: adjacency only {bad}, with A-buffer {resolution}: {fixed}")
         assert fixed == 0 and broken == 0
+
+
+def test_checker_counts_each_consecutive_pair_once(torus_shell):
+    camera = views(distance=4.5)[1]
+    order = visibility_order(torus_shell, camera, method="centroid").order
+    check = ordering_violations(torus_shell, camera, order)
+    reverse = ordering_violations(torus_shell, camera, order[::-1].copy())
+    assert isinstance(check, OrderCheck) and check.seconds >= 0
+    # ranks are distinct: every consecutive pair is inverted by exactly one of the two
+    assert check.violations + reverse.violations == check.pairs == reverse.pairs
+    assert reverse.bad_rays == reverse.rays == check.rays > 0
+    assert 0 < check.bad_rays <= check.rays <= check.pairs and check.violations > 0
+    small = ordering_violations(torus_shell, camera, order, size=(16, 16))
+    assert 0 < small.rays <= 16 * 16 and small.pairs < check.pairs
+    with pytest.raises(UsageError):
+        ordering_violations(torus_shell, camera, order[:-1])
+    with pytest.raises(UsageError):
+        ordering_violations(torus_shell, camera, order, size=(0, 16))
+
+
+def test_checker_speed():
+    shell = build_shell(sphere_mesh(subdivisions=4), 0.03)  # 15360 tetrahedra
+    camera = Camera.orbit((0, 0, 0), 30, 20, 4.0, size=(256, 256))
+    order = visibility_order(shell, camera).order
+    ordering_violations(shell, camera, order)  # compile / load the cache
+    check = ordering_violations(shell, camera, order)
+    print(f"checker: {len(shell.tets)} tetrahedra, 256x256 rays, {check.rays} crossing 2+, "
+          f"{check.pairs} pairs in {check.seconds * 1e3:.1f} ms")
+    assert check.violations == 0 and check.rays > 10000
+    assert check.seconds < 1.0
+
+
+#: Pixel rays per random view (and SXMPVO's A-buffer resolution, see below).
+RAYS = 48
+
+#: name -> (mesh builder, shell thickness, rough radius of the shape around the origin)
+SHAPES = {"torus": (torus_mesh, 0.08, 1.5), "dented sphere": (dented_sphere_mesh, 0.06, 1.1),
+          "two spheres": (two_spheres_mesh, 0.1, 1.8)}
+
+
+def random_views(rng, count, reach):
+    """Random orbits around a point near the origin, the eye outside the shape: perspective
+    with a random field of view, a quarter orthographic."""
+    cameras = []
+    for _ in range(count):
+        target = tuple(rng.uniform(-0.3, 0.3, 3))
+        distance = rng.uniform(2.2, 7.0) * reach / 1.5
+        kind = {"ortho_height": rng.uniform(0.6, 1.2) * reach} if rng.random() < 0.25 \
+            else {"fov_deg": rng.uniform(15.0, 80.0)}
+        cameras.append(Camera.orbit(target, rng.uniform(0, 360), rng.uniform(-85, 85),
+                                    distance, size=(RAYS, RAYS), **kind))
+    return cameras
+
+
+@pytest.mark.parametrize("name", list(SHAPES))
+def test_random_views_sxmpvo_exact_centroid_not(name):
+    """SXMPVO is exact on the rays its A-buffer samples (module docstring of `order`), so
+    the A-buffer is the checked ray grid itself (`resolution=RAYS`: the same pixel rays).
+    Over 1000 random views nothing may be violated; the centroid sort, on the same views,
+    is reported and must fail somewhere."""
+    build, thickness, reach = SHAPES[name]
+    shell = build_shell(build(), thickness)
+    rng = np.random.default_rng(sum(map(ord, name)))
+    sx_bad = sx_cycles = ce_bad = pairs = bad_views = 0
+    for camera in random_views(rng, 1000, reach):
+        sx = visibility_order(shell, camera, resolution=RAYS)
+        ce = visibility_order(shell, camera, method="centroid")
+        check = ordering_violations(shell, camera, sx.order)
+        sx_bad += check.violations
+        sx_cycles += sx.cycles
+        bad_views += check.violations > 0
+        pairs += check.pairs
+        ce_bad += ordering_violations(shell, camera, ce.order).violations
+    print(f"{name}: {len(shell.tets)} tetrahedra, 1000 views at {RAYS}x{RAYS}, {pairs} "
+          f"constraints: sxmpvo {sx_bad} violated ({bad_views} views, {sx_cycles} cycles), "
+          f"centroid {ce_bad} violated")
+    assert pairs > 0
+    assert sx_bad == 0 and sx_cycles == 0
+    assert ce_bad > 0

@@ -1,4 +1,9 @@
-"""Procedural demo assets: a terrain, a closed blob, a tree and a van.
+"""Procedural demo assets: a terrain, a closed blob, a tree and a van, and textured surfaces.
+
+The surfaces (`SURFACE_NAMES`, from :mod:`.surfaces`: a sphere, a dented sphere, a torus, two
+spheres, a plane, a tube, a vase and the Utah teapot) carry texture coordinates and smooth
+normals for techniques that need (u, v); `make_asset` builds them by name too, while
+`ASSET_NAMES` and `all_assets` keep to the four assets.
 
 Every asset is deterministic for a given seed (``np.random.default_rng(seed)``), built with
 numpy, scipy and scikit-image only (nothing is downloaded) and returned as a
@@ -19,12 +24,14 @@ from collections.abc import Callable
 from ...errors import UsageError
 from ..mesh import RenderMesh
 from .blob import blob
+from .surfaces import SURFACES
 from .terrain import terrain, terrain_heights
 from .tree import tree
 from .vehicle import vehicle
 
 __all__ = [
     "ASSET_NAMES",
+    "SURFACE_NAMES",
     "all_assets",
     "blob",
     "make_asset",
@@ -36,6 +43,9 @@ __all__ = [
 
 ASSET_NAMES = ("terrain", "blob", "tree", "vehicle")
 
+#: The textured demo surfaces `make_asset` also knows (see :mod:`.surfaces`).
+SURFACE_NAMES = tuple(SURFACES)
+
 _FACTORIES: dict[str, Callable[[], RenderMesh]] = {
     "terrain": terrain,
     "blob": blob,
@@ -45,16 +55,18 @@ _FACTORIES: dict[str, Callable[[], RenderMesh]] = {
 
 
 def make_asset(name: str) -> RenderMesh:
-    """The demo asset called `name` (one of `ASSET_NAMES`) with its default parameters.
+    """The demo asset or surface called `name` (one of `ASSET_NAMES` or `SURFACE_NAMES`)
+    with its default parameters.
 
     Raises
     ------
     UsageError
         If `name` is not a known asset.
     """
-    factory = _FACTORIES.get(name) if isinstance(name, str) else None
+    factory = (_FACTORIES.get(name) or SURFACES.get(name)) if isinstance(name, str) else None
     if factory is None:
-        raise UsageError(f"unknown asset {name!r}; choose one of: {', '.join(ASSET_NAMES)}")
+        raise UsageError(f"unknown asset {name!r}; choose one of: {', '.join(ASSET_NAMES)} "
+                         f"or a surface: {', '.join(SURFACE_NAMES)}")
     return factory()
 
 

@@ -1,6 +1,7 @@
 """Drawing a `TexturedShell` (semi-transparent 3D texture paper, §4-§5).
 
-Every frame: the tetrahedra are sorted front to back (SXMPVO, order.py; or the centroid
+Every frame: the tetrahedra are sorted front to back (SXMPVO, order.py, its A-buffer at the
+frame's resolution so that the order is exact on every pixel's ray; or the centroid
 baseline), written to an instance buffer, and drawn in that order in one instanced call of 12
 vertices per tetrahedron (shaders/shell.glsl); the transparent pass composites each
 fragment "under" what is in front of it. Opaque textures are drawn in the opaque pass,
@@ -29,7 +30,8 @@ from ...gl.shaders import program
 from ...gl.textures import texture2d, texture3d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
-from .order import METHODS as SORTS, visibility_order
+from .order import METHODS as SORTS
+from .order import visibility_order
 from .representation import TexturedShell
 from .textures import density_normals
 
@@ -217,7 +219,9 @@ class TexturedShellDrawable(GLObjects):
         ctx = self.ctx
         start = time.perf_counter()
         if self.transparent:
-            order = visibility_order(self.shell, camera, method=self.options.sort)
+            # the A-buffer samples the frame's own pixel rays: the order is exact on them
+            order = visibility_order(self.shell, camera, method=self.options.sort,
+                                     resolution=max(camera.size))
             self.instances.write(order.order.astype(np.int32).tobytes())
             self.stats.update(sort=order.method, sort_seconds=order.seconds,
                               cycles=order.cycles)
