@@ -28,11 +28,12 @@ class ShellVolumeParams:
                                 "voxelized texture", kind="floats", count=3, lo=2, hi=256)
 
 
-def make_texture(spec: str, size, progress=None):
-    """The texture ``spec`` names (see `ShellVolumeParams.texture`) at ``size`` (W, H, D)."""
+def make_texture(spec: str, size, thickness: float, progress=None):
+    """The texture ``spec`` names (see `ShellVolumeParams.texture`) at ``size`` (W, H, D);
+    a generated one's alpha converted for a shell of ``thickness``."""
     size = tuple(int(round(s)) for s in size)
     if spec in TEXTURES:
-        return TEXTURES[spec](size=size)
+        return TEXTURES[spec](size=size).per_unit_length(thickness)
     if spec.lower().endswith(".npy"):
         return load_texture_npy(spec)
     from ...io.inputs import load_input
@@ -49,10 +50,10 @@ def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
     for t in p.tile:
         if t != int(t):
             raise UsageError(f"--tile takes whole numbers, got {p.tile[0]:g},{p.tile[1]:g}")
-    texture = make_texture(p.texture, p.texture_size, progress).tiled(
-        (int(p.tile[0]), int(p.tile[1])))
     lo, hi = source.bounds
     thickness = p.thickness if p.thickness is not None else \
         DEFAULT_THICKNESS * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
+    texture = make_texture(p.texture, p.texture_size, thickness, progress).tiled(
+        (int(p.tile[0]), int(p.tile[1])))
     return TexturedShell(source, thickness, texture,
                          {"source": source.name, "thickness_given": p.thickness})

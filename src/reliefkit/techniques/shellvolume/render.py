@@ -80,7 +80,10 @@ def tet_texels(shell, origin, tile) -> np.ndarray:
     origin = np.asarray(origin, np.float64)
     count = len(shell.tets)
     block = np.zeros((count, TET_TEXELS, 4), np.float64)
-    block[:, 0:4, :3] = shell.positions[shell.tets] - origin
+    corners = shell.positions[shell.tets]
+    block[:, 0:4, :3] = corners - origin
+    block[:, 0:4, 3] = np.einsum("tfk,tfk->tf", shell.planes[..., :3], corners) + \
+        shell.planes[..., 3]  # vertex f's value in the plane of face f: minus its height
     normals = shell.planes[..., :3]
     block[:, 4:8, :3] = normals
     block[:, 4:8, 3] = shell.planes[..., 3] + normals @ origin
@@ -88,6 +91,7 @@ def tet_texels(shell, origin, tile) -> np.ndarray:
     rows = shell.object_to_texture[:, :3, :] * scale[None, :, None]
     block[:, 8:11, :3] = rows[..., :3]
     block[:, 8:11, 3] = rows[..., 3] + rows[..., :3] @ origin
+    block[:, 11:15, :3] = shell.normals[shell.tets]
     per_row = TET_ROW_TEXELS // TET_TEXELS
     padded = np.zeros((-(-count // per_row) * per_row, TET_TEXELS, 4), np.float32)
     padded[:count] = block

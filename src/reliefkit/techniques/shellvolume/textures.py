@@ -6,6 +6,11 @@ float32, straight linear RGB, and its alpha is opacity per unit of object-space 
 segment of length L through a voxel has opacity ``1 - (1 - alpha)^L`` (the paper's §4.3
 correction). w = 0 is the base (the mesh surface), w = 1 the top of the shell.
 
+The generators author alpha as the opacity of the shell's whole thickness (a medium of
+alpha 0.3 dims what is below it by 30% seen straight down, whatever the shell's size);
+`VolumeTexture.per_unit_length` converts that to the contract once the thickness is known
+(the baker does).
+
 ``normal`` (D, H, W, 3) holds unit vectors with components (u, v, w), computed from the
 density (alpha) gradient by central differences in voxel units, pointing from dense towards
 empty (``-grad``); where the gradient vanishes the normal is +w.
@@ -69,6 +74,21 @@ class VolumeTexture:
         the depth test, without sorting."""
         alpha = self.rgba[..., 3]
         return self.glow is None and bool(np.all((alpha == 0) | (alpha == 1)))
+
+    def per_unit_length(self, thickness: float) -> VolumeTexture:
+        """This texture, its alpha read as the opacity of the shell's whole ``thickness``
+        (how the generators author it), converted to the contract's opacity per unit of
+        object-space length: ``1 - (1 - alpha)^(1 / thickness)``."""
+        from dataclasses import replace
+
+        if not thickness > 0:
+            raise UsageError(f"thickness must be > 0, got {thickness}")
+        alpha = np.clip(self.rgba[..., 3].astype(np.float64), 0.0, 1.0)
+        with np.errstate(under="ignore"):
+            converted = 1.0 - (1.0 - alpha) ** (1.0 / thickness)
+        rgba = self.rgba.copy()
+        rgba[..., 3] = np.where(alpha >= 1.0, 1.0, converted)
+        return replace(self, rgba=rgba)
 
     def tiled(self, tile) -> VolumeTexture:
         """The same texture repeated ``tile`` (U, V) times over the uvs."""
@@ -144,13 +164,15 @@ def _make(name, rgb, alpha, tile=(1, 1)):
 
 
 def make_fur(size=(32, 32, 16), seed=0) -> VolumeTexture:
-    """Brown strands rising from w = 0, each thinning to nothing at w = 1, bending slightly."""
+    """Brown strands rising from a dark skin at w = 0, each thinning to nothing at w = 1,
+    bending slightly."""
     rng = np.random.default_rng(seed)
     w, v, u = _grid(size)
-    count = 48
+    count = 140
     alpha = np.zeros(w.shape)
     rgb = np.zeros(w.shape + (3,))
-    base_radius = 0.045
+    alpha[0], rgb[0] = 1.0, (0.18, 0.1, 0.05)
+    base_radius = 0.04
     for _ in range(count):
         u0, v0 = rng.random(2)
         bend = rng.normal(0, 0.08, 2)

@@ -155,7 +155,7 @@ vec3 sample_color(VolumeSample v, vec3 p, vec3 dir) {
 #if defined SHADOWS
     lit = light_visibility(p);
 #endif
-    return shade_phong(v.rgba.rgb, tet_normal(v_tet, v.normal, v.size), -dir, lit);
+    return shade_phong(v.rgba.rgb, shading_normal(v_tet, v.normal, v.size, p), -dir, lit);
 #else
     return v.rgba.rgb;
 #endif
@@ -196,7 +196,8 @@ void main() {
         optical_depth += sample_optical_depth(v.rgba.a, dt);
         if (optical_depth >= search.y || k == n - 1) {
             vec3 world = mix(v_local, p_out, lambda) + u_model_offset;
-            write_transparent_at(vec3(0.0), 0.0, world, tet_normal(v_tet, v.normal, v.size),
+            write_transparent_at(vec3(0.0), 0.0, world,
+                                 shading_normal(v_tet, v.normal, v.size, world - u_model_offset),
                                  true);
             return;
         }
@@ -208,7 +209,8 @@ void main() {
 #if defined OPAQUE
         if (opacity >= 0.5) {
             vec3 world = p + u_model_offset;
-            write_frame(vec4(color / opacity, 1.0), world, tet_normal(v_tet, v.normal, v.size));
+            write_frame(vec4(color / opacity, 1.0), world,
+                        shading_normal(v_tet, v.normal, v.size, p));
             gl_FragDepth = window_depth(world);
             return;
         }

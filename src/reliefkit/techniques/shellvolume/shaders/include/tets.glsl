@@ -1,7 +1,9 @@
 // The tetrahedra of a shell, one block of TET_TEXELS texels each in an RGBA32F texture
-// (render.py, tet_texels): texels 0-3 the vertices, 4-7 the face planes (face f opposite
-// vertex f, outward unit normal, inside <= 0), 8-10 the rows of the object-to-texture map
-// with the tiling folded in (s = row . (p, 1) gives the lookup coordinate along u, v, w).
+// (render.py, tet_texels): texels 0-3 vertex f and in .w its height over face f (the plane
+// value there, < 0), 4-7 the face planes (face f opposite vertex f, outward unit normal,
+// inside <= 0), 8-10 the rows of the object-to-texture map with the tiling folded in
+// (s = row . (p, 1) gives the lookup coordinate along u, v, w), 11-14 the shell's smooth
+// normal at vertex f.
 // Everything is relative to the shell's origin (u_model_offset places it, camera.glsl).
 #define TET_TEXELS 16
 #define TET_ROW_TEXELS 2048
@@ -29,6 +31,30 @@ vec3 tet_normal(int tet, vec3 n_vox, vec3 size) {
              + g.z * tet_texel(tet, 10).xyz;
     float len = length(n);
     return len > 0.0 ? n / len : vec3(0.0, 1.0, 0.0);
+}
+
+// The shell's normal at p, interpolated from its vertices (the paper's interpolated frame,
+// §5.3): barycentric weights are plane values over the heights.
+vec3 tet_smooth_normal(int tet, vec3 p) {
+    vec3 n = vec3(0.0);
+    for (int f = 0; f < 4; ++f) {
+        vec4 plane = tet_plane(tet, f);
+        float weight = (dot(plane.xyz, p) + plane.w) / tet_texel(tet, f).w;
+        n += clamp(weight, 0.0, 1.0) * tet_texel(tet, 11 + f).xyz;
+    }
+    float len = length(n);
+    return len > 0.0 ? n / len : vec3(0.0, 1.0, 0.0);
+}
+
+// A texture-space normal at p in world space: mapped by the tetrahedron's own affine map
+// (right for anisotropic u, v, w scales), then bent from the tetrahedron's flat w direction
+// to the smooth normal, so a shell over a curved mesh shades without facets.
+vec3 shading_normal(int tet, vec3 n_vox, vec3 size, vec3 p) {
+    vec3 n = tet_normal(tet, n_vox, size);
+    vec3 flat_w = tet_normal(tet, vec3(0.0, 0.0, 1.0), size);
+    vec3 bent = n + (tet_smooth_normal(tet, p) - flat_w) * dot(n, flat_w);
+    float len = length(bent);
+    return len > 0.0 ? bent / len : n;
 }
 
 // Corner k (0..2) of face f, counter-clockwise seen from outside (a tetrahedron of positive
