@@ -146,6 +146,18 @@ def test_result_does_not_depend_on_submission_order(gl, cloudy_sphere):
     assert np.abs(a.color - b.color).max() < 1e-4
 
 
+def test_depth_peeling_gives_the_sorted_picture(gl, cloudy_sphere):
+    cam = sphere_camera(az=80.0, el=10.0)
+    sorted_ = render(cloudy_sphere, cam, ctx=gl, samples=6)
+    peeled = render(cloudy_sphere, cam, ctx=gl, samples=6, sort="peel")
+    assert np.abs(sorted_.color - peeled.color).max() < 1e-4
+    assert peeled.stats["peeled_layers"] >= 4  # a ray crosses several tetrahedra per side
+    # without the half-opacity search (and with peeling) the AOVs are the opaque pass's: none
+    assert not np.isfinite(peeled.position).any()
+    plain = render(cloudy_sphere, cam, ctx=gl, samples=6, half_opacity=False)
+    assert np.array_equal(plain.color, sorted_.color) and not np.isfinite(plain.position).any()
+
+
 def test_centroid_sort_is_the_baseline(gl):
     """On a torus seen side-on the centroid order composites some rays out of order, SXMPVO
     matches the reference."""

@@ -27,10 +27,11 @@ from ...core.technique import DrawableSpec, ProgramVariant
 from ...gl.context import check_gl_error
 from ...gl.objects import GLObjects
 from ...gl.shaders import program
+from ...gl.targets import use_transparent_blending
 from ...gl.textures import texture2d, texture3d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
-from .order import METHODS as SORTS
+from .order import METHODS
 from .order import visibility_order
 from .representation import TexturedShell
 from .textures import density_normals
@@ -43,12 +44,16 @@ SHADOW_SIZE = 1024
 _COLOR_UNITS, _NORMAL_UNITS = range(0, 4), range(4, 8)
 _TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT = 8, 9, 10, 11
 EXITS = ("fragment", "vertex")
+SORTS = (*METHODS, "peel")  # peel: depth peeling, the baseline the paper measured against
+MAX_PEELS = 1024
 COMPOSITES = ("auto", "sorted", "opaque")
 
+LAYER_PROGRAM = "shellvolume:layer.glsl"
 PROGRAMS = tuple(ProgramVariant(PROGRAM, d) for d in (
     {"LIT": True}, {"LIT": True, "SHADOWS": True}, {}, {"EXIT_VERTEX": True, "LIT": True},
     {"OPAQUE": True, "LIT": True}, {"OPAQUE": True}, {"AOV_BINS": True},
-    {"AOV_FINAL": True}, {"SHADOW_MAP": True}))
+    {"AOV_FINAL": True}, {"SHADOW_MAP": True}, {"PEEL": True, "LIT": True})) + (
+    ProgramVariant(LAYER_PROGRAM, {}),)
 
 
 @dataclass(frozen=True)
@@ -56,8 +61,9 @@ class ShellRenderOptions:
     """The render options of shell volumes."""
 
     samples: int = param(16, "samples along each tetrahedron's segment (§5.1)", lo=1, hi=256)
-    sort: str = param("sxmpvo", "visibility order: SXMPVO (exact) or the centroid sort "
-                      "(approximate, the baseline)", choices=SORTS)
+    sort: str = param("sxmpvo", "visibility order: SXMPVO (exact), the centroid sort "
+                      "(approximate), or depth peeling (exact, one pass per layer; its AOVs "
+                      "come from opaque objects only)", choices=SORTS)
     shadows: bool = param(False, "self and volumetric shadows from a shadow map (§5.3)")
     unlit: bool = param(False, "composite the stored colours without lighting (what "
                         "measurements compare against)")
@@ -170,14 +176,18 @@ class TexturedShellDrawable(GLObjects):
         self.instances = self.keep(ctx.buffer(np.arange(count, dtype=np.int32).tobytes()))
         lit = not self.options.unlit
         exit_vertex = self.options.exit == "vertex"
+        self.peel = self.transparent and self.options.sort == "peel"
         if self.transparent:
             main = {"LIT": lit, "SHADOWS": lit and self.options.shadows,
-                    "EXIT_VERTEX": exit_vertex}
+                    "EXIT_VERTEX": exit_vertex, "PEEL": self.peel}
         else:
             main = {"OPAQUE": True, "LIT": lit, "SHADOWS": lit and self.options.shadows,
                     "EXIT_VERTEX": exit_vertex}
         self.programs = {"main": program(ctx, PROGRAM, main)}
-        if self.transparent and self.options.half_opacity:
+        if self.peel:
+            self.layer_program = program(ctx, LAYER_PROGRAM)
+            self.layer_vao = self.keep(ctx.vertex_array(self.layer_program, []))
+        if self.transparent and self.options.half_opacity and not self.peel:
             self.programs["bins"] = program(ctx, PROGRAM, {"AOV_BINS": True,
                                                             "EXIT_VERTEX": exit_vertex})
             self.programs["final"] = program(ctx, PROGRAM, {"AOV_FINAL": True,
@@ -222,7 +232,7 @@ class TexturedShellDrawable(GLObjects):
 
         ctx = self.ctx
         start = time.perf_counter()
-        if self.transparent:
+        if self.transparent and not self.peel:
             # the A-buffer samples the frame's own pixel rays: the order is exact on them
             order = visibility_order(self.shell, camera, method=self.options.sort,
                                      resolution=max(camera.size))
@@ -240,11 +250,17 @@ class TexturedShellDrawable(GLObjects):
                 outer.use()
             if self.transparent:
                 uniforms |= self._opaque_depth(outer, made)
-            search = self.transparent and self.options.half_opacity
+            search = "bins" in self.programs
             front = _read_alpha(outer) if search else None
-            ctx.enable_only(enabled | moderngl.CULL_FACE)
             ctx.cull_face, ctx.front_face = "back", "ccw"
-            self._draw("main", uniforms)
+            if self.peel:
+                self._draw_peeled(outer, uniforms, made)
+            elif self.transparent:
+                use_transparent_blending(ctx, moderngl.CULL_FACE)
+                self._draw("main", uniforms)
+            else:
+                ctx.enable_only(enabled | moderngl.CULL_FACE)
+                self._draw("main", uniforms)
             if search:
                 self._half_opacity_point(outer, front, uniforms, made)
             check_gl_error(ctx, f"drawing a shell of {len(self.shell.tets)} tetrahedra")
@@ -287,6 +303,9 @@ class TexturedShellDrawable(GLObjects):
         """A copy of the opaque pass's depth to sample (the attached one cannot be)."""
         width, height = outer.size
         depth = np.frombuffer(outer.read(attachment=-1, components=1, dtype="f4"), np.float32)
+        # reading the depth leaves GL's read buffer at none; a later blit from this
+        # framebuffer (the pass copies its opacity) then crashes Mesa: read a colour texel
+        outer.read(viewport=(0, 0, 1, 1), attachment=0)
         tex = self.ctx.texture((width, height), 1, depth.tobytes(), dtype="f4")
         made.append(tex)
         import moderngl
@@ -338,10 +357,49 @@ class TexturedShellDrawable(GLObjects):
                      .astype(np.float32).tobytes())
         search.use(_SEARCH_UNIT)
         outer.use()
-        from ...gl.targets import use_transparent_blending
-
         use_transparent_blending(ctx, moderngl.CULL_FACE)
         self._draw("final", uniforms)
+
+    def _draw_peeled(self, outer, uniforms, made) -> None:
+        """Depth peeling: pass k draws every tetrahedron, keeps the nearest fragment behind
+        layer k - 1 (depth test), and adds it under the layers in front; until a pass draws
+        nothing (an occlusion query) or `MAX_PEELS` passes."""
+        import moderngl
+
+        ctx = self.ctx
+        width, height = outer.size
+        color = ctx.texture((width, height), 4, dtype="f4")
+        depths = [ctx.depth_texture((width, height)) for _ in range(2)]
+        made.extend([color, *depths])
+        for depth in depths:
+            depth.compare_func = ""
+            depth.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        fbos = [ctx.framebuffer(color_attachments=[color], depth_attachment=d) for d in depths]
+        made.extend(fbos)
+        fbos[1].use()
+        fbos[1].clear(depth=0.0)  # "layer -1": nothing peeled yet
+        self.layer_program["u_layer"].value = _SEARCH_UNIT
+        layers = 0
+        for k in range(MAX_PEELS):
+            fbo, before = fbos[k % 2], depths[(k + 1) % 2]
+            fbo.use()
+            fbo.viewport = (0, 0, width, height)
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+            before.use(_SEARCH_UNIT + 1)
+            query = ctx.query(samples=True)
+            with query:
+                self._draw("main", uniforms | {"u_peel_depth": _SEARCH_UNIT + 1})
+            drawn = query.samples
+            if drawn == 0:
+                break
+            layers += 1
+            outer.use()
+            use_transparent_blending(ctx)
+            ctx.disable(moderngl.DEPTH_TEST)
+            color.use(_SEARCH_UNIT)
+            self.layer_vao.render(moderngl.TRIANGLES, vertices=3)
+        self.stats["peeled_layers"] = layers
 
     def finish(self, frame) -> None:
         frame.stats.update({"tetrahedra": len(self.shell.tets),

@@ -11,7 +11,9 @@
 //                for the point where the accumulated opacity reaches 0.5)
 //   AOV_FINAL    the tetrahedron found by that search writes that point's position, normal
 //   SHADOW_MAP   from the light: depth of the first sample dense enough to cast a shadow
-//! defines: OPAQUE AOV_BINS AOV_FINAL SHADOW_MAP EXIT_VERTEX LIT SHADOWS
+//   PEEL         (with the default) depth peeling, the baseline: only fragments behind the
+//                layer peeled before (u_peel_depth) are drawn, the nearest one wins
+//! defines: OPAQUE AOV_BINS AOV_FINAL SHADOW_MAP EXIT_VERTEX LIT SHADOWS PEEL
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
@@ -86,6 +88,9 @@ uniform highp sampler2D u_search;   // per pixel, see render.py (half_opacity_se
 #endif
 #if defined SHADOW_MAP
 uniform float u_shadow_length;      // length over which a sample must reach opacity 0.5
+#endif
+#if defined PEEL
+uniform highp sampler2D u_peel_depth;  // the depth of the layer peeled before this one
 #endif
 #if defined SHADOWS
 uniform highp sampler2D u_shadow_map;
@@ -167,6 +172,9 @@ void main() {
     float lod = volume_lod(s_in);  // derivatives first, before any fragment is discarded
     float len = min(exit_distance(dir), opaque_distance(dir));
     if (!(len > 0.0)) discard;
+#if defined PEEL
+    if (gl_FragCoord.z <= texelFetch(u_peel_depth, ivec2(gl_FragCoord.xy), 0).r) discard;
+#endif
 #if defined AOV_BINS
     vec2 range = texelFetch(u_search, ivec2(gl_FragCoord.xy), 0).xy;
     float rank = float(v_rank);
