@@ -31,8 +31,7 @@ from ...gl.targets import use_transparent_blending
 from ...gl.textures import texture2d, texture3d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
-from .order import METHODS
-from .order import visibility_order
+from .order import METHODS, visibility_order
 from .representation import TexturedShell
 from .textures import density_normals
 
