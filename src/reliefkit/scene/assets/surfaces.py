@@ -397,7 +397,7 @@ def teapot(subdivisions: int = 8) -> RenderMesh:
 #: The thickest shell the teapot takes along its exact normals (checked in the tests): the
 #: classic data's creases are tight, the foot's concave curvature radius is 0.017 data units
 #: (0.005 here) and the spout's rolled-back lip is a bore about 0.05 across.
-TEAPOT_SHELL = 0.01
+TEAPOT_SHELL = 0.008
 
 
 #: The surfaces by demo name (``demo:NAME``), each called with its defaults.

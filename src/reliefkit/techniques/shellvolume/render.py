@@ -368,29 +368,34 @@ class TexturedShellDrawable(GLObjects):
         ctx = self.ctx
         width, height = outer.size
         color = ctx.texture((width, height), 4, dtype="f4")
-        depths = [ctx.depth_texture((width, height)) for _ in range(2)]
-        made.extend([color, *depths])
-        for depth in depths:
-            depth.compare_func = ""
-            depth.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        fbos = [ctx.framebuffer(color_attachments=[color], depth_attachment=d) for d in depths]
+        made.append(color)
+        # the depth test picks the nearest fragment; its exact z goes to a float attachment
+        # (a 24-bit depth texture would round it, and the layer would be peeled again)
+        peeled = [ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
+        depth = ctx.depth_texture((width, height))
+        made.extend([*peeled, depth])
+        for tex in peeled:
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        fbos = [ctx.framebuffer(color_attachments=[color, z], depth_attachment=depth)
+                for z in peeled]
         made.extend(fbos)
-        fbos[1].use()
-        fbos[1].clear(depth=0.0)  # "layer -1": nothing peeled yet
+        # a pixel no fragment reaches keeps "beyond everything", so nothing comes back
+        beyond = np.full((height, width, 4), 2.0, np.float32).tobytes()
+        peeled[1].write(np.full((height, width, 4), -1.0, np.float32).tobytes())  # none yet
         self.layer_program["u_layer"].value = _SEARCH_UNIT
         layers = 0
         for k in range(MAX_PEELS):
-            fbo, before = fbos[k % 2], depths[(k + 1) % 2]
+            fbo, before = fbos[k % 2], peeled[(k + 1) % 2]
             fbo.use()
             fbo.viewport = (0, 0, width, height)
             fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            peeled[k % 2].write(beyond)
             ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
             before.use(_SEARCH_UNIT + 1)
             query = ctx.query(samples=True)
             with query:
                 self._draw("main", uniforms | {"u_peel_depth": _SEARCH_UNIT + 1})
-            drawn = query.samples
-            if drawn == 0:
+            if query.samples == 0:
                 break
             layers += 1
             outer.use()
@@ -402,7 +407,8 @@ class TexturedShellDrawable(GLObjects):
 
     def finish(self, frame) -> None:
         frame.stats.update({"tetrahedra": len(self.shell.tets),
-                            "samples": self.options.samples, **self.stats})
+                            "samples": self.options.samples, "unlit": self.options.unlit,
+                            "mip": self.options.mip, **self.stats})
 
 
 def _needed_optical_depth(front: np.ndarray) -> np.ndarray:

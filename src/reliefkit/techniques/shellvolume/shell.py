@@ -10,8 +10,10 @@ adjacency. All of it is pure numpy, in float64 world coordinates.
 **The split.** The three tetrahedra of neighbouring prisms must meet face to face: a side
 quad shared by two prisms has to be cut by the same diagonal on both sides, or the shell has
 cracks and overlaps. The rule only looks at global vertex indices, which both prisms agree
-on: a side quad over the base edge (p, q) with p < q is cut by the diagonal from p's base
-vertex to q's top vertex. With the triangle's indices sorted, i < j < k, the tetrahedra
+on (welded: the copies of a vertex that a uv seam splits count as the lowest of them, so the
+prisms on both sides of a seam agree too, and become neighbours): a side quad over the base
+edge (p, q) with p < q is cut by the diagonal from p's base vertex to q's top vertex. With
+the triangle's indices sorted, i < j < k, the tetrahedra
 
     (i, j, k, k'),  (i, j, j', k'),  (i, i', j', k')
 
@@ -122,10 +124,14 @@ def build_shell(mesh, thickness, direction: str = "normals") -> ShellVolume:
     uv = np.asarray(mesh.uvs, dtype=np.float64)
     uvw = np.concatenate([np.column_stack([uv, np.zeros(count)]),
                           np.column_stack([uv, np.ones(count)])])
-    tets = _split_prisms(positions, faces, count)
+    welded = _welded(positions, count)
+    tets = _split_prisms(positions, faces, count, welded)
     corners = positions[tets]
     planes = _face_planes(corners)
-    neighbors, neighbor_faces = _adjacency(tets)
+    try:  # seams (vertices split for their uvs) joined: one shell, no boundary there
+        neighbors, neighbor_faces = _adjacency(welded[tets])
+    except UsageError:  # coincident surfaces: only the mesh's own connectivity
+        neighbors, neighbor_faces = _adjacency(tets)
     _check_folds(planes, neighbors, neighbor_faces)
     tangents, bitangents = _tangent_frames(base, uv, faces, normals)
     return ShellVolume(
@@ -185,12 +191,24 @@ def _check_triangles(base: np.ndarray, faces: np.ndarray) -> None:
                          "(no area); remove them before building a shell")
 
 
-def _split_prisms(positions: np.ndarray, faces: np.ndarray, count: int) -> np.ndarray:
-    """(3F, 4) int64 tetrahedra, each in the vertex order positive in its ideal prism.
+def _welded(positions: np.ndarray, count: int) -> np.ndarray:
+    """(2V,) the lowest shell vertex index at the same base and top positions as each vertex:
+    a uv seam's two copies of a vertex become one, so the prisms on either side split their
+    shared quad the same way and meet as neighbours."""
+    pairs = np.concatenate([positions[:count], positions[count:]], axis=1)
+    _, first, inverse = np.unique(pairs, axis=0, return_index=True, return_inverse=True)
+    base = first[inverse.ravel()]
+    return np.concatenate([base, base + count])
+
+
+def _split_prisms(positions: np.ndarray, faces: np.ndarray, count: int,
+                  welded: np.ndarray) -> np.ndarray:
+    """(3F, 4) int64 tetrahedra, each in the vertex order positive in its ideal prism; the
+    diagonals follow the welded indices, so a seam's two sides agree.
 
     Raises UsageError when some are inverted (see the module docstring).
     """
-    order = np.argsort(faces, axis=1, kind="stable")  # winding positions of i < j < k
+    order = np.argsort(welded[faces], axis=1, kind="stable")  # corners i < j < k
     ijk = np.take_along_axis(faces, order, axis=1)
     prism = np.concatenate([ijk, ijk + count], axis=1)  # (i, j, k, i', j', k')
     tets = prism[:, _SPLIT]  # (F, 3, 4)

@@ -12,7 +12,8 @@
 //   AOV_FINAL    the tetrahedron found by that search writes that point's position, normal
 //   SHADOW_MAP   from the light: depth of the first sample dense enough to cast a shadow
 //   PEEL         (with the default) depth peeling, the baseline: only fragments behind the
-//                layer peeled before (u_peel_depth) are drawn, the nearest one wins
+//                layer peeled before (u_peel_depth) are drawn, the nearest one wins and
+//                writes its own depth to attachment 1 for the next layer
 //! defines: OPAQUE AOV_BINS AOV_FINAL SHADOW_MAP EXIT_VERTEX LIT SHADOWS PEEL
 
 #if defined VERTEX_SHADER
@@ -90,7 +91,7 @@ uniform highp sampler2D u_search;   // per pixel, see render.py (half_opacity_se
 uniform float u_shadow_length;      // length over which a sample must reach opacity 0.5
 #endif
 #if defined PEEL
-uniform highp sampler2D u_peel_depth;  // the depth of the layer peeled before this one
+uniform highp sampler2D u_peel_depth;  // .r: the exact gl_FragCoord.z peeled before
 #endif
 #if defined SHADOWS
 uniform highp sampler2D u_shadow_map;
@@ -241,6 +242,9 @@ void main() {
     f_color = vec4(color, opacity);  // premultiplied: the pass composites with "under"
     f_position = vec4(0.0);
     f_normal = vec4(0.0);
+#if defined PEEL
+    f_position = vec4(gl_FragCoord.z);  // the next layer compares with exactly this value
+#endif
 #endif
 }
 #endif
