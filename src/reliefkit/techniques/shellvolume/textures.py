@@ -78,7 +78,8 @@ class VolumeTexture:
     def per_unit_length(self, thickness: float) -> VolumeTexture:
         """This texture, its alpha read as the opacity of the shell's whole ``thickness``
         (how the generators author it), converted to the contract's opacity per unit of
-        object-space length: ``1 - (1 - alpha)^(1 / thickness)``."""
+        object-space length: ``1 - (1 - alpha)^(1 / thickness)``; its glow (light over the
+        whole thickness) likewise to light per unit length, ``glow / thickness``."""
         from dataclasses import replace
 
         if not thickness > 0:
@@ -88,7 +89,8 @@ class VolumeTexture:
             converted = 1.0 - (1.0 - alpha) ** (1.0 / thickness)
         rgba = self.rgba.copy()
         rgba[..., 3] = np.where(alpha >= 1.0, 1.0, converted)
-        return replace(self, rgba=rgba)
+        glow = None if self.glow is None else (self.glow / thickness).astype(np.float32)
+        return replace(self, rgba=rgba, glow=glow)
 
     def tiled(self, tile) -> VolumeTexture:
         """The same texture repeated ``tile`` (U, V) times over the uvs."""
@@ -276,6 +278,27 @@ def make_rocks(size=(32, 32, 16), seed=0) -> VolumeTexture:
     return _make("rocks", rgb, alpha)
 
 
+def make_glow(size=(32, 32, 16), seed=0) -> VolumeTexture:
+    """Glowing embers in a thin grey smoke over a dark opaque floor: the paper's glow
+    (Color plate G), light added where the voxels' ``glow`` is set."""
+    rng = np.random.default_rng(seed)
+    w, v, u = _grid(size)
+    alpha = np.full(w.shape, 0.15)
+    rgb = np.broadcast_to(np.array([0.5, 0.5, 0.55]), w.shape + (3,)).copy()
+    glow = np.zeros(w.shape)
+    for _ in range(10):
+        c = rng.uniform([0, 0, 0.25], [1, 1, 0.8])
+        r2 = (_wrapped(u - c[0]) ** 2 + _wrapped(v - c[1]) ** 2 + (w - c[2]) ** 2) / 0.06 ** 2
+        ember = np.exp(-r2)
+        glow = np.maximum(glow, 3.0 * ember)
+        rgb = np.where((ember > 0.2)[..., None], [1.0, 0.45, 0.1], rgb)
+    alpha[0], rgb[0] = 1.0, (0.05, 0.04, 0.04)
+    texture = _make("glow", rgb, alpha)
+    from dataclasses import replace
+
+    return replace(texture, glow=glow.astype(np.float32))
+
+
 def texture_from_mesh(mesh, size=(32, 32, 16), progress=None) -> VolumeTexture:
     """A mesh voxelized by the core voxelizer into an opaque texture (the paper's "texture of
     a tree", Color plate E): its box fills the tile, x along u, -z along v, +y up along w
@@ -316,6 +339,7 @@ TEXTURES = {
     "absorption": make_absorption,
     "chain": make_chain,
     "rocks": make_rocks,
+    "glow": make_glow,
 }
 
 
