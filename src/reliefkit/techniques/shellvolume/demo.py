@@ -6,7 +6,7 @@ from __future__ import annotations
 from ...core.technique import DemoTile
 
 #: (texture, tile U, V): how each of Figure 1's textures repeats over the sphere.
-FIGURE_1 = (("fur", (8, 4)), ("clouds", (1, 1)), ("ellipsoids", (4, 2)),
+FIGURE_1 = (("fur", (8, 4)), ("clouds", (2, 1)), ("ellipsoids", (4, 2)),
             ("absorption", (1, 1)), ("chain", (6, 3)), ("rocks", (4, 2)))
 THICKNESS = 0.15  # of the unit sphere's radius
 

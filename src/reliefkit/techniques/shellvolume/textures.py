@@ -198,7 +198,7 @@ def make_clouds(size=(32, 32, 16), seed=0) -> VolumeTexture:
                       np.where((land > 0.7)[..., None], [0.45, 0.35, 0.2], [0.15, 0.45, 0.12]))
     density = _fbm(rng, w.shape)
     profile = np.clip((w - 0.4) / 0.2, 0, 1) * np.clip((1.0 - w) / 0.15, 0, 1)
-    alpha = np.clip((density - 0.45) * 3.0, 0, 0.9) * profile
+    alpha = np.clip((density - 0.55) * 6.0, 0, 0.97) * profile  # puffs over a third
     rgb = np.full(w.shape + (3,), 0.95)
     alpha[0] = 1.0
     rgb[0] = ground
