@@ -74,9 +74,18 @@ def test_bad_bake_input(tmp_path):
     np.save(bad, np.zeros((4, 4, 4, 3), np.float32))
     assert_one_line_error(run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture",
                                   bad, "-o", tmp_path / "x.rk"), "(D, H, W, 4)")
-    assert_one_line_error(run_cli("bake", "demo:torus", "--as", "shell-volume",
-                                  "--thickness", "1", "-o", tmp_path / "x.rk"), "thickness")
     assert not (tmp_path / "x.rk").exists()
+
+
+def test_a_too_thick_shell_is_thinned_where_it_folds(tmp_path):
+    """On a torus of minor radius 0.35, 1.0 folds the inner side: thinner there, with a
+    warning, the outer side keeps 1.0."""
+    out = run_cli("bake", "demo:torus", "--as", "shell-volume", "--thickness", "1",
+                  "-o", tmp_path / "t.rk")
+    assert out.returncode == 0, out.stderr
+    assert "warning: the shell is thinner" in out.stderr
+    thickness = load(tmp_path / "t.rk").thickness
+    assert thickness.max() == 1.0 and thickness.min() < 0.5
 
 
 def test_npy_and_voxelized_textures(tmp_path):

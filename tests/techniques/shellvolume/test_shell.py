@@ -249,3 +249,26 @@ def test_bad_inputs_are_refused_in_one_line():
         build_shell(mesh(positions + [(2, 0, 0)], [(0, 1, 3)],
                          normals=np.tile([0.0, 0, 1], (4, 1))), 0.1)
     assert all("\n" not in str(e.value) for e in errors)
+
+
+def test_unusable_triangles_and_fitted_thickness():
+    """A backward vertex normal makes its triangle unusable at any thickness; a too thick
+    shell over a concave mesh is thinned only where it would fold."""
+    from reliefkit.scene.assets import make_asset
+    from reliefkit.techniques.shellvolume.shell import fitted_thickness, unusable_triangles
+
+    torus = make_asset("torus")
+    assert not unusable_triangles(torus).any()
+    normals = np.asarray(torus.normals).copy()
+    normals[0] = -normals[0]
+    flipped = RenderMesh(torus.world_positions, torus.indices, normals, torus.colors,
+                         torus.uvs)
+    bad = unusable_triangles(flipped)
+    assert bad.sum() == (np.asarray(torus.indices) == 0).any(axis=1).sum()
+    with pytest.raises(UsageError):
+        build_shell(torus, 1.0)
+    fitted = fitted_thickness(torus, 1.0)
+    shell = build_shell(torus, fitted)  # builds now
+    assert fitted.max() == 1.0 and fitted.min() < 0.5 and len(shell.tets) > 0
+    outer = np.hypot(*torus.world_positions[:, [0, 2]].T) > 1.2  # the convex outside
+    assert (fitted[outer] == 1.0).all()

@@ -9,6 +9,7 @@ import numpy as np
 from ...core.params import param
 from ...errors import UsageError
 from .representation import TexturedShell
+from .shell import fitted_thickness, unusable_triangles
 from .textures import TEXTURES, load_texture_npy, texture_from_mesh
 
 DEFAULT_THICKNESS = 0.05  # of the base's bounding-box diagonal, when --thickness is not given
@@ -55,5 +56,28 @@ def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
         DEFAULT_THICKNESS * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
     texture = make_texture(p.texture, p.texture_size, thickness, progress).tiled(
         (int(p.tile[0]), int(p.tile[1])))
-    return TexturedShell(source, thickness, texture,
-                         {"source": source.name, "thickness_given": p.thickness})
+    base, dropped = usable_part(source)
+    fitted = fitted_thickness(base, thickness)
+    thinned = int((fitted < thickness).sum())
+    return TexturedShell(base, fitted, texture,
+                         {"source": source.name, "thickness": thickness,
+                          "dropped_triangles": dropped, "thinned_vertices": thinned})
+
+
+def usable_part(mesh):
+    """``mesh`` without the triangles a shell cannot use (no area, or no uv area), and how
+    many were left out; a mesh without uvs is refused."""
+    if mesh.uvs is None:
+        raise UsageError(f"{mesh.name}: a shell volume needs texture coordinates (uvs); "
+                         "unwrap the mesh (for example in Blender) or use a demo surface")
+    bad = unusable_triangles(mesh)
+    if bad.all():
+        raise UsageError(f"{mesh.name}: none of its {len(bad)} triangles has an area in "
+                         "space and in uv; there is nothing to extrude")
+    if not bad.any():
+        return mesh, 0
+    from ...scene.mesh import RenderMesh
+
+    kept = np.asarray(mesh.indices)[~bad]
+    return RenderMesh(mesh.world_positions, kept, mesh.normals, mesh.colors, mesh.uvs,
+                      name=mesh.name), int(bad.sum())

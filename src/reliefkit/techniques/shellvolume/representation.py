@@ -82,7 +82,17 @@ class TexturedShell:
         s = self.shell.summary()
         d, h, w = self.texture.shape
         kind = "opaque" if self.opaque else "semi-transparent"
-        return [f"shell volume: {s['prisms']} prisms, {s['tetrahedra']} tetrahedra, thickness "
-                f"{s['thickness'][0]:.4g}..{s['thickness'][1]:.4g}; texture "
-                f"'{self.texture.name}' {w}x{h}x{d} ({kind}), tiled "
-                f"{self.texture.tile[0]}x{self.texture.tile[1]}"]
+        lines = [f"shell volume: {s['prisms']} prisms, {s['tetrahedra']} tetrahedra, thickness "
+                 f"{s['thickness'][0]:.4g}..{s['thickness'][1]:.4g}; texture "
+                 f"'{self.texture.name}' {w}x{h}x{d} ({kind}), tiled "
+                 f"{self.texture.tile[0]}x{self.texture.tile[1]}"]
+        dropped, thinned = (self.params.get(k, 0) for k in ("dropped_triangles",
+                                                             "thinned_vertices"))
+        if dropped:
+            lines.append(f"warning: {dropped} triangles were left out of the shell (no area "
+                         "in space or in uv, or a vertex normal along or behind the triangle)")
+        if thinned:
+            lines.append(f"warning: the shell is thinner (down to {s['thickness'][0]:.3g}) at "
+                         f"{thinned} of {s['base_vertices']} vertices, where "
+                         f"{self.params.get('thickness', 0):.3g} would fold it over itself")
+        return lines

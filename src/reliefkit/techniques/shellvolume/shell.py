@@ -128,10 +128,7 @@ def build_shell(mesh, thickness, direction: str = "normals") -> ShellVolume:
     tets = _split_prisms(positions, faces, count, welded)
     corners = positions[tets]
     planes = _face_planes(corners)
-    try:  # seams (vertices split for their uvs) joined: one shell, no boundary there
-        neighbors, neighbor_faces = _adjacency(welded[tets])
-    except UsageError:  # coincident surfaces: only the mesh's own connectivity
-        neighbors, neighbor_faces = _adjacency(tets)
+    neighbors, neighbor_faces = _shell_adjacency(tets, welded)
     _check_folds(planes, neighbors, neighbor_faces)
     tangents, bitangents = _tangent_frames(base, uv, faces, normals)
     return ShellVolume(
@@ -141,6 +138,64 @@ def build_shell(mesh, thickness, direction: str = "normals") -> ShellVolume:
         tets=tets.astype(np.int32), object_to_texture=_object_to_texture(corners, uvw[tets]),
         planes=planes, neighbors=neighbors, neighbor_faces=neighbor_faces,
         thickness=offsets_len)
+
+
+#: A triangle whose vertex normal makes a smaller cosine than this with its own normal is
+#: no use for a shell: its prism is inverted (or flat) at any thickness.
+MIN_NORMAL_COSINE = 0.05
+
+
+def unusable_triangles(mesh) -> np.ndarray:
+    """(F,) bool: triangles whose prism would have no volume or no texture mapping (no area
+    in space or in uv, or a vertex normal pointing along or behind the triangle); a baker may
+    leave them out of the shell."""
+    base = mesh.world_positions
+    faces = np.asarray(mesh.indices, dtype=np.int64)
+    a, b, c = (base[faces[:, k]] for k in range(3))
+    edge = np.max([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
+                   np.linalg.norm(a - c, axis=1)], axis=0)
+    cross = np.cross(b - a, c - a)
+    area2 = np.linalg.norm(cross, axis=1)
+    flat = area2 <= FLAT * edge ** 2
+    unit = cross / np.where(flat, 1.0, area2)[:, None]
+    normals = np.asarray(mesh.normals, dtype=np.float64)
+    normals = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    cosines = np.einsum("fi,fki->fk", unit, normals[faces])
+    flat |= (cosines < MIN_NORMAL_COSINE).any(axis=1)
+    if mesh.uvs is None:
+        return flat
+    uv = np.asarray(mesh.uvs, dtype=np.float64)[faces]
+    du, dv = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    uv_edge = np.max(np.linalg.norm(uv - np.roll(uv, 1, axis=1), axis=2), axis=1)
+    no_uv = np.abs(du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0]) <= FLAT * uv_edge ** 2
+    return flat | no_uv
+
+
+def fitted_thickness(mesh, thickness, direction: str = "normals",
+                     halvings: int = 12) -> np.ndarray:
+    """(V,) per-vertex thickness: ``thickness`` everywhere the shell does not fold, halved
+    (repeatedly, up to ``halvings`` times) at the vertices of the tetrahedra that would be
+    inverted or folded onto a neighbour — so a shell over a detailed mesh gets thinner only
+    in its tight concave places instead of being refused. Raises UsageError if folds remain.
+    """
+    base = mesh.world_positions
+    faces = np.asarray(mesh.indices, dtype=np.int64)
+    count = len(base)
+    values = _thickness(thickness, count).copy()
+    normals = _directions(mesh, direction)
+    for _ in range(halvings + 1):
+        positions = np.concatenate([base, base + values[:, None] * normals])
+        welded = _welded(positions, count)
+        tets = _prism_tets(positions, faces, count, welded)
+        bad = _inverted(positions[tets])
+        if not bad.any():
+            neighbors, neighbor_faces = _shell_adjacency(tets, welded)
+            bad = _folded(_face_planes(positions[tets]), neighbors, neighbor_faces)
+        if not bad.any():
+            return values
+        values[np.unique(tets[bad] % count)] *= 0.5
+    raise UsageError(f"{mesh.name}: the shell still folds after thinning it {halvings} times "
+                     "where it folds; smooth the mesh's normals or give a smaller thickness")
 
 
 def _thickness(thickness, count: int) -> np.ndarray:
@@ -203,11 +258,16 @@ def _welded(positions: np.ndarray, count: int) -> np.ndarray:
 
 def _split_prisms(positions: np.ndarray, faces: np.ndarray, count: int,
                   welded: np.ndarray) -> np.ndarray:
-    """(3F, 4) int64 tetrahedra, each in the vertex order positive in its ideal prism; the
-    diagonals follow the welded indices, so a seam's two sides agree.
+    """`_prism_tets`, refused when some are inverted (see the module docstring)."""
+    tets = _prism_tets(positions, faces, count, welded)
+    _check_inverted(positions[tets])
+    return tets
 
-    Raises UsageError when some are inverted (see the module docstring).
-    """
+
+def _prism_tets(positions: np.ndarray, faces: np.ndarray, count: int,
+                welded: np.ndarray) -> np.ndarray:
+    """(3F, 4) int64 tetrahedra, each in the vertex order positive in its ideal prism; the
+    diagonals follow the welded indices, so a seam's two sides agree."""
     order = np.argsort(welded[faces], axis=1, kind="stable")  # corners i < j < k
     ijk = np.take_along_axis(faces, order, axis=1)
     prism = np.concatenate([ijk, ijk + count], axis=1)  # (i, j, k, i', j', k')
@@ -215,9 +275,7 @@ def _split_prisms(positions: np.ndarray, faces: np.ndarray, count: int,
     ideal = _ideal_signs(positions, faces, order, count)
     flip = ideal < 0
     tets[flip, 0], tets[flip, 1] = tets[flip, 1], tets[flip, 0].copy()
-    tets = tets.reshape(-1, 4)
-    _check_inverted(positions[tets])
-    return tets
+    return tets.reshape(-1, 4)
 
 
 def _ideal_signs(positions: np.ndarray, faces: np.ndarray, order: np.ndarray,
@@ -246,13 +304,18 @@ def _signed_volumes(corners: np.ndarray) -> np.ndarray:
     return np.linalg.det(edges) / 6.0
 
 
-def _check_inverted(corners: np.ndarray) -> None:
-    """Refuse tetrahedra that are flat or inverted relative to their ideal prism."""
+def _inverted(corners: np.ndarray) -> np.ndarray:
+    """(T,) bool: tetrahedra flat or inverted relative to their ideal prism."""
     six = 6.0 * _signed_volumes(corners)
     pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
     longest = np.max([np.linalg.norm(corners[:, p] - corners[:, q], axis=1)
                       for p, q in pairs], axis=0)
-    bad = six <= FLAT * longest ** 3
+    return six <= FLAT * longest ** 3
+
+
+def _check_inverted(corners: np.ndarray) -> None:
+    """Refuse tetrahedra that are flat or inverted relative to their ideal prism."""
+    bad = _inverted(corners)
     if bad.any():
         raise UsageError(f"{int(bad.sum())} of {len(corners)} tetrahedra are inverted or flat "
                          "(the extruded shell folds over itself); use a smaller thickness")
@@ -294,6 +357,15 @@ def _object_to_texture(corners: np.ndarray, uvw: np.ndarray) -> np.ndarray:
     return m
 
 
+def _shell_adjacency(tets: np.ndarray, welded: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`_adjacency` with uv seams joined (one shell, no boundary there); by the mesh's own
+    connectivity alone where joining them makes it non-manifold (coincident surfaces)."""
+    try:
+        return _adjacency(welded[tets])
+    except UsageError:
+        return _adjacency(tets)
+
+
 def _adjacency(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(T, 4) neighbour and its face across each face, -1 on the boundary.
 
@@ -316,6 +388,17 @@ def _adjacency(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     neighbors = np.where(flat_neighbor >= 0, flat_neighbor // 4, -1).reshape(total, 4)
     neighbor_faces = np.where(flat_neighbor >= 0, flat_neighbor % 4, -1).reshape(total, 4)
     return neighbors.astype(np.int32), neighbor_faces.astype(np.int8)
+
+
+def _folded(planes: np.ndarray, neighbors: np.ndarray,
+            neighbor_faces: np.ndarray) -> np.ndarray:
+    """(T,) bool: tetrahedra with a neighbour on the same side of their shared face."""
+    t, f = np.nonzero(neighbors >= 0)
+    mine = planes[t, f, :3]
+    theirs = planes[neighbors[t, f], neighbor_faces[t, f], :3]
+    out = np.zeros(len(planes), bool)
+    out[t[np.einsum("ni,ni->n", mine, theirs) > 0]] = True
+    return out
 
 
 def _check_folds(planes: np.ndarray, neighbors: np.ndarray,
