@@ -31,11 +31,13 @@ read at s = (u U, v V, w), (U, V) = ``texture.tile``, with GL trilinear filterin
 of size n, x = s n - 0.5, i0 = floor(x), f = x - i0 and the value is
 (1 - f) T[i0] + f T[i0 + 1]; u and v REPEAT (s is first reduced to s - floor(s), indices
 taken modulo n, so the filter wraps across the edge), w CLAMP_TO_EDGE (indices clamped to
-[0, D - 1]). All four channels are filtered alike (straight, not premultiplied, colour).
+[0, D - 1]). The colour is filtered straight (not premultiplied); the opacity as the
+optical density sigma = -ln(1 - alpha) per unit length (`textures.optical_density`, alpha
+being opacity per unit object-space length; solid voxels get a large finite density).
 
-**Transfer.** alpha_t = clip(filtered alpha, 0, 1) is opacity per unit object-space length
-(object space = world space); the sample's opacity is a = 1 - (1 - alpha_t)^dt and its
-colour c = filtered rgb (unlit, no shading). Front to back, with C and A starting at 0:
+**Transfer.** The sample's opacity is a = 1 - exp(-sigma dt) (= 1 - (1 - alpha)^dt on a
+texel centre, the paper's §4.3 correction) and its colour c = filtered rgb (unlit). Front
+to back, with C and A starting at 0:
 C += (1 - A) a c, A += (1 - A) a. The ray stops once A > 1 - 1e-6.
 
 **Outputs.** ``color`` is (C / A, A) (straight colour; 0 where A = 0); ``position`` the
@@ -60,6 +62,7 @@ from numba import njit, prange
 from ...errors import UsageError
 from ...scene.camera import pixel_segments
 from .filtering import mip_pyramid
+from .textures import optical_density
 
 #: Tile size (pixels) of the screen-space binning.
 TILE = 8
@@ -184,6 +187,8 @@ def _volume(texture, level, rgba, mean_thickness) -> np.ndarray:
         raise UsageError(f"rgba must have shape (D, H, W, 4), got {arr.shape}")
     if not np.isfinite(arr).all():
         raise UsageError("rgba contains NaN or Inf values")
+    arr = arr.copy()
+    arr[..., 3] = optical_density(arr[..., 3], mean_thickness)
     return np.ascontiguousarray(arr)
 
 
@@ -359,8 +364,7 @@ def _render(origins, dirs, t_far, planes, m, starts, items, ntx, vol, tile_u, ti
                         v = m[t, 1, 0] * px + m[t, 1, 1] * py + m[t, 1, 2] * pz + m[t, 1, 3]
                         w = m[t, 2, 0] * px + m[t, 2, 1] * py + m[t, 2, 2] * pz + m[t, 2, 3]
                         _fetch(vol, u * tile_u, v * tile_v, w, texel)
-                        alpha = min(max(texel[3], 0.0), 1.0)
-                        a = 1.0 - (1.0 - alpha) ** dt
+                        a = 1.0 - math.exp(-max(texel[3], 0.0) * dt)
                         weight = (1.0 - acc_a) * a
                         acc_r += weight * texel[0]
                         acc_g += weight * texel[1]

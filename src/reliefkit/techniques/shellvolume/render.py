@@ -33,7 +33,7 @@ from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
 from .representation import TexturedShell
-from .textures import density_normals
+from .textures import density_normals, optical_density
 
 PROGRAM = "shellvolume:shell.glsl"
 TET_TEXELS, TET_ROW_TEXELS = 16, 2048  # shaders/include/tets.glsl
@@ -113,7 +113,8 @@ def level_count(shape) -> int:
 
 
 def texture_levels(texture, thickness: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Per level: (rgba (D,H,W,4), normal + glow (D,H,W,4)) float32, §5.2's filtering."""
+    """Per level: (colour + optical density (D,H,W,4), normal + glow (D,H,W,4)) float32,
+    §5.2's filtering; the GPU interpolates densities (`textures.optical_density`)."""
     levels = level_count(texture.shape)
     colours = mip_pyramid(texture, levels, thickness)
     glow = texture.glow if texture.glow is not None else np.zeros(texture.shape, np.float32)
@@ -121,7 +122,9 @@ def texture_levels(texture, thickness: float) -> list[tuple[np.ndarray, np.ndarr
     out = []
     for k, (rgba, g) in enumerate(zip(colours, glows, strict=True)):
         normal = texture.normal if k == 0 else density_normals(rgba[..., 3])
-        out.append((rgba, np.concatenate([normal, g[..., :1]], axis=-1).astype(np.float32)))
+        marched = rgba.copy()
+        marched[..., 3] = optical_density(rgba[..., 3], thickness)
+        out.append((marched, np.concatenate([normal, g[..., :1]], axis=-1).astype(np.float32)))
     return out
 
 

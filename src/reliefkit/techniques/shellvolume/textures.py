@@ -99,6 +99,25 @@ class VolumeTexture:
         return replace(self, tile=tuple(int(t) for t in tile))
 
 
+#: A solid voxel (alpha 1) is opaque over this fraction of the shell's thickness: the
+#: optical density it is filtered and marched with (`optical_density`).
+SOLID_LENGTH = 1e-4
+
+
+def optical_density(alpha: np.ndarray, thickness: float) -> np.ndarray:
+    """Optical density -ln(1 - alpha) per unit length of an alpha volume: what the renderer
+    and the CPU reference filter and march (a sample of length dt has opacity
+    1 - exp(-density dt), the §4.3 correction). Interpolating densities is exact for
+    absorption (Beer-Lambert) and keeps its precision where alpha is within a float of 1,
+    where interpolated alphas would not. Solid voxels (alpha 1) get a finite density that
+    makes `SOLID_LENGTH` of the shell's ``thickness`` opaque (optical depth 50)."""
+    a = np.clip(np.asarray(alpha, dtype=np.float64), 0.0, 1.0)
+    solid = 50.0 / (SOLID_LENGTH * thickness)
+    with np.errstate(divide="ignore"):
+        density = -np.log1p(-np.minimum(a, 1.0 - 1e-16))
+    return np.where(a >= 1.0, solid, np.minimum(density, solid)).astype(np.float32)
+
+
 def density_normals(alpha: np.ndarray) -> np.ndarray:
     """Unit normals (u, v, w components) of a (D,H,W) density: ``-grad / |grad|``, +w where 0."""
     alpha = np.asarray(alpha, dtype=np.float64)
@@ -289,7 +308,8 @@ def make_glow(size=(32, 32, 16), seed=0) -> VolumeTexture:
     for _ in range(10):
         c = rng.uniform([0, 0, 0.25], [1, 1, 0.8])
         r2 = (_wrapped(u - c[0]) ** 2 + _wrapped(v - c[1]) ** 2 + (w - c[2]) ** 2) / 0.06 ** 2
-        ember = np.exp(-r2)
+        with np.errstate(under="ignore"):
+            ember = np.where(r2 < 80.0, np.exp(-np.minimum(r2, 80.0)), 0.0)
         glow = np.maximum(glow, 3.0 * ember)
         rgb = np.where((ember > 0.2)[..., None], [1.0, 0.45, 0.1], rgb)
     alpha[0], rgb[0] = 1.0, (0.05, 0.04, 0.04)

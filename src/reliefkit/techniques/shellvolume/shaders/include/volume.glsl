@@ -1,6 +1,6 @@
 // The 3D texture and its mip pyramid (filtering.py, §5.2), one sampler per level (up to
 // MAX_LEVELS; the levels differ in size, and a 3D texture's levels cannot be uploaded one
-// by one through moderngl). Colour + alpha per unit length in u_color<l>, the density normal
+// by one through moderngl). Colour + optical density per unit length in u_color<l>, the density normal
 // (u, v, w components, voxel units) + glow in u_normal<l>. Lookups use textureLod(.., 0.0)
 // so they are valid in any control flow; two levels are blended by hand.
 #define MAX_LEVELS 4
@@ -42,7 +42,7 @@ float volume_lod(vec3 s) {
 }
 
 struct VolumeSample {
-    vec4 rgba;      // straight colour, alpha per unit length
+    vec4 rgba;      // straight colour, optical density per unit length
     vec3 normal;    // voxel units of level `level` (tet_normal converts it)
     float glow;
     vec3 size;      // voxels per tile of that level
@@ -62,14 +62,14 @@ VolumeSample volume_sample(vec3 s, float lod) {
     return VolumeSample(c, n.xyz, n.w, u_level_size[f > 0.5 ? hi : lo]);
 }
 
-// Opacity of a sample of object-space length dt (§4.3): 1 - (1 - alpha)^dt.
-float sample_opacity(float alpha, float dt) {
-    return 1.0 - pow(max(1.0 - clamp(alpha, 0.0, 1.0), 0.0), dt);
+// The textures hold the optical density sigma = -ln(1 - alpha) per unit length in .a
+// (render.py, textures.optical_density): interpolated, it keeps its precision where alpha
+// is within a float of 1. A sample of object-space length dt has the optical depth
+// sigma dt and the opacity 1 - exp(-sigma dt) = 1 - (1 - alpha)^dt (§4.3).
+float sample_optical_depth(float density, float dt) {
+    return max(density, 0.0) * dt;
 }
 
-// Its optical depth -ln(1 - opacity); a solid voxel (alpha 1) stops the ray whatever dt is.
-#define SOLID_OPTICAL_DEPTH 1e20
-float sample_optical_depth(float alpha, float dt) {
-    float a = clamp(alpha, 0.0, 1.0);
-    return a >= 1.0 ? SOLID_OPTICAL_DEPTH : -dt * log(1.0 - a);
+float sample_opacity(float density, float dt) {
+    return 1.0 - exp(-sample_optical_depth(density, dt));
 }
