@@ -7,7 +7,7 @@ import numpy as np
 import trimesh
 
 from reliefkit.scene.camera import Camera
-from reliefkit.scene.mesh import RenderMesh
+from reliefkit.scene.mesh import RenderMesh, vertex_normals
 from reliefkit.techniques.shellvolume.textures import VolumeTexture, density_normals
 
 HALF = 1.0  # the grid covers [-HALF, HALF]^2 at z = 0, normal +z
@@ -70,3 +70,15 @@ def inside_grid(camera, thickness, margin=0.05):
         hit = o + ((z - o[..., 2]) / dz)[..., None] * d
         inside &= (np.abs(hit[..., :2]) < HALF - margin).all(axis=-1)
     return inside, o, d
+
+
+def torus_mesh():
+    """A torus (non-convex: side-on rays leave the shell and re-enter it)."""
+    tor = trimesh.creation.torus(1.0, 0.35, major_sections=20, minor_sections=10)
+    p = np.asarray(tor.vertices, dtype=np.float64)
+    faces = np.asarray(tor.faces)
+    theta = np.arctan2(p[:, 1], p[:, 0])
+    phi = np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]) - 1.0)
+    uvs = np.column_stack([theta / (2 * np.pi) + 0.05 * np.sin(phi),
+                           phi / (2 * np.pi) + 0.05 * np.cos(theta)])
+    return RenderMesh(p, faces, vertex_normals(p, faces), np.ones((len(p), 4)), uvs)

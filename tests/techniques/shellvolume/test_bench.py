@@ -108,7 +108,9 @@ def test_targets_follow_the_numbers():
                              "capped": False, "speedup": speedup, "peel_ms": 10.0,
                              "sxmpvo_ms": 1.0, "peeled_layers": 4}],
                 "reference": {"rows": [{"rmse": rmse, "projection": "p", "samples": 2}],
-                              "halving": {"max_alpha_change": halving, "samples": [32, 64]}},
+                              "halving": {"max_alpha_change": 0.05, "samples": [32, 64],
+                                          "mean_alpha_change": halving,
+                                          "fraction_over": halving / 10}},
                 "filtering": [{"texture": "x", "pyramid": "mip", "drift": mip},
                               {"texture": "x", "pyramid": "naive", "drift": naive}]}
 

@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 import pytest
-import trimesh
+from shell_scenes import sphere_mesh, torus_mesh
 
 from reliefkit.errors import UsageError
 from reliefkit.scene.camera import Camera
@@ -22,29 +22,6 @@ from reliefkit.techniques.shellvolume.order import (
 )
 from reliefkit.techniques.shellvolume.order_check import OrderCheck, ordering_violations
 from reliefkit.techniques.shellvolume.shell import build_shell
-
-
-def sphere_mesh(subdivisions=2):
-    """trimesh's icosphere, radial normals, a tilted spherical mapping (as test_shell)."""
-    ico = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
-    p = np.asarray(ico.vertices, dtype=np.float64)
-    unit = p / np.linalg.norm(p, axis=1, keepdims=True)
-    u = np.arctan2(unit[:, 1], unit[:, 0]) / (2 * np.pi) + 0.5
-    v = np.arccos(np.clip(unit[:, 2], -1, 1)) / np.pi
-    uvs = np.column_stack([u + 0.05 * unit[:, 2], v + 0.05 * unit[:, 0]])
-    return RenderMesh(p, np.asarray(ico.faces), unit, np.ones((len(p), 4)), uvs)
-
-
-def torus_mesh():
-    """A torus (non-convex: side-on rays leave the shell and re-enter it)."""
-    tor = trimesh.creation.torus(1.0, 0.35, major_sections=20, minor_sections=10)
-    p = np.asarray(tor.vertices, dtype=np.float64)
-    faces = np.asarray(tor.faces)
-    theta = np.arctan2(p[:, 1], p[:, 0])
-    phi = np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]) - 1.0)
-    uvs = np.column_stack([theta / (2 * np.pi) + 0.05 * np.sin(phi),
-                           phi / (2 * np.pi) + 0.05 * np.cos(theta)])
-    return RenderMesh(p, faces, vertex_normals(p, faces), np.ones((len(p), 4)), uvs)
 
 
 def dented_sphere_mesh(subdivisions=2, direction=(0.3, 0.5, 0.8), cap_deg=55.0, depth=0.6):

@@ -6,10 +6,9 @@ import sys
 
 import numpy as np
 import pytest
-import trimesh
+from shell_scenes import torus_mesh
 
 from reliefkit.scene.camera import Camera
-from reliefkit.scene.mesh import RenderMesh, vertex_normals
 from reliefkit.techniques.shellvolume.order import centroid_depths, visibility_order
 from reliefkit.techniques.shellvolume.order_check import ordering_violations
 from reliefkit.techniques.shellvolume.peers import PeerOrder, vtk_available, vtk_depth_sort
@@ -17,18 +16,6 @@ from reliefkit.techniques.shellvolume.shell import build_shell
 
 AVAILABLE, REASON = vtk_available()
 needs_vtk = pytest.mark.skipif(not AVAILABLE, reason=REASON or "vtk unavailable")
-
-
-def torus_mesh():
-    """A torus (as test_order's): side-on rays leave the shell and re-enter it."""
-    tor = trimesh.creation.torus(1.0, 0.35, major_sections=20, minor_sections=10)
-    p = np.asarray(tor.vertices, dtype=np.float64)
-    faces = np.asarray(tor.faces)
-    theta = np.arctan2(p[:, 1], p[:, 0])
-    phi = np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1]) - 1.0)
-    uvs = np.column_stack([theta / (2 * np.pi) + 0.05 * np.sin(phi),
-                           phi / (2 * np.pi) + 0.05 * np.cos(theta)])
-    return RenderMesh(p, faces, vertex_normals(p, faces), np.ones((len(p), 4)), uvs)
 
 
 @pytest.fixture(scope="module")

@@ -91,7 +91,7 @@ uniform highp sampler2D u_search;   // per pixel, see render.py (half_opacity_se
 uniform float u_shadow_length;      // length over which a sample must reach opacity 0.5
 #endif
 #if defined PEEL
-uniform highp sampler2D u_peel_depth;  // .r: the exact gl_FragCoord.z peeled before
+uniform highp sampler2D u_peel_depth;  // .xy: gl_FragCoord.z and tetrahedron peeled before
 #endif
 #if defined SHADOWS
 uniform highp sampler2D u_shadow_map;
@@ -174,7 +174,12 @@ void main() {
     float len = min(exit_distance(dir), opaque_distance(dir));
     if (!(len > 0.0)) discard;
 #if defined PEEL
-    if (gl_FragCoord.z <= texelFetch(u_peel_depth, ivec2(gl_FragCoord.xy), 0).r) discard;
+    // behind the layer before in (depth, tetrahedron) order: fragments at exactly equal
+    // depth (rays through a shared vertex) are peeled one after the other, lowest index
+    // first (the depth test keeps the first drawn of equal depths; instances go by index)
+    vec2 before = texelFetch(u_peel_depth, ivec2(gl_FragCoord.xy), 0).xy;
+    if (gl_FragCoord.z < before.x || (gl_FragCoord.z == before.x && float(v_tet) <= before.y))
+        discard;
 #endif
 #if defined AOV_BINS
     vec2 range = texelFetch(u_search, ivec2(gl_FragCoord.xy), 0).xy;
@@ -243,7 +248,7 @@ void main() {
     f_position = vec4(0.0);
     f_normal = vec4(0.0);
 #if defined PEEL
-    f_position = vec4(gl_FragCoord.z);  // the next layer compares with exactly this value
+    f_position = vec4(gl_FragCoord.z, float(v_tet), 0.0, 0.0);  // what the next layer is behind
 #endif
 #endif
 }
