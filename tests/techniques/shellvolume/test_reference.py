@@ -77,14 +77,18 @@ def _quadrature(w_of_s, thickness, alpha_layers, rgb_layers, cells=200_000):
     """Exact (to O(1/cells^2)) front-to-back transfer along a vertical ray through a slab
     whose w profile is w_of_s(s), s = depth along the ray; texture layers along w with GL
     CLAMP_TO_EDGE linear filtering (np.interp clamps exactly so) of the optical density
-    -ln(1 - alpha), as the transfer defines."""
+    -ln(1 - alpha) and of the colour weighted by density + floor, as the transfer defines."""
     depth = len(alpha_layers)
     centres = (np.arange(depth) + 0.5) / depth
     ds = thickness / cells
     s = (np.arange(cells) + 0.5) * ds
     w = w_of_s(s)
-    density = np.interp(w, centres, -np.log1p(-np.asarray(alpha_layers, np.float64)))
-    rgb = np.stack([np.interp(w, centres, rgb_layers[:, k]) for k in range(3)], axis=1)
+    layer_density = -np.log1p(-np.asarray(alpha_layers, np.float64))
+    density = np.interp(w, centres, layer_density)
+    floor = 1e-3 / thickness
+    weighted = rgb_layers * (layer_density + floor)[:, None]
+    rgb = np.stack([np.interp(w, centres, weighted[:, k]) for k in range(3)], axis=1)
+    rgb = rgb / (density + floor)[:, None]
     a = 1 - np.exp(-density * ds)
     trans = np.concatenate([[1.0], np.cumprod(1 - a)[:-1]])
     premult = (trans * a) @ rgb

@@ -326,7 +326,7 @@ def test_mip_filtering_is_closer_to_the_supersampled_picture(gl):
     """Far away, a fine texture aliases; the pyramid's level from the footprint (§5.2) gives
     a picture closer to the supersampled one than level 0 does."""
     rep = TexturedShell(grid_mesh(4), 0.2,
-                        textures.make_ellipsoids(size=(32, 32, 16)).per_unit_length(0.2)
+                        textures.make_ellipsoids(size=(32, 32, 16)).over_length(0.2)
                         .tiled((16, 16)))
     far = slab_camera(40.0, size=(48, 48), ortho=False, dist=9.0)
     fine = slab_camera(40.0, size=(192, 192), ortho=False, dist=9.0)

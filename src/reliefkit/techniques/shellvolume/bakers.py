@@ -34,7 +34,7 @@ def make_texture(spec: str, size, thickness: float, progress=None):
     a generated one's alpha converted for a shell of ``thickness``."""
     size = tuple(int(round(s)) for s in size)
     if spec in TEXTURES:
-        return TEXTURES[spec](size=size).per_unit_length(thickness)
+        return TEXTURES[spec](size=size).over_length(thickness)
     if spec.lower().endswith(".npy"):
         return load_texture_npy(spec)
     from ...io.inputs import load_input

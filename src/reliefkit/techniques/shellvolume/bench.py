@@ -105,7 +105,7 @@ def scene(name: str, cfg: BenchConfig):
     texture_name, tile = SCENES[name]
     thickness = FIXED_THICKNESS.get(name, THICKNESS * diagonal(base.bounds))
     texture = TEXTURES[texture_name](size=tuple(cfg.texture_size), seed=cfg.seed)
-    texture = texture.per_unit_length(thickness).tiled(tile)
+    texture = texture.over_length(thickness).tiled(tile)
     return base, TexturedShell(base, thickness, texture, {"source": name})
 
 

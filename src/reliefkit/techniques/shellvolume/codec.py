@@ -3,7 +3,9 @@
 Arrays: ``positions`` float64 (V, 3) world, ``indices`` int32 (F, 3), ``normals`` float32
 (V, 3), ``uvs`` float32 (V, 2), ``thickness`` float64 (V,), ``texture_rgba`` float32
 (D, H, W, 4), ``texture_normal`` float32 (D, H, W, 3), optional ``texture_glow`` float32
-(D, H, W); params ``texture`` (its name) and ``tile`` [U, V]. The shell's tetrahedra are
+(D, H, W); params ``texture`` (its name), ``tile`` [U, V] and ``alpha_length`` (the
+object-space length the alphas are the opacity of: 1, or the shell thickness the generated
+textures are authored over). The shell's tetrahedra are
 rebuilt from these when the file is read (nothing else is precomputed).
 """
 
@@ -37,9 +39,10 @@ def _to_arrays(rep: TexturedShell) -> tuple[dict, dict]:
               "normals": base.normals, "uvs": base.uvs, "thickness": rep.thickness,
               "texture_rgba": tex.rgba, "texture_normal": tex.normal,
               "texture_glow": tex.glow}
-    own = ("texture", "tile")
+    own = ("texture", "tile", "alpha_length")
     params = {k: v for k, v in rep.params.items() if k not in own}
-    return arrays, params | {"texture": tex.name, "tile": list(tex.tile)}
+    return arrays, params | {"texture": tex.name, "tile": list(tex.tile),
+                             "alpha_length": tex.length}
 
 
 def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
@@ -47,6 +50,11 @@ def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
 
     params = dict(params)
     name, tile = params.pop("texture", None), params.pop("tile", None)
+    length = params.pop("alpha_length", 1.0)
+    if isinstance(length, bool) or not isinstance(length, int | float) or not (
+            np.isfinite(length) and length > 0):
+        raise FormatError(f"shell-volume param 'alpha_length' must be a positive number, got "
+                          f"{length!r}")
     if not isinstance(name, str):
         raise FormatError(f"shell-volume param 'texture' must be a name, got {name!r}")
     if not (isinstance(tile, list) and len(tile) == 2
@@ -67,7 +75,7 @@ def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
                           f"{rgba.shape[:3]}")
     try:
         texture = VolumeTexture(rgba, arrays["texture_normal"], name, tuple(tile),
-                                arrays.get("texture_glow"))
+                                arrays.get("texture_glow"), float(length))
         colors = np.broadcast_to(np.float32(0.8), (count, 4))
         base = RenderMesh(positions, arrays["indices"], arrays["normals"], colors,
                           arrays["uvs"], name=params.get("source", "shell base"))

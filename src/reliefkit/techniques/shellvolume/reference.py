@@ -31,9 +31,11 @@ read at s = (u U, v V, w), (U, V) = ``texture.tile``, with GL trilinear filterin
 of size n, x = s n - 0.5, i0 = floor(x), f = x - i0 and the value is
 (1 - f) T[i0] + f T[i0 + 1]; u and v REPEAT (s is first reduced to s - floor(s), indices
 taken modulo n, so the filter wraps across the edge), w CLAMP_TO_EDGE (indices clamped to
-[0, D - 1]). The colour is filtered straight (not premultiplied); the opacity as the
-optical density sigma = -ln(1 - alpha) per unit length (`textures.optical_density`, alpha
-being opacity per unit object-space length; solid voxels get a large finite density).
+[0, D - 1]). What is filtered is `textures.marched_volume`: the optical density
+sigma = -ln(1 - alpha) / length per unit length (alpha being the opacity over the
+texture's ``length``, 1 by default; solid voxels get a large finite density) and the colour
+times it plus `textures.density_floor`; a sample's colour is the filtered colour over the
+filtered density plus that floor.
 
 **Transfer.** The sample's opacity is a = 1 - exp(-sigma dt) (= 1 - (1 - alpha)^dt on a
 texel centre, the paper's §4.3 correction) and its colour c = filtered rgb (unlit). Front
@@ -62,7 +64,7 @@ from numba import njit, prange
 from ...errors import UsageError
 from ...scene.camera import pixel_segments
 from .filtering import mip_pyramid
-from .textures import optical_density
+from .textures import density_floor, marched_volume
 
 #: Tile size (pixels) of the screen-space binning.
 TILE = 8
@@ -152,7 +154,7 @@ def reference_render(shell, texture, camera, *, step=None, samples=None, level=N
             np.ascontiguousarray(shell.planes, dtype=np.float64),
             np.ascontiguousarray(shell.object_to_texture, dtype=np.float64),
             starts, items, ntx, volume, tile_u, tile_v, n_samples, h, eps,
-            color, position, crossings)
+            density_floor(mean_thickness), color, position, crossings)
     return ReferenceImage(color, position, crossings, time.perf_counter() - start)
 
 
@@ -179,7 +181,8 @@ def _volume(texture, level, rgba, mean_thickness) -> np.ndarray:
     if level is not None:
         if isinstance(level, bool) or int(level) != level or level < 0:
             raise UsageError(f"level must be a non-negative integer, got {level!r}")
-        rgba = mip_pyramid(texture, int(level) + 1, mean_thickness)[int(level)]
+        rgba = mip_pyramid(texture, int(level) + 1,
+                           mean_thickness / texture.length)[int(level)]
     elif rgba is None:
         rgba = texture.rgba
     arr = np.asarray(rgba, dtype=np.float64)
@@ -187,9 +190,8 @@ def _volume(texture, level, rgba, mean_thickness) -> np.ndarray:
         raise UsageError(f"rgba must have shape (D, H, W, 4), got {arr.shape}")
     if not np.isfinite(arr).all():
         raise UsageError("rgba contains NaN or Inf values")
-    arr = arr.copy()
-    arr[..., 3] = optical_density(arr[..., 3], mean_thickness)
-    return np.ascontiguousarray(arr)
+    return np.ascontiguousarray(marched_volume(arr, texture.length, mean_thickness),
+                                dtype=np.float64)
 
 
 def _tile_ranges(shell, camera, width, height) -> np.ndarray:
@@ -319,7 +321,7 @@ def _fetch(vol, su, sv, sw, out):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def _render(origins, dirs, t_far, planes, m, starts, items, ntx, vol, tile_u, tile_v,
-            n_samples, h, eps, color, position, crossings):
+            n_samples, h, eps, floor, color, position, crossings):
     height, width = t_far.shape
     for k in prange(starts.shape[0] - 1):
         ty, tx = k // ntx, k % ntx
@@ -364,7 +366,12 @@ def _render(origins, dirs, t_far, planes, m, starts, items, ntx, vol, tile_u, ti
                         v = m[t, 1, 0] * px + m[t, 1, 1] * py + m[t, 1, 2] * pz + m[t, 1, 3]
                         w = m[t, 2, 0] * px + m[t, 2, 1] * py + m[t, 2, 2] * pz + m[t, 2, 3]
                         _fetch(vol, u * tile_u, v * tile_v, w, texel)
-                        a = 1.0 - math.exp(-max(texel[3], 0.0) * dt)
+                        sigma = max(texel[3], 0.0)
+                        a = 1.0 - math.exp(-sigma * dt)
+                        weight = sigma + floor  # colour stored times density + floor
+                        texel[0] /= weight
+                        texel[1] /= weight
+                        texel[2] /= weight
                         weight = (1.0 - acc_a) * a
                         acc_r += weight * texel[0]
                         acc_g += weight * texel[1]

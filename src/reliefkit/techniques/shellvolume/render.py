@@ -33,7 +33,7 @@ from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
 from .representation import TexturedShell
-from .textures import density_normals, optical_density
+from .textures import density_floor, density_normals, marched_volume
 
 PROGRAM = "shellvolume:shell.glsl"
 TET_TEXELS, TET_ROW_TEXELS = 16, 2048  # shaders/include/tets.glsl
@@ -114,16 +114,15 @@ def level_count(shape) -> int:
 
 def texture_levels(texture, thickness: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """Per level: (colour + optical density (D,H,W,4), normal + glow (D,H,W,4)) float32,
-    §5.2's filtering; the GPU interpolates densities (`textures.optical_density`)."""
+    §5.2's filtering; the GPU interpolates densities (`textures.marched_volume`)."""
     levels = level_count(texture.shape)
-    colours = mip_pyramid(texture, levels, thickness)
+    colours = mip_pyramid(texture, levels, thickness / texture.length)
     glow = texture.glow if texture.glow is not None else np.zeros(texture.shape, np.float32)
     glows = naive_pyramid(np.repeat(glow[..., None], 4, axis=-1), levels)
     out = []
     for k, (rgba, g) in enumerate(zip(colours, glows, strict=True)):
         normal = texture.normal if k == 0 else density_normals(rgba[..., 3])
-        marched = rgba.copy()
-        marched[..., 3] = optical_density(rgba[..., 3], thickness)
+        marched = marched_volume(rgba, texture.length, thickness)
         out.append((marched, np.concatenate([normal, g[..., :1]], axis=-1).astype(np.float32)))
     return out
 
@@ -213,6 +212,7 @@ class TexturedShellDrawable(GLObjects):
         return (camera_uniforms(camera) | model_offset(camera, self.origin) | light.uniforms()
                 | units | {"u_tets": _TETS_UNIT, "u_levels": len(self.levels),
                            "u_level_size": sizes, "u_mip": self.options.mip,
+                           "u_density_floor": density_floor(float(np.mean(self.rep.thickness))),
                            "u_samples": self.options.samples,
                            "u_time": float(self.options.time or 0.0),
                            "u_sway": 0.04 if animated else 0.0,

@@ -8,8 +8,9 @@ correction). w = 0 is the base (the mesh surface), w = 1 the top of the shell.
 
 The generators author alpha as the opacity of the shell's whole thickness (a medium of
 alpha 0.3 dims what is below it by 30% seen straight down, whatever the shell's size);
-`VolumeTexture.per_unit_length` converts that to the contract once the thickness is known
-(the baker does).
+`VolumeTexture.over_length` records that length once the thickness is known (the baker
+does). Converting the alphas themselves to one unit of length would round dense media over a
+thin shell to exactly 1 (solid) in float32.
 
 ``normal`` (D, H, W, 3) holds unit vectors with components (u, v, w), computed from the
 density (alpha) gradient by central differences in voxel units, pointing from dense towards
@@ -38,13 +39,17 @@ MAX_VOXELS = 256**3
 class VolumeTexture:
     """A 3D texture: ``rgba`` (D,H,W,4), ``normal`` (D,H,W,3), both float32; ``tile`` (U, V)
     repetitions over the base's uvs; optional ``glow`` (D,H,W) float32 >= 0, light emitted per
-    unit of object-space length in units of the voxel's colour (the paper's glow, §5.3)."""
+    unit of object-space length in units of the voxel's colour (the paper's glow, §5.3);
+    ``length``: the object-space length alpha is the opacity of (1, DESIGN.md's per unit
+    length, unless the texture was authored over a shell's thickness: `over_length`; alpha
+    stays the authored float32 value, so a dense medium keeps its precision)."""
 
     rgba: np.ndarray
     normal: np.ndarray
     name: str
     tile: tuple[int, int] = (1, 1)
     glow: np.ndarray | None = None
+    length: float = 1.0
 
     def __post_init__(self) -> None:
         if self.rgba.ndim != 4 or self.rgba.shape[3] != 4 or self.rgba.dtype != np.float32:
@@ -57,6 +62,9 @@ class VolumeTexture:
                                       or self.glow.dtype != np.float32):
             got = f"{self.glow.dtype} {self.glow.shape}"
             raise UsageError(f"texture glow must be float32 (D, H, W), got {got}")
+        if not (isinstance(self.length, int | float) and np.isfinite(self.length)
+                and self.length > 0):
+            raise UsageError(f"texture length must be a positive number, got {self.length!r}")
         tile = tuple(self.tile)
         if len(tile) != 2 or not all(isinstance(t, int | np.integer) and 1 <= t <= 4096
                                      for t in tile):
@@ -75,22 +83,16 @@ class VolumeTexture:
         alpha = self.rgba[..., 3]
         return self.glow is None and bool(np.all((alpha == 0) | (alpha == 1)))
 
-    def per_unit_length(self, thickness: float) -> VolumeTexture:
-        """This texture, its alpha read as the opacity of the shell's whole ``thickness``
-        (how the generators author it), converted to the contract's opacity per unit of
-        object-space length: ``1 - (1 - alpha)^(1 / thickness)``; its glow (light over the
-        whole thickness) likewise to light per unit length, ``glow / thickness``."""
+    def over_length(self, length: float) -> VolumeTexture:
+        """This texture with its alpha read as the opacity over ``length`` of object space
+        (the generators author it over the shell's whole thickness) and its glow as light
+        over ``length`` (converted to light per unit length, ``glow / length``)."""
         from dataclasses import replace
 
-        if not thickness > 0:
-            raise UsageError(f"thickness must be > 0, got {thickness}")
-        alpha = np.clip(self.rgba[..., 3].astype(np.float64), 0.0, 1.0)
-        with np.errstate(under="ignore"):
-            converted = 1.0 - (1.0 - alpha) ** (1.0 / thickness)
-        rgba = self.rgba.copy()
-        rgba[..., 3] = np.where(alpha >= 1.0, 1.0, converted)
-        glow = None if self.glow is None else (self.glow / thickness).astype(np.float32)
-        return replace(self, rgba=rgba, glow=glow)
+        if not length > 0:
+            raise UsageError(f"length must be > 0, got {length}")
+        glow = None if self.glow is None else (self.glow / length).astype(np.float32)
+        return replace(self, length=float(length), glow=glow)
 
     def tiled(self, tile) -> VolumeTexture:
         """The same texture repeated ``tile`` (U, V) times over the uvs."""
@@ -104,18 +106,38 @@ class VolumeTexture:
 SOLID_LENGTH = 1e-4
 
 
-def optical_density(alpha: np.ndarray, thickness: float) -> np.ndarray:
-    """Optical density -ln(1 - alpha) per unit length of an alpha volume: what the renderer
-    and the CPU reference filter and march (a sample of length dt has opacity
-    1 - exp(-density dt), the §4.3 correction). Interpolating densities is exact for
-    absorption (Beer-Lambert) and keeps its precision where alpha is within a float of 1,
-    where interpolated alphas would not. Solid voxels (alpha 1) get a finite density that
-    makes `SOLID_LENGTH` of the shell's ``thickness`` opaque (optical depth 50)."""
+def optical_density(alpha: np.ndarray, length: float, thickness: float) -> np.ndarray:
+    """Optical density per unit length, -ln(1 - alpha) / ``length``, of alphas that are the
+    opacity over ``length``: what the renderer and the CPU reference filter and march (a
+    sample of length dt has opacity 1 - exp(-density dt), the §4.3 correction).
+    Interpolating densities is exact for absorption (Beer-Lambert) and keeps its precision
+    where alpha is close to 1, where interpolated alphas would not. Solid voxels (alpha 1)
+    get a finite density that makes `SOLID_LENGTH` of the shell's ``thickness`` opaque
+    (optical depth 50)."""
     a = np.clip(np.asarray(alpha, dtype=np.float64), 0.0, 1.0)
     solid = 50.0 / (SOLID_LENGTH * thickness)
-    with np.errstate(divide="ignore"):
-        density = -np.log1p(-np.minimum(a, 1.0 - 1e-16))
+    density = -np.log1p(-np.minimum(a, 1.0 - 1e-16)) / length
     return np.where(a >= 1.0, solid, np.minimum(density, solid)).astype(np.float32)
+
+
+def marched_volume(rgba: np.ndarray, length: float, thickness: float) -> np.ndarray:
+    """(D, H, W, 4) float32 what is filtered and marched: the optical density
+    (`optical_density`) in alpha, and the colour premultiplied by it, so that filtering
+    weights each voxel's colour by its extinction (between a solid voxel and a thin medium
+    the solid's colour wins, as it should where the ray stops; empty voxels add almost
+    nothing). A sample's colour is the filtered colour over the filtered weight, density
+    plus `density_floor`."""
+    rgba = np.asarray(rgba, dtype=np.float64)
+    density = optical_density(rgba[..., 3], length, thickness).astype(np.float64)
+    weight = density + density_floor(thickness)
+    out = np.concatenate([rgba[..., :3] * weight[..., None], density[..., None]], axis=-1)
+    return out.astype(np.float32)
+
+
+def density_floor(thickness: float) -> float:
+    """What colour weights add to the density (`marched_volume`): an optical depth of 1e-3
+    over the shell's thickness, so a clear (glowing) medium keeps its colour."""
+    return 1e-3 / thickness
 
 
 def density_normals(alpha: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ uniform highp sampler3D u_normal3;
 uniform int u_levels;          // levels present
 uniform vec3 u_level_size[MAX_LEVELS];  // (W, H, D) voxels of each level per tile
 uniform bool u_mip;            // pick the level from the screen footprint (else level 0)
+uniform float u_density_floor; // textures.density_floor of the shell
 
 vec4 color_level(int level, vec3 s) {
     if (level == 0) return textureLod(u_color0, s, 0.0);
@@ -59,6 +60,8 @@ VolumeSample volume_sample(vec3 s, float lod) {
         c = mix(c, color_level(hi, s), f);
         n = mix(n, normal_level(hi, s), f);
     }
+    // colour is stored times density + floor (textures.marched_volume)
+    c.rgb /= max(c.a, 0.0) + u_density_floor;
     return VolumeSample(c, n.xyz, n.w, u_level_size[f > 0.5 ? hi : lo]);
 }
 
