@@ -70,6 +70,8 @@ def test_bad_bake_input(tmp_path):
                                   tmp_path / "x.rk"), "uvs")
     assert_one_line_error(run_cli("bake", "demo:sphere", "--as", "shell-volume", "--tile",
                                   "1.5,2", "-o", tmp_path / "x.rk"), "whole numbers")
+    assert_one_line_error(run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture",
+                                  "furr", "-o", tmp_path / "x.rk"), "not one of fur")
     bad = tmp_path / "bad.npy"
     np.save(bad, np.zeros((4, 4, 4, 3), np.float32))
     assert_one_line_error(run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture",

@@ -37,9 +37,14 @@ def make_texture(spec: str, size, thickness: float, progress=None):
         return TEXTURES[spec](size=size).over_length(thickness)
     if spec.lower().endswith(".npy"):
         return load_texture_npy(spec)
-    from ...io.inputs import load_input
+    from pathlib import Path
+
+    from ...io.inputs import DEMO_PREFIX, load_input
     from ...scene.mesh import RenderMesh
 
+    if not spec.startswith(DEMO_PREFIX) and not Path(spec).is_file():
+        raise UsageError(f"--texture {spec}: not one of {', '.join(TEXTURES)}, and no such "
+                         "file (give a generated texture's name, a .npy volume or a mesh)")
     mesh = load_input(spec)
     if not isinstance(mesh, RenderMesh):
         raise UsageError(f"--texture {spec}: expected one of {', '.join(TEXTURES)}, a .npy "
