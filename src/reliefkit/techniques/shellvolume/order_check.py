@@ -26,16 +26,13 @@ from numba import njit
 
 from ...errors import UsageError
 from ...scene.camera import pixel_segments
+from .binning import bin_by_tile, screen_boxes
 
 #: A ray crosses a tetrahedron when its length inside is more than this (world units).
 TOL = 1e-9
 
 #: Side of the square screen tiles tetrahedra are binned into, in pixels.
 TILE = 4
-
-#: Pixels the screen rectangle of a tetrahedron is grown by before binning.
-MARGIN = 1.0
-
 
 @dataclass(frozen=True)
 class OrderCheck:
@@ -81,63 +78,15 @@ def ordering_violations(shell, camera, order, size=None) -> OrderCheck:
     dirs = dirs / np.linalg.norm(dirs, axis=-1, keepdims=True)  # as Camera.pixel_rays
     rank = np.empty(count, np.int64)
     rank[order.astype(np.int64)] = np.arange(count)
-    lo_c, hi_c, lo_r, hi_r = _screen_boxes(shell, camera, width, height)
+    lo_c, hi_c, lo_r, hi_r = screen_boxes(shell, camera, width, height)
     tiles_x, tiles_y = -(-width // TILE), -(-height // TILE)
-    starts, items = _bin(lo_c, hi_c, lo_r, hi_r, tiles_x, tiles_y, TILE)
+    starts, items = bin_by_tile(lo_c, hi_c, lo_r, hi_r, tiles_x, tiles_y, TILE)
     violations, pairs, rays, bad_rays = _check(
         np.ascontiguousarray(shell.planes, dtype=np.float64), np.ascontiguousarray(near),
         np.ascontiguousarray(dirs), starts, items, np.stack([lo_c, hi_c, lo_r, hi_r], axis=1),
         rank, TILE, tiles_x, TOL)
     return OrderCheck(int(violations), int(pairs), int(rays), int(bad_rays),
                       time.perf_counter() - start)
-
-
-def _screen_boxes(shell, camera, width: int, height: int):
-    """Per tetrahedron the inclusive pixel column and row ranges its projection may cover
-    (empty ranges when it is off screen; the whole screen when a vertex is behind the eye)."""
-    m = np.asarray(camera.proj, dtype=np.float64) @ np.asarray(camera.view, dtype=np.float64)
-    corners = shell.positions[shell.tets]  # (T, 4, 3)
-    clip = corners @ m[:2, :3].T + m[:2, 3]
-    w = corners @ m[3, :3] + m[3, 3]
-    behind = (w <= 1e-12 * max(1.0, float(np.abs(w).max(initial=0.0)))).any(axis=1)
-    w = np.where(behind[:, None], 1.0, w)
-    x = (clip[..., 0] / w + 1.0) * 0.5 * width
-    y = (1.0 - clip[..., 1] / w) * 0.5 * height
-    # pixel c's sample is at c + 0.5
-    lo_c = np.ceil(x.min(axis=1) - 0.5 - MARGIN)
-    hi_c = np.floor(x.max(axis=1) - 0.5 + MARGIN)
-    lo_r = np.ceil(y.min(axis=1) - 0.5 - MARGIN)
-    hi_r = np.floor(y.max(axis=1) - 0.5 + MARGIN)
-    lo_c = np.where(behind, 0, np.clip(lo_c, 0, width)).astype(np.int64)
-    hi_c = np.where(behind, width - 1, np.clip(hi_c, -1, width - 1)).astype(np.int64)
-    lo_r = np.where(behind, 0, np.clip(lo_r, 0, height)).astype(np.int64)
-    hi_r = np.where(behind, height - 1, np.clip(hi_r, -1, height - 1)).astype(np.int64)
-    return lo_c, hi_c, lo_r, hi_r
-
-
-@njit(cache=True)
-def _bin(lo_c, hi_c, lo_r, hi_r, tiles_x, tiles_y, tile):
-    """CSR lists of tetrahedra per tile (row-major), each list in increasing index."""
-    n = lo_c.shape[0]
-    counts = np.zeros(tiles_x * tiles_y + 1, np.int64)
-    for i in range(n):
-        if lo_c[i] > hi_c[i] or lo_r[i] > hi_r[i]:
-            continue
-        for ty in range(lo_r[i] // tile, hi_r[i] // tile + 1):
-            for tx in range(lo_c[i] // tile, hi_c[i] // tile + 1):
-                counts[ty * tiles_x + tx + 1] += 1
-    starts = np.cumsum(counts)
-    fill = starts[:-1].copy()
-    items = np.empty(starts[-1], np.int64)
-    for i in range(n):
-        if lo_c[i] > hi_c[i] or lo_r[i] > hi_r[i]:
-            continue
-        for ty in range(lo_r[i] // tile, hi_r[i] // tile + 1):
-            for tx in range(lo_c[i] // tile, hi_c[i] // tile + 1):
-                k = ty * tiles_x + tx
-                items[fill[k]] = i
-                fill[k] += 1
-    return starts, items
 
 
 @njit(cache=True)

@@ -63,6 +63,7 @@ from numba import njit, prange
 
 from ...errors import UsageError
 from ...scene.camera import pixel_segments
+from .binning import bin_by_tile, screen_boxes
 from .filtering import mip_pyramid
 from .textures import density_floor, marched_volume
 
@@ -144,8 +145,8 @@ def reference_render(shell, texture, camera, *, step=None, samples=None, level=N
     size = float(np.linalg.norm(positions.max(axis=0) - positions.min(axis=0)))
     eps = MIN_LENGTH * size
     ntx, nty = -(-width // TILE), -(-height // TILE)
-    ranges = _tile_ranges(shell, camera, width, height)
-    starts, items = _bin(ranges, ntx, nty)
+    lo_c, hi_c, lo_r, hi_r = screen_boxes(shell, camera, width, height)
+    starts, items = bin_by_tile(lo_c, hi_c, lo_r, hi_r, ntx, nty, TILE)
 
     color = np.zeros((height, width, 4), np.float32)
     position = np.full((height, width, 3), np.nan)
@@ -192,62 +193,6 @@ def _volume(texture, level, rgba, mean_thickness) -> np.ndarray:
         raise UsageError("rgba contains NaN or Inf values")
     return np.ascontiguousarray(marched_volume(arr, texture.length, mean_thickness),
                                 dtype=np.float64)
-
-
-def _tile_ranges(shell, camera, width, height) -> np.ndarray:
-    """(T, 4) int64 tile ranges (x0, x1, y0, y1), inclusive; x0 > x1 for none."""
-    corners = np.asarray(shell.positions, dtype=np.float64)[shell.tets]  # (T, 4, 3)
-    mvp = np.asarray(camera.proj, dtype=np.float64) @ np.asarray(camera.view, dtype=np.float64)
-    clip = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], axis=-1) @ mvp.T
-    w = clip[..., 3]
-    scale = max(float(np.abs(w).max()), 1e-300) if w.size else 1.0
-    behind = w <= 1e-9 * scale
-    safe = np.where(behind, 1.0, w)
-    wx = (clip[..., 0] / safe + 1.0) * 0.5 * width  # window x; pixel c's centre at c + 0.5
-    wy = (clip[..., 1] / safe + 1.0) * 0.5 * height  # window y; row r's centre at H - r - 0.5
-    xmin = np.where(behind, np.inf, wx).min(axis=1)
-    xmax = np.where(behind, -np.inf, wx).max(axis=1)
-    ymin = np.where(behind, np.inf, wy).min(axis=1)
-    ymax = np.where(behind, -np.inf, wy).max(axis=1)
-    some, every = behind.any(axis=1), behind.all(axis=1)
-    out = np.empty((len(corners), 4), np.int64)
-    ntx, nty = -(-width // TILE), -(-height // TILE)
-    ok = ~some
-    c0 = np.floor(np.where(ok, xmin, 0.0) - 1.5)  # one pixel of slack either side
-    c1 = np.ceil(np.where(ok, xmax, 0.0) + 0.5)
-    r0 = np.floor(height - 0.5 - np.where(ok, ymax, 0.0) - 1.0)
-    r1 = np.ceil(height - 0.5 - np.where(ok, ymin, 0.0) + 1.0)
-    c0, c1 = np.clip(c0, -1, width), np.clip(c1, -1, width)
-    r0, r1 = np.clip(r0, -1, height), np.clip(r1, -1, height)
-    out[:, 0] = np.maximum(c0, 0) // TILE
-    out[:, 1] = np.minimum(c1, width - 1) // TILE
-    out[:, 2] = np.maximum(r0, 0) // TILE
-    out[:, 3] = np.minimum(r1, height - 1) // TILE
-    off = (c1 < 0) | (c0 > width - 1) | (r1 < 0) | (r0 > height - 1)
-    out[off & ok] = (1, 0, 1, 0)
-    out[some] = (0, ntx - 1, 0, nty - 1)
-    out[every] = (1, 0, 1, 0)
-    return out
-
-
-@njit(cache=True)
-def _bin(ranges, ntx, nty):
-    """CSR lists of tetrahedra per tile (row-major tiles): starts (ntiles + 1), items."""
-    counts = np.zeros(ntx * nty + 1, np.int64)
-    for t in range(ranges.shape[0]):
-        for ty in range(ranges[t, 2], ranges[t, 3] + 1):
-            for tx in range(ranges[t, 0], ranges[t, 1] + 1):
-                counts[ty * ntx + tx + 1] += 1
-    starts = np.cumsum(counts)
-    fill = starts[:-1].copy()
-    items = np.empty(starts[-1], np.int64)
-    for t in range(ranges.shape[0]):
-        for ty in range(ranges[t, 2], ranges[t, 3] + 1):
-            for tx in range(ranges[t, 0], ranges[t, 1] + 1):
-                k = ty * ntx + tx
-                items[fill[k]] = t
-                fill[k] += 1
-    return starts, items
 
 
 @njit(cache=True)
