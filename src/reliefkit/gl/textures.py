@@ -88,11 +88,14 @@ def read_rgba(fbo, attachment: int, *, top_row_first: bool = True) -> np.ndarray
     return image[::-1].copy() if top_row_first else image.copy()
 
 
-def read_depth(fbo) -> np.ndarray:
-    """Read the depth attachment as an (H, W) float32 array with row 0 at the top."""
+def read_depth(fbo, *, top_row_first: bool = True) -> np.ndarray:
+    """Read the depth attachment as an (H, W) float32 array with row 0 at the top, or with
+    ``top_row_first=False`` at GL's y = 0. (From the texture itself: reading it through the
+    framebuffer leaves GL's read buffer at none, and Mesa crashes on a later blit.)"""
     width, height = fbo.size
     data = fbo.depth_attachment.read()
-    return np.frombuffer(data, np.float32).reshape(height, width)[::-1].copy()
+    image = np.frombuffer(data, np.float32).reshape(height, width)
+    return image[::-1].copy() if top_row_first else image.copy()
 
 
 MAX_TEXTURE3D_BYTES = 2 << 30  # refuse 3D textures above 2 GiB (checked before allocating)

@@ -28,7 +28,7 @@ from ...gl.context import check_gl_error
 from ...gl.objects import GLObjects
 from ...gl.shaders import program
 from ...gl.targets import use_transparent_blending
-from ...gl.textures import texture2d, texture3d
+from ...gl.textures import read_depth, read_rgba, texture2d, texture3d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
@@ -304,10 +304,7 @@ class TexturedShellDrawable(GLObjects):
     def _opaque_depth(self, outer, made) -> dict:
         """A copy of the opaque pass's depth to sample (the attached one cannot be)."""
         width, height = outer.size
-        depth = np.frombuffer(outer.read(attachment=-1, components=1, dtype="f4"), np.float32)
-        # reading the depth leaves GL's read buffer at none; a later blit from this
-        # framebuffer (the pass copies its opacity) then crashes Mesa: read a colour texel
-        outer.read(viewport=(0, 0, 1, 1), attachment=0)
+        depth = read_depth(outer, top_row_first=False)  # GL rows: texelFetch(gl_FragCoord)
         tex = self.ctx.texture((width, height), 1, depth.tobytes(), dtype="f4")
         made.append(tex)
         import moderngl
@@ -347,9 +344,8 @@ class TexturedShellDrawable(GLObjects):
             ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
             ctx.blend_func = moderngl.ONE, moderngl.ONE
             self._draw("bins", uniforms)
-            sums = np.concatenate([np.frombuffer(fbo.read(attachment=k, components=4,
-                                                          dtype="f4"), np.float32)
-                                   .reshape(height, width, 4) for k in range(4)], axis=-1)
+            sums = np.concatenate([read_rgba(fbo, k, top_row_first=False)
+                                   for k in range(4)], axis=-1)
             lo, hi, need = _narrow(lo, hi, need, sums.astype(np.float64))
             passes += 1
         self.stats["half_opacity_passes"] = passes + 1
@@ -445,9 +441,7 @@ def _narrow(lo, hi, need, sums):
 
 def _read_alpha(fbo) -> np.ndarray:
     """(H, W) float64 alpha of colour attachment 0 (GL row order, bottom row first)."""
-    width, height = fbo.size
-    rgba = np.frombuffer(fbo.read(attachment=0, components=4, dtype="f4"), np.float32)
-    return rgba.reshape(height, width, 4)[..., 3].astype(np.float64)
+    return read_rgba(fbo, 0, top_row_first=False)[..., 3].astype(np.float64)
 
 
 def drawable_spec() -> DrawableSpec:
