@@ -149,15 +149,8 @@ def unusable_triangles(mesh) -> np.ndarray:
     """(F,) bool: triangles whose prism would have no volume or no texture mapping (no area
     in space or in uv, or a vertex normal pointing along or behind the triangle); a baker may
     leave them out of the shell."""
-    base = mesh.world_positions
     faces = np.asarray(mesh.indices, dtype=np.int64)
-    a, b, c = (base[faces[:, k]] for k in range(3))
-    edge = np.max([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
-                   np.linalg.norm(a - c, axis=1)], axis=0)
-    cross = np.cross(b - a, c - a)
-    area2 = np.linalg.norm(cross, axis=1)
-    flat = area2 <= FLAT * edge ** 2
-    unit = cross / np.where(flat, 1.0, area2)[:, None]
+    flat, unit = _flat_triangles(mesh.world_positions, faces)
     normals = np.asarray(mesh.normals, dtype=np.float64)
     normals = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
     cosines = np.einsum("fi,fki->fk", unit, normals[faces])
@@ -235,15 +228,23 @@ def _directions(mesh, direction) -> np.ndarray:
 
 def _check_triangles(base: np.ndarray, faces: np.ndarray) -> None:
     """Refuse triangles with a repeated corner or no area: their prisms have no volume."""
-    a, b, c = (base[faces[:, k]] for k in range(3))
-    area2 = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    edge = np.max([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
-                   np.linalg.norm(a - c, axis=1)], axis=0)
-    flat = (area2 <= FLAT * edge ** 2) | (faces[:, 0] == faces[:, 1]) \
+    flat = _flat_triangles(base, faces)[0] | (faces[:, 0] == faces[:, 1]) \
         | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
     if flat.any():
         raise UsageError(f"{int(flat.sum())} of {len(faces)} triangles are degenerate "
                          "(no area); remove them before building a shell")
+
+
+def _flat_triangles(base: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(F,) bool triangles with no area (relative to their longest edge), and (F, 3) their
+    unit normals (anything where flat)."""
+    a, b, c = (base[faces[:, k]] for k in range(3))
+    edge = np.max([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
+                   np.linalg.norm(a - c, axis=1)], axis=0)
+    cross = np.cross(b - a, c - a)
+    area2 = np.linalg.norm(cross, axis=1)
+    flat = area2 <= FLAT * edge ** 2
+    return flat, cross / np.where(flat, 1.0, area2)[:, None]
 
 
 def _welded(positions: np.ndarray, count: int) -> np.ndarray:
