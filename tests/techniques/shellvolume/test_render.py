@@ -342,3 +342,21 @@ def test_mip_filtering_is_closer_to_the_supersampled_picture(gl):
     def err(img):
         return float(np.sqrt(((img - truth) ** 2).mean()))
     assert err(filtered) < 0.8 * err(aliased), (err(filtered), err(aliased))
+
+
+def test_compare_scores_the_variants_against_the_reference(gl, cloudy_sphere):
+    """`compare`'s variants: the unlit ones match the CPU reference within the bound, the
+    SXMPVO-sorted ones have no ordering violation on the frame's rays, the centroid one has
+    some (the sphere's shell seen from outside: front and back cross on every ray)."""
+    from reliefkit.compare import compare
+
+    cam = sphere_camera(size=(64, 64), az=80.0, el=10.0)
+    result = compare(cloudy_sphere.base, cloudy_sphere, cam)
+    rows = result["metrics"]
+    for name in ("unlit", "unlit, depth peeling", "unlit, exit per vertex"):
+        assert rows[name]["reference_rmse"] <= RMSE_BOUND, (name, rows[name])
+    assert rows["sxmpvo"]["order_violations"] == 0
+    assert rows["unlit, exit per vertex"]["order_violations"] == 0
+    assert rows["unlit, centroid sort"]["order_violations"] > 0
+    assert set(rows) == {"sxmpvo", "shadows", "unlit", "unlit, centroid sort",
+                         "unlit, depth peeling", "unlit, exit per vertex"}
