@@ -6,5 +6,6 @@ Adding a technique means one new package beside these and one entry here.
 from .billboard import TECHNIQUE as BILLBOARD
 from .relief import TECHNIQUE as RELIEF
 from .shellvolume import TECHNIQUE as SHELLVOLUME
+from .slicing import TECHNIQUE as SLICING
 
-TECHNIQUES = (RELIEF, BILLBOARD, SHELLVOLUME)
+TECHNIQUES = (RELIEF, BILLBOARD, SHELLVOLUME, SLICING)

@@ -1,7 +1,61 @@
-"""Displacement slicing and image-based depth objects (Kautz & Seidel), in progress.
+"""Displacement mapping by slicing, image-based depth objects and visual hulls (Kautz &
+Seidel 2001): a displacement volume (or the bounding cube of six depth images) cut into
+slices, each fragment kept by an alpha test against the displacement (or against all six
+depth images).
 
-Not registered as a technique yet (`reliefkit.techniques.TECHNIQUES` does not list it):
-so far it holds the six depth images of a mesh on its bounding cube (`depth_images`) and
-the exact CPU reference for the object they define (`reference`), and the slice polygons of
-the paper's three slicing modes (`slices`: surface-aligned, orthogonal, screen-space).
+Two halves, each a `parts.Part`: displacement maps (§3, `displacement_part`) and depth
+objects with visual hulls (§4-§5, `depth_object_part`); this module merges them into one
+`Technique`.
 """
+
+from __future__ import annotations
+
+from ...core.technique import Technique
+from .depth_object_part import PART as DEPTH_OBJECTS
+from .displacement_part import PART as DISPLACEMENT
+
+PARTS = (DEPTH_OBJECTS, DISPLACEMENT)
+
+
+def _merged(name: str) -> tuple:
+    return tuple(x for part in PARTS for x in getattr(part, name))
+
+
+def _demo_tiles() -> list:
+    return [tile for part in PARTS if part.demo_tiles for tile in part.demo_tiles()]
+
+
+def _samples() -> dict:
+    out: dict = {}
+    for part in PARTS:
+        if part.samples:
+            out |= part.samples()
+    return out
+
+
+def _cli_examples() -> dict:
+    out: dict = {}
+    for part in PARTS:
+        for command, lines in part.cli_examples.items():
+            out.setdefault(command, []).extend(lines)
+    return out
+
+
+TECHNIQUE = Technique(
+    name="slicing",
+    summary="displacement maps, depth objects and visual hulls drawn by slicing their volume "
+            "(or by ray casting the six depth images)",
+    package=__name__,
+    codecs=_merged("codecs"),
+    representations=_merged("representations"),
+    bakers=_merged("bakers"),
+    drawables=_merged("drawables"),
+    compare_variants=_merged("compare_variants"),
+    compare_metrics=_merged("compare_metrics"),
+    demo_tiles=_demo_tiles,
+    programs=_merged("programs"),
+    samples=_samples,
+    cli_examples=_cli_examples(),
+)
+
+__all__ = ["TECHNIQUE"]
