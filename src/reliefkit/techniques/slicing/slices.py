@@ -391,3 +391,41 @@ def orthogonal_count(box_to_world, axis: int, edge_count: int,
         return edge_count
     thick = axis_thickness(box_to_world)
     return max(1, math.ceil(edge_count * thick[axis] / (scale * thick[2]) - 1e-9))
+
+
+# --- how many slices --------------------------------------------------------------------------
+
+#: Bounds of the automatic slice count.
+AUTO_MIN, AUTO_MAX = 2, 2048
+
+
+def pixel_world_size(camera, point) -> float:
+    """World length that one pixel spans at ``point`` (in the image plane's vertical), from
+    the camera's own matrices (so any camera kind)."""
+    from ...core.transforms import transform_points
+
+    p = np.asarray(point, dtype=np.float64)
+    view = np.asarray(camera.view, dtype=np.float64)
+    eye_p = transform_points(view, p[None])[0]
+    clip_of = np.asarray(camera.proj, dtype=np.float64)
+    h = camera.size[1]
+
+    def ndc_y(e):
+        c = clip_of @ np.append(e, 1.0)
+        return c[1] / c[3]
+
+    step = max(abs(float(eye_p[2])), 1e-6) * 1e-3
+    up = eye_p + np.array([0.0, step, 0.0])
+    pixels = abs(ndc_y(up) - ndc_y(eye_p)) * 0.5 * h
+    return step / pixels if pixels > 0 else math.inf
+
+
+def auto_slice_count(thickness: float, camera, centre, finest: float) -> int:
+    """The automatic slice count for a volume ``thickness`` deep along the slicing normal:
+    slices one pixel apart at ``centre`` (the volume's size on screen decides), but never
+    closer than ``finest`` (a texel of the images: closer slices add nothing), clamped to
+    [`AUTO_MIN`, `AUTO_MAX`]."""
+    spacing = max(pixel_world_size(camera, centre), float(finest))
+    if not math.isfinite(spacing) or spacing <= 0:
+        return AUTO_MIN
+    return int(min(AUTO_MAX, max(AUTO_MIN, math.ceil(thickness / spacing - 1e-9))))

@@ -1,0 +1,75 @@
+"""`DepthObject` and `VisualHull`: six depth images on a cube, drawn as the intersection of
+their displaced volumes (§4) or of their silhouettes' extrusions (§5).
+
+A visual hull is the same images with every depth inside a silhouette set to 0 (the paper's
+"all depth values greater than 0 were set to 1", in our convention where depth is measured
+from the face); its colours and normals are kept for texturing. Opposite silhouettes of a
+cube are mirror images, so a hull needs only three of its six images to be tested.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import UsageError
+from .depth_images import DepthImages, visual_hull
+
+
+@dataclass(eq=False)
+class DepthObject:
+    """An image-based depth object: `images` (six depth images, see `depth_images`)."""
+
+    images: DepthImages
+    params: dict = field(default_factory=dict)
+
+    #: Whether only silhouettes are stored (depth 0 inside every mask).
+    hull = False
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.images, DepthImages):
+            raise UsageError(f"a depth object needs DepthImages, got "
+                             f"{type(self.images).__name__}")
+
+    @property
+    def resolution(self) -> int:
+        return self.images.resolution
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) world box of the cube."""
+        c = self.images.cube_to_world
+        lo = c[:3, 3]
+        return np.array([lo, lo + np.diag(c)[:3]])
+
+    @property
+    def tested_faces(self) -> tuple[int, ...]:
+        """The images a fragment is tested against: all six, or for a hull one per axis."""
+        return (0, 2, 4) if self.hull else tuple(range(6))
+
+    def bake_report(self) -> list[str]:
+        n = self.resolution
+        covered = [f"{100 * float(m.mean()):.0f}%" for m in self.images.mask]
+        kind = "visual hull" if self.hull else "depth object"
+        return [f"{kind}: six {n}x{n} depth images on a cube of side "
+                f"{self.images.side:.4g} (texel {self.images.texel:.3g}); silhouette cover "
+                f"per face (+x -x +y -y +z -z): {' '.join(covered)}"]
+
+
+@dataclass(eq=False)
+class VisualHull(DepthObject):
+    """The visual hull of six silhouettes (§5): build it with `VisualHull.of(images)`."""
+
+    hull = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        images = self.images
+        if (images.depth[images.mask] != 0).any():
+            raise UsageError("a visual hull's images must have depth 0 inside every "
+                             "silhouette (build it with VisualHull.of(images))")
+
+    @classmethod
+    def of(cls, images: DepthImages, params: dict | None = None) -> VisualHull:
+        return cls(visual_hull(images), dict(params or {}))

@@ -1,0 +1,148 @@
+// Image-based depth objects and visual hulls (§4-§5): slices through the cube, each fragment
+// kept when it lies inside the volume of every tested image, then textured from the images
+// closest to the view. Variants:
+//   (default)   one pass: all tested images in this shader (§4.1's "imaginary graphics card")
+//   TEST_ONE    stencil multi-pass: only image u_face is tested, nothing is written but the
+//               stencil (render.py counts passes there, as §4.1's algorithm does)
+//   COLOR_ONLY  stencil multi-pass: no test, the texturing pass where the count is complete
+//   RAYCAST     the cube's faces drawn, the pixel's ray walked through the N^3 voxels
+//               (exact for the nearest-texel images, like the CPU reference)
+//   HULL        a visual hull: three silhouettes (one per axis) are tested
+//   TEXTURING_NEAREST  the single closest image instead of the three-image blend
+//   UNLIT       the blended colour without lighting
+//! defines: TEST_ONE COLOR_ONLY RAYCAST HULL TEXTURING_NEAREST UNLIT
+
+#if defined VERTEX_SHADER
+#include "core:include/camera.glsl"
+uniform vec3 u_model_offset;
+in vec3 in_position;   // world, relative to the cube's centre
+in vec3 in_cube;       // cube coordinates of the vertex
+out vec3 v_world;
+out vec3 v_cube;
+
+void main() {
+    v_world = in_position + u_model_offset;
+    v_cube = in_cube;
+    gl_Position = u_proj * u_view * vec4(v_world, 1.0);
+}
+#endif
+
+#if defined FRAGMENT_SHADER
+#include "core:include/camera.glsl"
+#include "core:include/shading.glsl"
+#include "core:include/frame_outputs.glsl"
+#include "core:include/iterations.glsl"
+#include "core:include/raybox.glsl"
+#include "include/cube_images.glsl"
+#include "include/texturing.glsl"
+uniform int u_face;                 // TEST_ONE: the image tested in this pass
+uniform mat4 u_world_to_box;        // camera-relative world -> cube coordinates
+uniform mat4 u_box_to_world;        // cube coordinates -> camera-relative world
+uniform int u_max_steps;            // RAYCAST: bound on the voxel walk
+in vec3 v_world;
+in vec3 v_cube;
+
+bool inside_all(vec3 q) {
+#if defined HULL
+    return inside_image(0, q) && inside_image(2, q) && inside_image(4, q);
+#else
+    for (int k = 0; k < 6; ++k)
+        if (!inside_image(k, q)) return false;
+    return true;
+#endif
+}
+
+#if defined RAYCAST
+// [lo, hi] of axis a inside voxel v: the two images looking along a, at v's column.
+vec2 column(int a, ivec3 v) {
+    vec3 centre = (vec3(v) + 0.5) / float(u_res);
+    int lower = 2 * a + 1, upper = 2 * a;    // faces -a and +a
+    vec3 fl = face_coords(lower, centre), fu = face_coords(upper, centre);
+    return vec2(face_depth(lower, fl), 1.0 - face_depth(upper, fu));
+}
+
+// First point of the object on the cube-space segment q0 + t dq, t in [0, 1]: a 3D DDA over
+// the voxels; inside each the object is one box (reference.py), intersected by slabs.
+bool raycast(vec3 q0, vec3 dq, out vec3 hit, out int steps) {
+    float n = float(u_res);
+    vec3 p = q0 * n, d = dq * n;
+    ivec3 v = clamp(ivec3(floor(p + 1e-6 * sign(d))), ivec3(0), ivec3(u_res - 1));
+    ivec3 step = ivec3(sign(d));
+    vec3 inv = vec3(1e30);
+    for (int a = 0; a < 3; ++a) if (d[a] != 0.0) inv[a] = 1.0 / d[a];
+    vec3 next = vec3(1e30);
+    for (int a = 0; a < 3; ++a)
+        if (d[a] != 0.0) next[a] = (float(v[a] + (step[a] > 0 ? 1 : 0)) - p[a]) * inv[a];
+    vec3 delta = abs(inv);
+    float t = 0.0;
+    steps = 0;
+    for (int i = 0; i < u_max_steps; ++i) {
+        ++steps;
+        float t_next = min(min(next.x, next.y), next.z);
+        float t1 = min(t_next, 1.0);
+        float lo = t, hi = t1;
+        for (int a = 0; a < 3; ++a) {
+            vec2 c = column(a, v);
+            if (c.x > c.y) { lo = 2.0; break; }
+            if (dq[a] == 0.0) {
+                if (q0[a] < c.x || q0[a] > c.y) { lo = 2.0; break; }
+            } else {
+                float ta = (c.x - q0[a]) / dq[a], tb = (c.y - q0[a]) / dq[a];
+                lo = max(lo, min(ta, tb));
+                hi = min(hi, max(ta, tb));
+            }
+        }
+        if (lo <= hi) { hit = q0 + lo * dq; return true; }
+        if (t_next >= 1.0) break;
+        int a = next.x <= next.y && next.x <= next.z ? 0 : (next.y <= next.z ? 1 : 2);
+        v[a] += step[a];
+        if (v[a] < 0 || v[a] >= u_res) break;
+        t = next[a];
+        next[a] += delta[a];
+    }
+    hit = vec3(0.0);
+    return false;
+}
+
+bool pixel_segment(out vec3 q0, out vec3 dq) {
+    vec2 ndc = fragment_ndc();
+    vec3 a = unproject(ndc, -1.0), b = unproject(ndc, 1.0);
+    vec3 qa = (u_world_to_box * vec4(a, 1.0)).xyz, qb = (u_world_to_box * vec4(b, 1.0)).xyz;
+    vec2 span = unit_cube_interval(qa, qb - qa);
+    span.x = max(span.x, 0.0);
+    span.y = min(span.y, 1.0);
+    if (span.y <= span.x) return false;
+    q0 = qa + span.x * (qb - qa);
+    dq = (span.y - span.x) * (qb - qa);
+    return true;
+}
+#endif
+
+void main() {
+    vec3 q = v_cube, world = v_world;
+    int steps = 0;
+#if defined RAYCAST
+    vec3 q0, dq;
+    if (!pixel_segment(q0, dq) || !raycast(q0, dq, q, steps)) discard;
+    world = (u_box_to_world * vec4(q, 1.0)).xyz;
+    gl_FragDepth = window_depth(world);
+#elif defined TEST_ONE
+    if (!inside_image(u_face, q)) discard;
+#elif !defined COLOR_ONLY
+    if (!inside_all(q)) discard;
+#endif
+#if defined TEST_ONE
+    write_frame(vec4(0.0), world, vec3(0.0));
+#else
+    vec3 towards = towards_eye(world);
+    vec4 color;
+    vec3 n;
+    textured(q, towards, color, n);
+#if !defined UNLIT
+    color.rgb = shade_phong(color.rgb, n, towards, 1.0);
+#endif
+    write_frame(color, world, n);
+#endif
+    write_iterations(steps, 0, true);
+}
+#endif

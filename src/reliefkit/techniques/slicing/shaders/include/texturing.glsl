@@ -1,0 +1,60 @@
+// View-dependent texturing of a depth object (§4.2). Include after cube_images.glsl and
+// core:include/camera.glsl.
+uniform highp sampler2DArray u_color;    // premultiplied linear RGBA, layer k = face k
+uniform highp sampler2DArray u_normals;  // world normals
+uniform vec3 u_face_normal[6];           // outward world normal of face k
+uniform float u_visible_depth;           // how far behind image k's surface q may lie and
+                                         // still be seen by it (cube-side units)
+
+// Whether image k saw the point q (it is its first surface from face k), given the depth
+// tested for visibility; a hull (depths 0) sees nothing this way.
+bool image_sees(int k, vec3 q) {
+    vec3 f = face_coords(k, q);
+    return 1.0 - f.z - face_depth(k, f) <= u_visible_depth;
+}
+
+// Weights of the images for a point q seen along `towards` (unit, towards the eye): the
+// three faces closest to the view direction, weighted by how much less than 90 degrees
+// their angle is (summing to one), among the images that see q where any does (NEAREST:
+// the single closest such image).
+void image_weights(vec3 q, vec3 towards, out float w[6]) {
+    float best = -2.0;
+    int nearest = 0;
+    float total = 0.0;
+    bool any_sees = false;
+    for (int k = 0; k < 6; ++k) any_sees = any_sees || (
+        dot(u_face_normal[k], towards) > 0.0 && image_sees(k, q));
+    for (int k = 0; k < 6; ++k) {
+        float c = dot(u_face_normal[k], towards);
+        bool usable = c > 0.0 && (!any_sees || image_sees(k, q));
+        w[k] = usable ? 1.5707963 - acos(min(c, 1.0)) : 0.0;
+        if (usable && c > best) { best = c; nearest = k; }
+        total += w[k];
+    }
+#if defined TEXTURING_NEAREST
+    for (int k = 0; k < 6; ++k) w[k] = k == nearest ? 1.0 : 0.0;
+#else
+    if (total <= 0.0) {  // exactly edge-on to all three: take the nearest
+        for (int k = 0; k < 6; ++k) w[k] = k == nearest ? 1.0 : 0.0;
+        total = 1.0;
+    }
+    for (int k = 0; k < 6; ++k) w[k] /= total;
+#endif
+}
+
+// Colour (straight alpha) and world normal blended from the images at q.
+void textured(vec3 q, vec3 towards, out vec4 color, out vec3 normal) {
+    float w[6];
+    image_weights(q, towards, w);
+    vec4 sum = vec4(0.0);
+    vec3 n = vec3(0.0);
+    for (int k = 0; k < 6; ++k) {
+        if (w[k] <= 0.0) continue;
+        vec3 f = face_coords(k, q);
+        vec3 uvl = vec3(clamp(f.xy, 0.0, 1.0), float(k));
+        sum += w[k] * texture(u_color, uvl);
+        n += w[k] * texture(u_normals, uvl).xyz;
+    }
+    color = sum.a > 0.0 ? vec4(sum.rgb / sum.a, 1.0) : vec4(0.5, 0.5, 0.5, 1.0);
+    normal = dot(n, n) > 1e-12 ? normalize(n) : towards;
+}
