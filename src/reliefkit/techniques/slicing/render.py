@@ -42,6 +42,7 @@ COPY_PROGRAM = "slicing:copy_frame.glsl"
 SLICINGS = ("orthogonal", "screen", "raycast")
 PASSES = ("single", "stencil")
 TEXTURINGS = ("blend3", "nearest")
+ALPHA_TESTS = ("point", "slab")
 EMPTY_DEPTH = 2.0          # uploaded for texels whose column is empty: no test can pass
 FINEST_TEXELS = 0.5        # automatic slices: never closer than half a texel (a slice hit
                            # lies up to one spacing / cos(angle) behind the exact one)
@@ -50,7 +51,7 @@ VISIBLE_TEXELS = 1.5       # a point this many texels (plus one slice) behind im
 _DEPTH_UNIT, _COLOR_UNIT, _NORMAL_UNIT = 0, 1, 2
 PROGRAMS = tuple(ProgramVariant(PROGRAM, d) for d in (
     {}, {"HULL": True}, {"TEXTURING_NEAREST": True}, {"UNLIT": True}, {"TEST_ONE": True},
-    {"COLOR_ONLY": True}, {"RAYCAST": True}, {"RAYCAST": True, "HULL": True})) + (
+    {"COLOR_ONLY": True}, {"SLAB": True}, {"RAYCAST": True}, {"RAYCAST": True, "HULL": True})) + (
     ProgramVariant(COPY_PROGRAM, {}),)
 
 
@@ -70,6 +71,9 @@ class DepthObjectRenderOptions:
     texturing: str = param("blend3", "view-dependent texturing from the three images "
                            "closest to the view, or from the nearest one (§4.2)",
                            choices=TEXTURINGS)
+    alpha_test: str = param("point", "slices: test the slice's own point (the paper's alpha "
+                            "test), or the whole slab of the ray the slice stands for "
+                            "(exact at any slice count)", choices=ALPHA_TESTS)
     unlit: bool = param(False, "the images' colours without lighting")
 
 
@@ -100,6 +104,9 @@ class DepthObjectDrawable(GLObjects):
         if opts.slicing == "raycast" and opts.passes == "stencil":
             raise UsageError("--passes stencil counts image tests per slice; ray casting "
                              "has no slices (use --slicing orthogonal or screen)")
+        if opts.alpha_test == "slab" and opts.passes == "stencil":
+            raise UsageError("--alpha-test slab tests all images together; the stencil "
+                             "passes test one image at a time (use --alpha-test point)")
         if opts.slicing == "raycast" and opts.slices is not None:
             raise UsageError("--slices does not apply to --slicing raycast")
         self.extra_attachments = 1 if instrument and opts.slicing == "raycast" else 0
@@ -135,7 +142,8 @@ class DepthObjectDrawable(GLObjects):
             self.copy_program = program(ctx, COPY_PROGRAM)
             self.copy_vao = self.keep(ctx.vertex_array(self.copy_program, []))
         else:
-            self.programs = {"main": program(ctx, PROGRAM, common)}
+            self.programs = {"main": program(ctx, PROGRAM, common | {
+                "SLAB": opts.alpha_test == "slab"})}
         check_gl_error(ctx, "uploading a depth object")
 
     def _cube_proxy(self) -> None:
@@ -218,7 +226,7 @@ class DepthObjectDrawable(GLObjects):
         if opts.slicing == "raycast":
             from ...render.proxy import cull_face
 
-            self._bind(camera, light)
+            self._bind(camera, light, {"u_visible_depth": self._visible_depth(None)})
             self.ctx.enable(moderngl.CULL_FACE)
             self.ctx.cull_face = cull_face(self.proxy, camera)
             self.vaos["main"].render()
@@ -230,7 +238,9 @@ class DepthObjectDrawable(GLObjects):
         relative = stack.positions - self.centre
         ordered = stack.triangles_in_order(front_to_back=True)
         self._geometry(relative, stack.box, ordered, self.centre)
-        self._bind(camera, light, {"u_visible_depth": self._visible_depth(stack)})
+        self._bind(camera, light, {"u_visible_depth": self._visible_depth(stack),
+                                   "u_slice_normal": tuple(float(x) for x in stack.plane_normal),
+                                   "u_slice_spacing": stack.spacing or self.rep.images.side})
         if opts.passes == "stencil":
             draws = self._draw_stencil(camera, stack)
         else:
@@ -238,11 +248,17 @@ class DepthObjectDrawable(GLObjects):
             draws = 1
         self.stats = {"slicing": opts.slicing, "slices": stack.slice_count,
                       "passes": opts.passes, "texturing": opts.texturing, "draws": draws,
+                      "alpha_test": opts.alpha_test,
                       "slice_polygons": int(np.count_nonzero(np.diff(stack.first_triangle))),
                       "fill_pixels": stack.area_pixels(camera)}
 
     def _visible_depth(self, stack) -> float:
-        return (VISIBLE_TEXELS / self.rep.resolution) + stack.spacing / self.rep.images.side
+        """How far behind image k's surface a drawn point may be and still count as seen by
+        it (cube-side units): `VISIBLE_TEXELS`, plus a slice spacing for the point test,
+        whose points lie up to that far inside the surface."""
+        slack = stack.spacing / self.rep.images.side if stack is not None and \
+            self.options.alpha_test == "point" else 0.0
+        return VISIBLE_TEXELS / self.rep.resolution + slack
 
     def _draw_stencil(self, camera, stack) -> int:
         """§4.1's algorithm into a stencil target, then copied into the frame's target."""

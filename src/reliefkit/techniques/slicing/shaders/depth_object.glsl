@@ -7,10 +7,15 @@
 //   COLOR_ONLY  stencil multi-pass: no test, the texturing pass where the count is complete
 //   RAYCAST     the cube's faces drawn, the pixel's ray walked through the N^3 voxels
 //               (exact for the nearest-texel images, like the CPU reference)
+//   SLAB        each slice tests exactly the slab of the cube around it (the ray from one
+//               spacing in front of it to one spacing behind, overlapping its neighbours'
+//               so that a ray crossing only one slice inside the cube is still covered),
+//               with the voxel walk of RAYCAST: exact hits at any slice count (beyond the
+//               paper)
 //   HULL        a visual hull: three silhouettes (one per axis) are tested
 //   TEXTURING_NEAREST  the single closest image instead of the three-image blend
 //   UNLIT       the blended colour without lighting
-//! defines: TEST_ONE COLOR_ONLY RAYCAST HULL TEXTURING_NEAREST UNLIT
+//! defines: TEST_ONE COLOR_ONLY RAYCAST SLAB HULL TEXTURING_NEAREST UNLIT
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
@@ -38,7 +43,9 @@ void main() {
 uniform int u_face;                 // TEST_ONE: the image tested in this pass
 uniform mat4 u_world_to_box;        // camera-relative world -> cube coordinates
 uniform mat4 u_box_to_world;        // cube coordinates -> camera-relative world
-uniform int u_max_steps;            // RAYCAST: bound on the voxel walk
+uniform int u_max_steps;            // RAYCAST, SLAB: bound on the voxel walk
+uniform vec3 u_slice_normal;        // SLAB: unit world normal of the slices
+uniform float u_slice_spacing;      // SLAB: world distance between slices
 in vec3 v_world;
 in vec3 v_cube;
 
@@ -52,7 +59,7 @@ bool inside_all(vec3 q) {
 #endif
 }
 
-#if defined RAYCAST
+#if defined RAYCAST || defined SLAB
 // [lo, hi] of axis a inside voxel v: the two images looking along a, at v's column.
 vec2 column(int a, ivec3 v) {
     vec3 centre = (vec3(v) + 0.5) / float(u_res);
@@ -104,6 +111,28 @@ bool raycast(vec3 q0, vec3 dq, out vec3 hit, out int steps) {
     return false;
 }
 
+#endif
+
+#if defined SLAB
+// The part of this pixel's ray within one spacing of the slice, in cube coordinates,
+// nearest end first (clipped to the cube).
+bool slab_segment(vec3 world, out vec3 q0, out vec3 dq) {
+    vec3 towards = towards_eye(world);
+    float c = abs(dot(towards, u_slice_normal));
+    if (c < 1e-6) return false;
+    vec3 half_ray = towards * (u_slice_spacing / c);
+    vec3 qa = (u_world_to_box * vec4(world + half_ray, 1.0)).xyz;
+    vec3 qb = (u_world_to_box * vec4(world - half_ray, 1.0)).xyz;
+    vec2 span = unit_cube_interval(qa, qb - qa);
+    span = clamp(span, 0.0, 1.0);
+    if (span.y <= span.x) return false;
+    q0 = qa + span.x * (qb - qa);
+    dq = (span.y - span.x) * (qb - qa);
+    return true;
+}
+#endif
+
+#if defined RAYCAST
 bool pixel_segment(out vec3 q0, out vec3 dq) {
     vec2 ndc = fragment_ndc();
     vec3 a = unproject(ndc, -1.0), b = unproject(ndc, 1.0);
@@ -124,6 +153,11 @@ void main() {
 #if defined RAYCAST
     vec3 q0, dq;
     if (!pixel_segment(q0, dq) || !raycast(q0, dq, q, steps)) discard;
+    world = (u_box_to_world * vec4(q, 1.0)).xyz;
+    gl_FragDepth = window_depth(world);
+#elif defined SLAB
+    vec3 q0, dq;
+    if (!slab_segment(world, q0, dq) || !raycast(q0, dq, q, steps)) discard;
     world = (u_box_to_world * vec4(q, 1.0)).xyz;
     gl_FragDepth = window_depth(world);
 #elif defined TEST_ONE

@@ -7,10 +7,12 @@ uniform float u_visible_depth;           // how far behind image k's surface q m
                                          // still be seen by it (cube-side units)
 
 // Whether image k saw the point q (it is its first surface from face k), given the depth
-// tested for visibility; a hull (depths 0) sees nothing this way.
+// tested for visibility; a hull (depths 0) sees nothing this way, nor does an empty texel
+// (met by points on a column's boundary).
 bool image_sees(int k, vec3 q) {
     vec3 f = face_coords(k, q);
-    return 1.0 - f.z - face_depth(k, f) <= u_visible_depth;
+    float d = face_depth(k, f);
+    return d <= 1.0 && 1.0 - f.z - d <= u_visible_depth;
 }
 
 // Weights of the images for a point q seen along `towards` (unit, towards the eye): the

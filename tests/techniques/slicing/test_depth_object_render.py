@@ -1,0 +1,148 @@
+"""Depth objects and visual hulls on the GPU against the exact CPU reference (reference.py),
+analytic scenes, and each other (single pass vs stencil passes)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from slicing_scenes import CUP_FLOOR, CUP_TOP, box_mesh, cup_mesh, sphere_mesh
+
+from reliefkit.errors import UsageError
+from reliefkit.render.registry import render
+from reliefkit.scene.camera import Camera
+from reliefkit.techniques.slicing.depth_images import bake_depth_images
+from reliefkit.techniques.slicing.measure import against_reference
+from reliefkit.techniques.slicing.reference import exact_intersection
+from reliefkit.techniques.slicing.representation import DepthObject, VisualHull
+
+N = 32
+SIZE = (64, 64)
+
+
+@pytest.fixture(scope="module")
+def objects(gl):
+    return {name: DepthObject(bake_depth_images(make(), N))
+            for name, make in (("box", box_mesh), ("sphere", sphere_mesh), ("cup", cup_mesh))}
+
+
+def cameras(rep):
+    centre = tuple(rep.bounds.mean(axis=0))
+    side = rep.images.side
+    return [Camera.orbit(centre, 30, 25, 1.7 * side, size=SIZE),
+            Camera.orbit(centre, -120, -40, 1.7 * side, size=SIZE),
+            Camera.orbit(centre, 75, 60, 1.7 * side, size=SIZE, ortho_height=0.6 * side)]
+
+
+@pytest.mark.parametrize("name", ["box", "sphere", "cup"])
+def test_ray_casting_is_the_exact_reference(objects, name):
+    rep = objects[name]
+    for cam in cameras(rep):
+        frame = render(rep, cam, slicing="raycast")
+        s = against_reference(frame, rep.images, cam)
+        assert s["reference_pixels"] > 300
+        assert s["wrong_fraction"] <= 0.002 and s["depth_rms_texels"] < 0.02, s
+
+
+@pytest.mark.parametrize("slicing", ["orthogonal", "screen"])
+def test_slab_test_is_exact_at_few_slices(objects, slicing):
+    rep = objects["sphere"]
+    for cam in cameras(rep):
+        frame = render(rep, cam, slicing=slicing, slices=8, alpha_test="slab")
+        s = against_reference(frame, rep.images, cam)
+        assert s["wrong_fraction"] <= 0.003 and s["depth_rms_texels"] < 0.1, s
+
+
+@pytest.mark.parametrize("slicing", ["orthogonal", "screen"])
+def test_point_test_converges_with_slices(objects, slicing):
+    """The paper's alpha test samples the object at the slice planes: wrong pixels fall as
+    slices grow, and the depth error with them."""
+    rep = objects["sphere"]
+    cam = cameras(rep)[0]
+    reference = exact_intersection(rep.images, cam)
+    scores = [against_reference(render(rep, cam, slicing=slicing, slices=n), rep.images, cam,
+                                reference=reference) for n in (8, 32, 128)]
+    wrong = [s["wrong_fraction"] for s in scores]
+    rms = [s["depth_rms_texels"] for s in scores]
+    assert wrong[0] > wrong[1] > wrong[2] and wrong[0] > 0.3 and wrong[2] < 0.05, wrong
+    assert rms[0] > rms[1] > rms[2], rms
+    assert scores[2]["iou"] >= 0.98
+
+
+@pytest.mark.parametrize("hull", [False, True])
+def test_stencil_passes_draw_the_single_pass_picture(objects, hull):
+    rep = objects["cup"]
+    rep = VisualHull.of(rep.images) if hull else rep
+    cam = cameras(rep)[0]
+    single = render(rep, cam, slices=24)
+    stencil = render(rep, cam, slices=24, passes="stencil")
+    assert single.mask.sum() > 300
+    assert np.array_equal(single.mask, stencil.mask)
+    m = single.mask
+    assert np.abs(single.color[m] - stencil.color[m]).max() < 1e-6
+    assert np.abs(single.position[m] - stencil.position[m]).max() < 1e-5
+    assert np.abs(single.depth[m] - stencil.depth[m]).max() < 1e-6
+    # one counting pass per tested image, one texturing and one reset pass, per slice
+    tested = 3 if hull else 6
+    assert stencil.stats["draws"] == stencil.stats["slices"] * (tested + 2)
+
+
+@pytest.mark.parametrize("slicing", ["raycast", "orthogonal", "screen"])
+def test_the_cup_needs_depth_the_hull_fills_it(objects, slicing):
+    """§5: a visual hull cannot show the cup's hole; the depth object sees its floor."""
+    rep = objects["cup"]
+    top = Camera.orbit(tuple(rep.bounds.mean(axis=0)), 0, 89.9, 3.0, size=SIZE,
+                       ortho_height=1.2)
+    options = {"slicing": slicing} | ({} if slicing == "raycast" else {"slices": 64})
+    depth = render(rep, top, **options)
+    hull = render(VisualHull.of(rep.images), top, **options)
+    centre = (slice(28, 36), slice(28, 36))  # inside the hole, |x|, |z| < 0.5
+    assert np.allclose(depth.position[centre][..., 1], CUP_FLOOR, atol=0.06)
+    assert np.allclose(hull.position[centre][..., 1], CUP_TOP, atol=0.06)
+
+
+def test_texturing_takes_each_face_colour_from_the_image_that_sees_it(gl):
+    """A box whose faces have different colours, seen across a corner: both texturings give
+    each face its own colour (the images that do not see a point are left out)."""
+    import trimesh
+
+    from reliefkit.scene.mesh import RenderMesh
+
+    tm = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+    tm = tm.subdivide()  # face-coloured vertices: split per face
+    tm = trimesh.Trimesh(tm.vertices[tm.faces].reshape(-1, 3),
+                         np.arange(3 * len(tm.faces)).reshape(-1, 3), process=False)
+    normal = np.repeat(tm.face_normals, 3, axis=0)
+    palette = {0: (0.9, 0.1, 0.1), 1: (0.1, 0.9, 0.1), 2: (0.1, 0.1, 0.9)}
+    axis = np.abs(normal).argmax(axis=1)
+    colors = np.array([[*palette[a], 1.0] for a in axis])
+    mesh = RenderMesh(tm.vertices, tm.faces, normal, colors, name="coloured box")
+    rep = DepthObject(bake_depth_images(mesh, N))
+    cam = Camera.orbit((0.0, 0.0, 0.0), 40, 30, 3.0, size=SIZE)
+    for texturing in ("blend3", "nearest"):
+        frame = render(rep, cam, slicing="raycast", texturing=texturing, unlit=True)
+        n = frame.normal[frame.mask]
+        got = frame.color[frame.mask][:, :3]
+        face = np.abs(n).argmax(axis=1)
+        expected = np.array([palette[a] for a in face])
+        close = np.abs(got - expected).max(axis=1) < 0.02
+        assert close.mean() > 0.9, (texturing, close.mean())
+
+
+def test_bad_option_combinations_are_refused(objects):
+    rep = objects["box"]
+    cam = cameras(rep)[0]
+    with pytest.raises(UsageError, match="ray casting has no slices"):
+        render(rep, cam, slicing="raycast", passes="stencil")
+    with pytest.raises(UsageError, match="stencil passes test one image"):
+        render(rep, cam, alpha_test="slab", passes="stencil")
+    with pytest.raises(UsageError, match="--slices does not apply"):
+        render(rep, cam, slicing="raycast", slices=10)
+
+
+def test_stats_count_the_fill(objects):
+    rep = objects["sphere"]
+    cam = cameras(rep)[0]
+    frame = render(rep, cam, slicing="screen", slices=20)
+    assert frame.stats["slices"] == 20 and frame.stats["slice_polygons"] == 20
+    # screen slices fill about the cube's depth in slices over its silhouette
+    assert frame.stats["fill_per_covered_pixel"] > 5
