@@ -15,8 +15,9 @@ pixel's ray walks the N^3 voxels; inside a voxel the nearest-texel object is one
 reference.py), so the hit is exact, the same as the CPU reference's.
 
 Texturing (§4.2): the three images closest to the view direction, or the single nearest
-(``texturing``), each restricted to the images that see the point; lit with the blended
-normal unless ``unlit``.
+(``texturing``), restricted to the images that see the point (a point is seen by image k
+when it lies within `VISIBLE_TEXELS` of k's first surface; ``visibility=False`` is the
+paper's texturing); lit with the blended normal unless ``unlit``.
 """
 
 from __future__ import annotations
@@ -74,6 +75,9 @@ class DepthObjectRenderOptions:
     alpha_test: str = param("point", "slices: test the slice's own point (the paper's alpha "
                             "test), or the whole slab of the ray the slice stands for "
                             "(exact at any slice count)", choices=ALPHA_TESTS)
+    visibility: bool = param(True, "texture each point only from the images that see it "
+                             "(off: the paper's texturing, which also paints hidden parts "
+                             "with whatever an image saw in front of them)")
     unlit: bool = param(False, "the images' colours without lighting")
 
 
@@ -207,7 +211,8 @@ class DepthObjectDrawable(GLObjects):
                 | light.uniforms() | {
                     "u_res": self.rep.resolution, "u_face_normal": _face_normals(),
                     "u_depth": _DEPTH_UNIT, "u_color": _COLOR_UNIT, "u_normals": _NORMAL_UNIT,
-                    "u_max_steps": 3 * self.rep.resolution + 3})
+                    "u_max_steps": 3 * self.rep.resolution + 3,
+                    "u_check_visibility": self.options.visibility})
 
     def _bind(self, camera, light, extra: dict | None = None) -> None:
         self.depth_tex.use(_DEPTH_UNIT)

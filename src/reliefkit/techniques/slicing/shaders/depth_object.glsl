@@ -60,6 +60,10 @@ bool inside_all(vec3 q) {
 }
 
 #if defined RAYCAST || defined SLAB
+// An exact hit lies on a column's boundary, where a texel lookup could pick either side:
+// the images are read this far (in texels) further along the ray, inside the hit box.
+#define INSIDE_TEXELS 0.05
+
 // [lo, hi] of axis a inside voxel v: the two images looking along a, at v's column.
 vec2 column(int a, ivec3 v) {
     vec3 centre = (vec3(v) + 0.5) / float(u_res);
@@ -155,11 +159,13 @@ void main() {
     if (!pixel_segment(q0, dq) || !raycast(q0, dq, q, steps)) discard;
     world = (u_box_to_world * vec4(q, 1.0)).xyz;
     gl_FragDepth = window_depth(world);
+    q += normalize(dq) * (INSIDE_TEXELS / float(u_res));
 #elif defined SLAB
     vec3 q0, dq;
     if (!slab_segment(world, q0, dq) || !raycast(q0, dq, q, steps)) discard;
     world = (u_box_to_world * vec4(q, 1.0)).xyz;
     gl_FragDepth = window_depth(world);
+    q += normalize(dq) * (INSIDE_TEXELS / float(u_res));
 #elif defined TEST_ONE
     if (!inside_image(u_face, q)) discard;
 #elif !defined COLOR_ONLY

@@ -5,6 +5,7 @@ uniform highp sampler2DArray u_normals;  // world normals
 uniform vec3 u_face_normal[6];           // outward world normal of face k
 uniform float u_visible_depth;           // how far behind image k's surface q may lie and
                                          // still be seen by it (cube-side units)
+uniform bool u_check_visibility;         // false: the paper's texturing, no visibility
 
 // Whether image k saw the point q (it is its first surface from face k), given the depth
 // tested for visibility; a hull (depths 0) sees nothing this way, nor does an empty texel
@@ -24,7 +25,7 @@ void image_weights(vec3 q, vec3 towards, out float w[6]) {
     int nearest = 0;
     float total = 0.0;
     bool any_sees = false;
-    for (int k = 0; k < 6; ++k) any_sees = any_sees || (
+    for (int k = 0; k < 6; ++k) any_sees = any_sees || (u_check_visibility &&
         dot(u_face_normal[k], towards) > 0.0 && image_sees(k, q));
     for (int k = 0; k < 6; ++k) {
         float c = dot(u_face_normal[k], towards);
