@@ -392,3 +392,18 @@ def test_vehicle_sides_are_vertical(meshes):
 def test_vehicle_seed_changes_paint_or_size():
     a, b = assets.vehicle(seed=0), assets.vehicle(seed=1)
     assert not np.array_equal(a.positions, b.positions)
+
+
+def test_the_cup_is_closed_and_hollow():
+    from reliefkit.scene.assets.cup import FLOOR, RIM
+
+    mesh = assets.make_asset("cup")
+    assert is_closed_and_oriented(mesh.indices, len(mesh.positions))
+    assert signed_volume(mesh.positions, mesh.indices) > 0
+    assert np.abs(mesh.positions).max() <= 1.1
+    # a vertical line through the middle meets the floor's top, not the rim: the triangles
+    # above the axis point x = z = 0 lie at the floor
+    p = mesh.positions.astype(np.float64)[mesh.indices.astype(np.int64)]
+    near_axis = (np.abs(p[..., 0]).max(axis=1) < 0.05) & (np.abs(p[..., 2]).max(axis=1) < 0.05)
+    assert near_axis.any()
+    assert abs(p[near_axis][..., 1].max() - FLOOR) < 0.03 and FLOOR < RIM - 0.5

@@ -1,9 +1,11 @@
-"""Procedural demo assets: a terrain, a closed blob, a tree and a van, and textured surfaces.
+"""Procedural demo assets: a terrain, a closed blob, a tree and a van, a cup, and textured
+surfaces.
 
 The surfaces (`SURFACE_NAMES`, from :mod:`.surfaces`: a sphere, a dented sphere, a torus, two
 spheres, a plane, a tube, a vase and the Utah teapot) carry texture coordinates and smooth
 normals for techniques that need (u, v); `make_asset` builds them by name too, while
-`ASSET_NAMES` and `all_assets` keep to the four assets.
+`ASSET_NAMES` and `all_assets` keep to the four assets (the cup, `SHAPE_NAMES`, is a
+test shape for the depth objects).
 
 Every asset is deterministic for a given seed (``np.random.default_rng(seed)``), built with
 numpy, scipy and scikit-image only (nothing is downloaded) and returned as a
@@ -24,6 +26,7 @@ from collections.abc import Callable
 from ...errors import UsageError
 from ..mesh import RenderMesh
 from .blob import blob
+from .cup import cup
 from .surfaces import SURFACES
 from .terrain import terrain, terrain_heights
 from .tree import tree
@@ -31,9 +34,11 @@ from .vehicle import vehicle
 
 __all__ = [
     "ASSET_NAMES",
+    "SHAPE_NAMES",
     "SURFACE_NAMES",
     "all_assets",
     "blob",
+    "cup",
     "make_asset",
     "terrain",
     "terrain_heights",
@@ -42,6 +47,8 @@ __all__ = [
 ]
 
 ASSET_NAMES = ("terrain", "blob", "tree", "vehicle")
+#: Further shapes `make_asset` knows that are not in the demo set (`all_assets`).
+SHAPE_NAMES = ("cup",)
 
 #: The textured demo surfaces `make_asset` also knows (see :mod:`.surfaces`).
 SURFACE_NAMES = tuple(SURFACES)
@@ -51,6 +58,7 @@ _FACTORIES: dict[str, Callable[[], RenderMesh]] = {
     "blob": blob,
     "tree": tree,
     "vehicle": vehicle,
+    "cup": cup,
 }
 
 
@@ -65,7 +73,8 @@ def make_asset(name: str) -> RenderMesh:
     """
     factory = (_FACTORIES.get(name) or SURFACES.get(name)) if isinstance(name, str) else None
     if factory is None:
-        raise UsageError(f"unknown asset {name!r}; choose one of: {', '.join(ASSET_NAMES)} "
+        raise UsageError(f"unknown asset {name!r}; choose one of: "
+                         f"{', '.join(ASSET_NAMES + SHAPE_NAMES)} "
                          f"or a surface: {', '.join(SURFACE_NAMES)}")
     return factory()
 
