@@ -25,13 +25,13 @@ from __future__ import annotations
 
 import json
 import os
-import platform
 import statistics
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ...bench.report import machine, machine_line
 from ...io.atomic import atomic_path
 from ...scene.assets.surfaces import TEAPOT_SHELL
 
@@ -434,20 +434,6 @@ def filtering(cfg: BenchConfig) -> list[dict]:
 
 # -- the run --------------------------------------------------------------------------------
 
-def machine() -> dict:
-    info = {"platform": platform.platform(), "cpu": platform.processor() or platform.machine(),
-            "cpus": os.cpu_count(), "python": platform.python_version(),
-            "renderer": "unavailable", "gl": "unavailable"}
-    try:
-        from ...gl.context import gl_info
-
-        gl = gl_info()
-        info |= {"renderer": gl.get("renderer"), "gl": gl.get("version")}
-    except Exception as error:  # no GL context: say so instead of failing the report
-        info["renderer"] = f"unavailable ({type(error).__name__}: {error})"
-    return info
-
-
 def run(cfg: BenchConfig, log=print) -> dict:
     results = {"machine": machine(),
                "config": {"size": cfg.size, "samples": list(cfg.samples),
@@ -554,8 +540,7 @@ def _f(value, fmt: str = ".2f", none: str = "—") -> str:
 
 def markdown(results: dict) -> str:
     m, c = results["machine"], results["config"]
-    lines = [f"Machine: {m['renderer']}, {m['gl']}, {m['platform']}, CPU {m['cpu']} x "
-             f"{m['cpus']}, Python {m['python']}; images {c['size']}², median of "
+    lines = [machine_line(m)[:-1] + f"; images {c['size']}², median of "
              f"{c['repeats']} draws; textures {'x'.join(map(str, c['texture_size']))} (W x H x "
              f"D)." + (" Quick run." if c["quick"] else ""), ""]
     lines += ["#### Table 1: frame time (ms) by scene and samples", "",

@@ -10,7 +10,7 @@ objects with visual hulls (§4-§5, `depth_object_part`); this module merges the
 
 from __future__ import annotations
 
-from ...core.technique import Technique
+from ...core.technique import BenchSuite, Technique
 from .depth_object_part import PART as DEPTH_OBJECTS
 from .displacement_part import PART as DISPLACEMENT
 
@@ -33,6 +33,12 @@ def _samples() -> dict:
     return out
 
 
+def _bench(quick, out, log):
+    from .bench import run_suite
+
+    return run_suite(quick, out, log)
+
+
 def _cli_examples() -> dict:
     out: dict = {}
     for part in PARTS:
@@ -52,6 +58,9 @@ TECHNIQUE = Technique(
     drawables=_merged("drawables"),
     compare_variants=_merged("compare_variants"),
     compare_metrics=_merged("compare_metrics"),
+    bench_suites=(BenchSuite("slicing", "quality, convergence, texturing, Fig. 12 and the "
+                             "stencil passes of the displacement slicing and depth objects "
+                             "paper, with Open3D's carving as a peer", _bench),),
     demo_tiles=_demo_tiles,
     programs=_merged("programs"),
     samples=_samples,
