@@ -41,7 +41,7 @@ class BenchConfig:
     assets: tuple = ("blob", "vehicle", "cup")
     views: tuple = ((35.0, 25.0), (150.0, -20.0))
     slice_counts: tuple = (32, 64, 128, 256, 512)
-    convergence_counts: tuple = (128, 256, 512, 1024, 2048, 4096)
+    convergence_counts: tuple = (256, 512, 1024, 2048, 4096, 8192)
     texturing_views: tuple = ((40.0, 20.0), (130.0, 35.0), (-60.0, 15.0), (200.0, 50.0),
                               (10.0, -20.0))
     coverages: tuple = (100, 200, 300, 400, 500)
