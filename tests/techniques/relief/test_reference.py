@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from reliefkit.reference.heightfield import surface_height
 from reliefkit.render import render
 from reliefkit.scene.assets import make_asset
 from reliefkit.scene.camera import Camera
@@ -18,7 +19,6 @@ from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.relief.bake import bake_relief
 from reliefkit.techniques.relief.frustum import bake_relief_cube, bake_relief_frustum
 from reliefkit.techniques.relief.reference import reference_hits, wrong_hits
-from reliefkit.techniques.relief.reference_heightfield import surface_height
 from reliefkit.techniques.relief.representation import ReliefObject
 
 BAKES = {

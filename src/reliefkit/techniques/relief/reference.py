@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.transforms import homogeneous
+from ...reference.heightfield import intersect_rays, surface_height
 from ...scene.camera import pixel_segments
-from .reference_heightfield import intersect_rays, surface_height
 from .representation import ReliefObject, ReliefTexture
 
 FLOOR_EPS = 1e-7

@@ -3,7 +3,7 @@
 Definition (the contract the renderer's robust walk relies on)
 --------------------------------------------------------------
 Texel coordinates, heights and the bilinear, border-clamped surface ``S`` are those of
-:mod:`reliefkit.techniques.relief.reference_heightfield`. Let a ray have projected direction
+:mod:`reliefkit.reference.heightfield`. Let a ray have projected direction
 ``(dx, dy)`` in texel units. If ``|dx| >= |dy|`` it is *x-major*: its walk positions ``P``
 are the points where it crosses the vertical centerlines ``x = i + 0.5``; the texel of such
 a ``P`` is ``(i, j)`` with ``j = clamp(floor(y_P), 0, H - 1)``, its radius is ``r =
@@ -77,7 +77,7 @@ import numpy as np
 from numba import njit, prange
 
 from ...errors import UsageError
-from .reference_heightfield import JIT_OPTIONS, as_height
+from ...reference.heightfield import JIT_OPTIONS, as_height
 
 __all__ = [
     "NUMERIC_FLOOR",

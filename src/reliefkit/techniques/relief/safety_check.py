@@ -1,7 +1,7 @@
 """Brute-force checker of safety radii, built only on the exact heightfield reference.
 
 It is independent of the baker (`safety.py`): rays are generated in the walk's own terms
-and judged with `reference_heightfield`, so a radius that lets the robust walk skip a
+and judged with `reliefkit.reference.heightfield`, so a radius that lets the robust walk skip a
 violating pair of crossings is reported as a `Violation`.
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit, prange
 
 from ...errors import UsageError
-from .reference_heightfield import (
+from ...reference.heightfield import (
     JIT_OPTIONS,
     cell_quadratic,
     clip_box,
@@ -297,7 +297,7 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     before ``P``). For the others every pair of crossings (down, then up) strictly between
     ``P`` and the jump target ``radius`` centerlines further (cut at the box boundary) whose
     largest depth exceeds ``tolerance + CHECK_FLOOR`` is a violation. Crossings, depths and
-    blocking use only :mod:`reliefkit.techniques.relief.reference_heightfield`, not the baker.
+    blocking use only :mod:`reliefkit.reference.heightfield`, not the baker.
 
     Parameters
     ----------

@@ -4,7 +4,7 @@
 //   METHOD_EXACT   walk from centreline to centreline (Amanatides-Woo in 2D, section 3.3)
 //   METHOD_ROBUST  jump by safety radii along the major axis, then binary search (section 3.4)
 // `iters` counts loop iterations (one height evaluation each) for the benchmarks.
-#include "heightfield.glsl"
+#include "core:include/heightfield.glsl"
 
 #define HARD_CAP 16384
 uniform int u_linear_steps;   // binary: number of fixed pre-steps

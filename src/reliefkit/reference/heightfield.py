@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ...errors import UsageError
+from ..errors import UsageError
 
 __all__ = [
     "JIT_OPTIONS",

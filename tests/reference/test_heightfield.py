@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from reliefkit.errors import UsageError
-from reliefkit.techniques.relief.reference_heightfield import (
+from reliefkit.reference.heightfield import (
     cells_visited,
     intersect_ray,
     intersect_rays,
