@@ -115,16 +115,21 @@ class SliceStack:
     def area_pixels(self, camera) -> float:
         """Total projected area of all slices in pixels (the fill the stack costs), without
         clipping to the viewport or the near plane."""
-        if not len(self.triangles):
-            return 0.0
-        clip = (np.asarray(camera.proj) @ np.asarray(camera.view)
-                @ np.c_[self.positions, np.ones(len(self.positions))].T).T
-        ndc = clip[:, :2] / clip[:, 3:4]
-        w, h = camera.size
-        pix = (ndc + 1.0) * 0.5 * np.array([w, h], dtype=np.float64)
-        t = pix[self.triangles]
-        d1, d2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
-        return float(np.abs(0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])).sum())
+        return projected_area(self.positions[self.triangles].reshape(-1, 3), camera)
+
+
+def projected_area(corners: np.ndarray, camera) -> float:
+    """Projected area in pixels of a triangle list given as (3M, 3) world corners, without
+    clipping (the fragments slices cost)."""
+    if not len(corners):
+        return 0.0
+    clip = np.c_[corners, np.ones(len(corners))] @ (np.asarray(camera.proj)
+                                                     @ np.asarray(camera.view)).T
+    w = np.where(np.abs(clip[:, 3:4]) > 1e-12, clip[:, 3:4], 1e-12)
+    pix = (clip[:, :2] / w + 1.0) * 0.5 * np.asarray(camera.size, dtype=np.float64)
+    t = pix.reshape(-1, 3, 2)
+    d1, d2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    return float(np.abs(0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])).sum())
 
 
 # --- validation -------------------------------------------------------------------------------
@@ -420,12 +425,13 @@ def pixel_world_size(camera, point) -> float:
     return step / pixels if pixels > 0 else math.inf
 
 
-def auto_slice_count(thickness: float, camera, centre, finest: float) -> int:
+def auto_slice_count(thickness: float, camera, centre, finest: float,
+                     maximum: int = AUTO_MAX) -> int:
     """The automatic slice count for a volume ``thickness`` deep along the slicing normal:
     slices one pixel apart at ``centre`` (the volume's size on screen decides), but never
-    closer than ``finest`` (a texel of the images: closer slices add nothing), clamped to
-    [`AUTO_MIN`, `AUTO_MAX`]."""
+    closer than ``finest`` (about a texel: closer slices add nothing), clamped to
+    [`AUTO_MIN`, ``maximum``]."""
     spacing = max(pixel_world_size(camera, centre), float(finest))
     if not math.isfinite(spacing) or spacing <= 0:
         return AUTO_MIN
-    return int(min(AUTO_MAX, max(AUTO_MIN, math.ceil(thickness / spacing - 1e-9))))
+    return int(min(maximum, max(AUTO_MIN, math.ceil(thickness / spacing - 1e-9))))

@@ -1,0 +1,89 @@
+"""The .rk kind ``displacement``: a base mesh and its displacement texture.
+
+Arrays: ``positions`` float64 (V, 3) world, ``indices`` int32 (F, 3), ``normals`` float32
+(V, 3), ``uvs`` float32 (V, 2), ``color`` float32 (H, W, 4) linear straight alpha, ``height``
+float32 (H, W) in [0, 1]. Typed params (they change rendering, so they are checked here):
+``scale`` (a positive number), ``tile`` [U, V] (positive numbers), ``wrap`` (a bool); the
+rest (``source``, ``texture``) is provenance. The volume's tetrahedra are rebuilt when drawn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import FormatError, MeshError, UsageError
+from ...io.rk import ArraySpec, Codec
+from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
+
+MAX_BASE_VERTICES = 1 << 22
+MAX_BASE_TRIANGLES = 1 << 22
+
+ARRAYS = {
+    "positions": ArraySpec(("float64",), ndim=2, trailing=(3,), finite=True),
+    "indices": ArraySpec(("int32",), ndim=2, trailing=(3,)),
+    "normals": ArraySpec(("float32",), ndim=2, trailing=(3,), finite=True),
+    "uvs": ArraySpec(("float32",), ndim=2, trailing=(2,), finite=True),
+    "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True),
+    "height": ArraySpec(("float32",), ndim=2, finite=True),
+}
+OWN = ("scale", "tile", "wrap")
+
+
+def _to_arrays(rep: DisplacementMap) -> tuple[dict, dict]:
+    base = rep.base
+    arrays = {"positions": base.world_positions, "indices": base.indices.astype(np.int32),
+              "normals": base.normals, "uvs": base.uvs, "color": rep.color,
+              "height": rep.height}
+    params = {k: v for k, v in rep.params.items() if k not in OWN}
+    return arrays, params | {"scale": rep.scale, "tile": list(rep.tile), "wrap": rep.wrap}
+
+
+def _number(value) -> bool:
+    return not isinstance(value, bool) and isinstance(value, int | float) and bool(
+        np.isfinite(value))
+
+
+def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
+    from ...scene.mesh import RenderMesh
+
+    params = dict(params)
+    scale, tile, wrap = (params.pop(k, None) for k in OWN)
+    if not (_number(scale) and scale > 0):
+        raise FormatError(f"displacement param 'scale' must be a positive number, got "
+                          f"{scale!r}")
+    if not (isinstance(tile, list) and len(tile) == 2
+            and all(_number(t) and 0 < t <= MAX_TILE for t in tile)):
+        raise FormatError(f"displacement param 'tile' must be two numbers in (0, "
+                          f"{MAX_TILE:g}], got {tile!r}")
+    if not isinstance(wrap, bool):
+        raise FormatError(f"displacement param 'wrap' must be true or false, got {wrap!r}")
+    positions = arrays["positions"]
+    count = len(positions)
+    if count > MAX_BASE_VERTICES or len(arrays["indices"]) > MAX_BASE_TRIANGLES:
+        raise FormatError(f"a displacement map's base has at most {MAX_BASE_VERTICES} "
+                          f"vertices and {MAX_BASE_TRIANGLES} triangles")
+    for key in ("normals", "uvs"):
+        if len(arrays[key]) != count:
+            raise FormatError(f"displacement array '{key}' has {len(arrays[key])} rows, the "
+                              f"base has {count} vertices")
+    height, color = arrays["height"], arrays["color"]
+    if height.size > MAX_TEXELS or color.shape != (*height.shape, 4):
+        raise FormatError(f"displacement arrays 'color' {color.shape} and 'height' "
+                          f"{height.shape} must be (H, W, 4) and (H, W), at most "
+                          f"{MAX_TEXELS} texels")
+    if height.size and (height.min() < 0 or height.max() > 1):
+        raise FormatError("displacement array 'height' must lie in [0, 1]")
+    if color.size and (color.min() < 0 or color.max() > 1):
+        raise FormatError("displacement array 'color' must lie in [0, 1]")
+    try:
+        colors = np.broadcast_to(np.float32(1.0), (count, 4))
+        base = RenderMesh(positions, arrays["indices"], arrays["normals"], colors,
+                          arrays["uvs"], name=str(params.get("source", "displacement base")))
+        return DisplacementMap(base, color, height, float(scale),
+                               (float(tile[0]), float(tile[1])), wrap, params)
+    except (UsageError, MeshError, ValueError) as exc:
+        raise FormatError(f"invalid displacement map: {exc}") from None
+
+
+CODECS = (Codec(kind="displacement", cls=DisplacementMap, arrays=ARRAYS, to_arrays=_to_arrays,
+                from_arrays=_from_arrays, version=1),)

@@ -1,0 +1,192 @@
+"""Displacement maps drawn by slicing against the exact CPU reference (ray vs bilinear
+heightfield, `reliefkit.reference.heightfield`) and against a finely tessellated displaced
+mesh; the alpha tests of §3.1 and §3.2."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from reliefkit.render import render
+from reliefkit.scene.views import orbit_bounds
+from reliefkit.techniques.slicing.displacement import DisplacementMap
+from reliefkit.techniques.slicing.displacement_bake import square_base
+from reliefkit.techniques.slicing.displacement_reference import reference_hits, wrong_hits
+from reliefkit.techniques.slicing.displacement_textures import terrain_colors, waves
+
+RES = 32
+HOLE = (0.3, 0.65, 0.15)  # centre u, v and radius of the zero-displacement disc
+
+
+def heights() -> np.ndarray:
+    x, y = np.meshgrid((np.arange(RES) + 0.5) / RES, (np.arange(RES) + 0.5) / RES)
+    h = np.clip(0.5 + 0.3 * np.sin(2 * np.pi * x * 1.5) * np.cos(2 * np.pi * y), 0, 1)
+    h[np.hypot(x - HOLE[0], y - HOLE[1]) < HOLE[2]] = 0.0
+    return h.astype(np.float32)
+
+
+@pytest.fixture(scope="module")
+def rep():
+    h = heights()
+    return DisplacementMap(square_base(), terrain_colors(h), h, 0.5)
+
+
+def camera(rep, az=30.0, el=40.0, size=96):
+    return orbit_bounds(rep.bounds, az, el, 2.4, size=(size, size))
+
+
+def _save_failure(tmp_path, name, frame, wrong):
+    from PIL import Image
+
+    Image.fromarray((frame.mask * 255).astype(np.uint8)).save(tmp_path / f"{name}_mask.png")
+    Image.fromarray((wrong * 255).astype(np.uint8)).save(tmp_path / f"{name}_wrong.png")
+    return str(tmp_path)
+
+
+# the slice count at which each mode first reaches <= 0.5% wrong pixels here (measured)
+CONVERGED = {("surface", "fill"): 128, ("orthogonal", "fill"): 64, ("screen", "fill"): 64}
+
+
+@pytest.mark.parametrize("mode, test", list(CONVERGED))
+def test_wrong_hits_fall_with_the_slice_count(gl, rep, mode, test, tmp_path):
+    cam = camera(rep)
+    fractions = []
+    for k in (4, 16, CONVERGED[(mode, test)]):
+        frame = render(rep, cam, slicing=mode, slices=k, alpha_test=test, unlit=True)
+        assert frame.stats["slices"] == k and frame.stats["slicing"] == mode
+        out = wrong_hits(frame, rep, cam)
+        fractions.append(out["wrong_fraction"])
+    assert fractions[0] > 0.2 > fractions[1] > fractions[2], fractions
+    where = _save_failure(tmp_path, mode, frame, out["wrong"])
+    assert fractions[2] <= 0.005, f"{fractions}; masks in {where}"
+    assert out["depth_error_texels"] < 0.5
+
+
+def test_orthogonal_and_screen_mask_out_zero_displacement(gl, rep):
+    cam = orbit_bounds(rep.bounds, 7.0, 80.0, 2.0, size=(96, 96))
+    ref, _ = reference_hits(rep, cam, floor=False)
+    # pixels that look straight down into the hole's centre
+    hole_world = np.array([2 * HOLE[0] - 1, 0.0, 2 * HOLE[1] - 1])
+    assert rep.one_polygon_box() is not None
+    for mode in ("orthogonal", "screen"):
+        frame = render(rep, cam, slicing=mode, slices=32)
+        near_hole = np.linalg.norm(frame.position - hole_world, axis=-1) < 0.1
+        assert not near_hole.any(), mode
+        assert (frame.mask & ~ref).sum() <= 0.002 * ref.sum()
+    fill = render(rep, cam, slicing="surface", slices=64, alpha_test="fill")
+    on_base = (np.linalg.norm(fill.position - hole_world, axis=-1) < 0.1)
+    assert on_base.sum() > 20  # the basic method draws the base where the height is 0
+    np.testing.assert_allclose(fill.position[on_base][:, 1], 0.0, atol=1e-5)
+    floor_ref, _ = reference_hits(rep, cam, floor=True)
+    assert (fill.mask != floor_ref).sum() <= 0.01 * floor_ref.sum()
+
+
+def test_bound_sees_through_where_fill_fills(gl, rep):
+    """Schaufler's bound keeps only fragments within one slice of the height: at an oblique
+    view it leaves holes in steep walls that Dietrich's fill closes (§3.1)."""
+    cam = camera(rep, az=30.0, el=20.0)
+    fill = render(rep, cam, slicing="surface", slices=24, alpha_test="fill")
+    bound = render(rep, cam, slicing="surface", slices=24, alpha_test="bound")
+    assert bound.mask.sum() < 0.97 * fill.mask.sum()
+    # where the bound test draws, the fill draws too (but for slices up to one spacing
+    # above the surface at silhouettes)
+    assert (bound.mask & ~fill.mask).sum() <= 0.04 * bound.mask.sum()
+    assert bound.stats["alpha_test"] == "bound" and fill.stats["alpha_test"] == "fill"
+
+
+def test_surface_slicing_looks_through_at_grazing_angles(gl, rep):
+    """Fig. 4: surface-aligned slices seen from a grazing angle leave gaps that orthogonal
+    slicing does not."""
+    cam = camera(rep, az=30.0, el=6.0)
+    surface = wrong_hits(render(rep, cam, slicing="surface", slices=16, alpha_test="bound"),
+                         rep, cam)
+    ortho = wrong_hits(render(rep, cam, slicing="orthogonal", slices=16), rep, cam)
+    assert ortho["missed"] < 0.5 * surface["missed"]
+
+
+def test_normals_and_positions_of_a_flat_displacement(gl):
+    res = 8
+    h = np.full((res, res), 0.5, np.float32)
+    rep = DisplacementMap(square_base(), np.ones((res, res, 4), np.float32), h, 0.4)
+    cam = orbit_bounds(rep.bounds, 15.0, 60.0, 2.4, size=(64, 64))
+    for mode in ("surface", "orthogonal", "screen"):
+        frame = render(rep, cam, slicing=mode, slices=20)
+        spacing = frame.stats["slice_spacing"]
+        top = frame.mask & (frame.position[..., 1] > 0.2 - spacing - 1e-5)
+        assert top.sum() > 0.5 * frame.mask.sum(), mode
+        np.testing.assert_allclose(frame.normal[top], [[0, 1, 0]] * int(top.sum()), atol=1e-4)
+        # the top at 0.2 is found within one slice spacing below it
+        assert (frame.position[top][:, 1] <= 0.2 + 1e-5).all()
+        assert frame.stats["slice_polygons"] > 0 and frame.stats["fill_pixels"] > 0
+
+
+def test_coverage_of_a_displaced_torus_matches_its_tessellation(gl):
+    from reliefkit.scene.assets.surfaces import torus
+
+    color, height = waves(res=32)
+    rep = DisplacementMap(torus(major_segments=25, minor_segments=25), color, height, 0.12,
+                          (2.0, 1.0), True)
+    truth = rep.displaced_mesh(6)
+    cam = orbit_bounds(rep.bounds, 30.0, 35.0, 2.4, size=(96, 96))
+    expected = render(truth, cam).mask
+    for mode in ("orthogonal", "screen"):
+        got = render(rep, cam, slicing=mode, slices=24).mask
+        iou = (got & expected).sum() / (got | expected).sum()
+        assert iou > 0.97, (mode, iou)
+
+
+def test_compare_metric_scores_one_polygon_maps_only(gl, rep):
+    from reliefkit.core.technique import technique
+    from reliefkit.techniques.slicing.displacement_demo import furry_donut
+
+    tech = technique("slicing")
+    (metric,) = [m for m in tech.compare_metrics if m.name == "displacement reference"]
+    cam = camera(rep, size=64)
+    good = render(rep, cam, slicing="screen", slices=64)
+    poor = render(rep, cam, slicing="screen", slices=4)
+    scores, wrong = metric.measure(good, rep, cam)
+    worse, _ = metric.measure(poor, rep, cam)
+    assert wrong.shape == (64, 64) and scores["slices"] == 64
+    assert scores["reference_wrong"] < 0.02 < worse["reference_wrong"]
+    assert scores["reference_depth_texels"] < worse["reference_depth_texels"]
+    donut = furry_donut(res=16)
+    assert metric.measure(render(donut, cam, slices=4), donut, cam) == ({}, None)
+    names = [v.name for v in tech.compare_variants if v.available(rep)]
+    assert {"orthogonal slicing", "screen slicing", "surface slicing (fill)",
+            "surface slicing (bound)"} <= set(names)
+
+
+def test_the_furry_donut_tile_is_figure_1(gl):
+    from reliefkit.core.technique import technique
+
+    tech = technique("slicing")
+    (tile,) = [t for t in tech.demo_tiles() if t.slug == "displacement-donut"]
+    rep = tile.make()
+    assert rep.triangle_count == 2 * 625  # 25 x 25 quads
+    assert tile.options["slicing"] == "orthogonal" and 15 <= tile.options["slices"] <= 25
+    cam = orbit_bounds(rep.bounds, *tile.view, size=(64, 64))
+    frame = render(rep, cam, **tile.options)
+    assert frame.mask.sum() > 500 and frame.stats["direction_b"] + frame.stats[
+        "direction_c"] > 0  # grazing prisms slice along b or c
+    sample = tech.samples()["displacement"]
+    assert sample.triangle_count == 1250
+    for other in tech.demo_tiles():
+        if other.slug.startswith("displacement-") and other is not tile:
+            made = other.make()
+            small = orbit_bounds(made.bounds, *other.view, size=(32, 32))
+            shot = render(made, small, **other.options)
+            assert shot.mask.sum() > 50 and shot.stats["slicing"] == other.options["slicing"]
+
+
+def test_automatic_slices_halve_to_fit_the_polygon_budget(gl, rep, monkeypatch):
+    from reliefkit.errors import UsageError
+    from reliefkit.techniques.slicing import displacement_slices
+
+    cam = orbit_bounds(rep.bounds, 30.0, 40.0, 2.4, size=(256, 256))
+    free = render(rep, cam, slicing="screen")
+    assert free.stats["slices"] == 8  # scale 0.5 / texel 2/32, the texel bound
+    monkeypatch.setattr(displacement_slices, "MAX_POLYGONS", free.stats["slice_polygons"] - 1)
+    fitted = render(rep, cam, slicing="screen")
+    assert fitted.stats["slices"] == 4
+    with pytest.raises(UsageError, match="slice polygons"):
+        render(rep, cam, slicing="screen", slices=8)
