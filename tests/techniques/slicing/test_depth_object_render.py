@@ -146,3 +146,14 @@ def test_stats_count_the_fill(objects):
     assert frame.stats["slices"] == 20 and frame.stats["slice_polygons"] == 20
     # screen slices fill about the cube's depth in slices over its silhouette
     assert frame.stats["fill_per_covered_pixel"] > 5
+
+
+def test_bounds_hold_the_object_within_half_a_texel(objects):
+    from slicing_scenes import BOX_HI, BOX_LO
+
+    rep = objects["box"]
+    half = 0.5 * rep.images.texel
+    lo, hi = rep.bounds
+    assert (lo <= BOX_LO + 1e-9).all() and (hi >= BOX_HI - 1e-9).all()
+    assert (lo >= BOX_LO - 2 * half).all() and (hi <= BOX_HI + 2 * half).all()
+    assert (rep.cube_bounds[0] <= lo).all() and (rep.cube_bounds[1] >= hi).all()

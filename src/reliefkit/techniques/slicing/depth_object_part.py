@@ -64,11 +64,11 @@ def _demo_tiles() -> list[DemoTile]:
         return make
 
     return [DemoTile("depth object: vehicle", "depth-object-vehicle", baked("vehicle", False),
-                     (40.0, 20.0, None), {"slicing": "orthogonal"}),
+                     (40.0, 20.0, None)),
             DemoTile("depth object: blob", "depth-object-blob", baked("blob", False),
-                     (35.0, 30.0, None), {"slicing": "orthogonal"}),
+                     (35.0, 30.0, None)),
             DemoTile("visual hull: blob", "visual-hull-blob", baked("blob", True),
-                     (35.0, 30.0, None), {"slicing": "orthogonal"})]
+                     (35.0, 30.0, None))]
 
 
 PART = Part(

@@ -35,7 +35,7 @@ def bumpy_square(res: int = 64):
 
 
 def demo_tiles() -> list[DemoTile]:
-    tiles = [DemoTile("displacement: furry donut (Fig. 1, orthogonal)", "displacement-donut",
+    tiles = [DemoTile("displacement: furry donut (Fig. 1)", "displacement-donut",
                       furry_donut, (30.0, 35.0, 2.4),
                       {"slicing": "orthogonal", "slices": DONUT_SLICES})]
     for mode in ("surface", "orthogonal", "screen"):

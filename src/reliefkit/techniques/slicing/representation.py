@@ -37,11 +37,39 @@ class DepthObject:
         return self.images.resolution
 
     @property
-    def bounds(self) -> np.ndarray:
+    def cube_bounds(self) -> np.ndarray:
         """(2, 3) world box of the cube."""
         c = self.images.cube_to_world
         lo = c[:3, 3]
         return np.array([lo, lo + np.diag(c)[:3]])
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) world box of the object: per axis, the texels that the silhouettes of the
+        four images across that axis cover, grown by half a texel (a silhouette misses at
+        most that much, where no texel centre is covered); the cube's if no image sees
+        anything."""
+        from ...bake.project import axis_frame
+        from .depth_images import FACE_INDEX
+
+        n = self.resolution
+        lo, hi = np.ones(3), np.zeros(3)
+        for face, k in FACE_INDEX.items():
+            mask = self.images.mask[k]
+            if not mask.any():
+                continue
+            frame = axis_frame(face)  # rows u, v, h in cube axes
+            corner = 0.5 - 0.5 * frame.sum(axis=0)
+            rows, cols = np.nonzero(mask)
+            for along, index in ((frame[0], cols), (frame[1], rows)):
+                a = int(np.argmax(np.abs(along)))
+                ends = corner[a] + along[a] * np.array([index.min(), index.max() + 1]) / n
+                lo[a], hi[a] = min(lo[a], ends.min()), max(hi[a], ends.max())
+        if (lo >= hi).any():
+            return self.cube_bounds
+        lo, hi = np.maximum(lo - 0.5 / n, 0.0), np.minimum(hi + 0.5 / n, 1.0)
+        cube = self.images.cube_to_world
+        return np.array([cube[:3, 3] + lo * cube[0, 0], cube[:3, 3] + hi * cube[0, 0]])
 
     @property
     def tested_faces(self) -> tuple[int, ...]:
