@@ -30,6 +30,13 @@ from .techniques.relief import (
     relief_from_heights,
 )
 from .techniques.shellvolume import TexturedShell, VolumeTexture, build_shell, visibility_order
+from .techniques.slicing import (
+    DepthImages,
+    DepthObject,
+    DisplacementMap,
+    VisualHull,
+    bake_depth_images,
+)
 
 __all__ = [
     "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
@@ -37,6 +44,7 @@ __all__ = [
     "relief_from_heights", "ReliefTexture", "ReliefObject", "build_billboard_cloud",
     "bake_billboard_cloud", "bake_boxes", "BillboardCloud", "BillboardBoxes",
     "build_shell", "visibility_order", "VolumeTexture", "TexturedShell",
+    "bake_depth_images", "DepthImages", "DepthObject", "VisualHull", "DisplacementMap",
     "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
 ]
 __version__ = "0.1.0"

@@ -6,13 +6,19 @@ depth images).
 Two halves, each a `parts.Part`: displacement maps (§3, `displacement_part`) and depth
 objects with visual hulls (§4-§5, `depth_object_part`); this module merges them into one
 `Technique`.
+
+The public API re-exported by `reliefkit`: `DepthImages`, `bake_depth_images`,
+`DepthObject`, `VisualHull`, `DisplacementMap`.
 """
 
 from __future__ import annotations
 
 from ...core.technique import BenchSuite, Technique
+from .depth_images import DepthImages, bake_depth_images
 from .depth_object_part import PART as DEPTH_OBJECTS
+from .displacement import DisplacementMap
 from .displacement_part import PART as DISPLACEMENT
+from .representation import DepthObject, VisualHull
 
 PARTS = (DEPTH_OBJECTS, DISPLACEMENT)
 
@@ -67,4 +73,5 @@ TECHNIQUE = Technique(
     cli_examples=_cli_examples(),
 )
 
-__all__ = ["TECHNIQUE"]
+__all__ = ["TECHNIQUE", "DepthImages", "DepthObject", "DisplacementMap", "VisualHull",
+           "bake_depth_images"]
