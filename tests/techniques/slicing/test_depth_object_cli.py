@@ -102,3 +102,28 @@ def test_compare_lists_every_variant_with_reference_columns(tmp_path):
                  "nearest image", "visual hull"):
         assert name in text
     assert "reference_wrong" in text and (tmp_path / "cmp" / "compare.png").exists()
+
+
+@pytest.fixture(scope="module")
+def flat_van(tmp_path_factory):
+    """The van: much flatter than its cube, whose corners lie far outside its bounds."""
+    path = tmp_path_factory.mktemp("van") / "van.rk"
+    out = run_cli("bake", "demo:vehicle", "--as", "depth-object", "--res", "32", "-o", path)
+    assert out.returncode == 0, out.stderr
+    return path
+
+
+@pytest.mark.parametrize("view", ["30,25", "200,-30", "90,0,1.3"])
+def test_framed_views_draw_the_whole_object(flat_van, tmp_path, view):
+    """The CLI's views hug the object's bounds with their near and far planes: ray casting
+    (whose proxy is the object's box, not the cube) and the slab test (exact slices) agree
+    pixel for pixel."""
+    masks = {}
+    for name, options in (("ray", ("--slicing", "raycast")),
+                          ("slab", ("--alpha-test", "slab", "--slices", "24"))):
+        out = run_cli("render", flat_van, "--size", "48x48", "--view", view, *options,
+                      "-o", tmp_path / f"{name}.png", "--aovs", tmp_path / f"{name}.npz")
+        assert out.returncode == 0, out.stderr
+        masks[name] = np.load(tmp_path / f"{name}.npz")["mask"]
+    assert masks["ray"].sum() > 100
+    assert (masks["ray"] != masks["slab"]).sum() <= 2

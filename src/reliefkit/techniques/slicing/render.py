@@ -151,10 +151,15 @@ class DepthObjectDrawable(GLObjects):
         check_gl_error(ctx, "uploading a depth object")
 
     def _cube_proxy(self) -> None:
+        """The object's box (its `bounds`, inside the cube), not the whole cube: views hug
+        the bounds with their near and far planes, which would clip the cube's corners."""
         from ...render.proxy import box_planes, convex_proxy
 
         cube = self.rep.images.cube_to_world
-        self.proxy = convex_proxy(box_planes(np.linalg.inv(cube)), near=self.centre)
+        lo, hi = self.rep.bounds
+        box = np.diag([*(hi - lo), 1.0])
+        box[:3, 3] = lo
+        self.proxy = convex_proxy(box_planes(np.linalg.inv(box)), near=0.5 * (lo + hi))
         corners = self.proxy.world_positions
         cube_coords = (np.c_[corners, np.ones(len(corners))] @ np.linalg.inv(cube).T)[:, :3]
         self._geometry(self.proxy.positions, cube_coords, self.proxy.triangles, self.proxy.origin)
