@@ -157,3 +157,32 @@ def test_bounds_hold_the_object_within_half_a_texel(objects):
     assert (lo <= BOX_LO + 1e-9).all() and (hi >= BOX_HI - 1e-9).all()
     assert (lo >= BOX_LO - 2 * half).all() and (hi <= BOX_HI + 2 * half).all()
     assert (rep.cube_bounds[0] <= lo).all() and (rep.cube_bounds[1] >= hi).all()
+
+
+def test_bake_report_warns_when_a_sheet_is_carved_away(gl):
+    """A ground plane under a box: the side images see the plane edge-on (no texels), so
+    they carve it away; the report says so. The closed box alone gets no warning."""
+    import trimesh
+
+    from reliefkit.scene.mesh import RenderMesh
+    from reliefkit.techniques.slicing.reference import carved_fraction
+
+    box = trimesh.creation.box(extents=(0.6, 0.6, 0.6))
+    box.apply_translation((0.0, 0.3, 0.0))
+    plane = trimesh.Trimesh([[-1, 0, -1], [1, 0, -1], [1, 0, 1], [-1, 0, 1]],
+                            [[0, 2, 1], [0, 3, 2]], process=False)
+    both = trimesh.util.concatenate([box, plane])
+
+    def mesh(tm):
+        pos = np.asarray(tm.vertices, np.float32)
+        return RenderMesh(pos, tm.faces, np.tile((0.0, 1.0, 0.0), (len(pos), 1)),
+                          np.ones((len(pos), 4)), name="scene")
+
+    closed = DepthObject(bake_depth_images(mesh(box), N))
+    sheet = DepthObject(bake_depth_images(mesh(both), N))
+    assert carved_fraction(closed.images).max() < 0.01
+    carved = carved_fraction(sheet.images)
+    assert carved[2] > 0.5 and carved[3] > 0.5  # the +y and -y images: mostly plane
+    assert not any(line.startswith("warning:") for line in closed.bake_report())
+    warning = [line for line in sheet.bake_report() if line.startswith("warning:")]
+    assert len(warning) == 1 and "carved away" in warning[0]

@@ -187,3 +187,15 @@ def test_reference_refuses_other_inputs(box_images):
         exact_intersection(object(), views(np.zeros(3))[0])
     with pytest.raises(UsageError, match="grid size"):
         voxel_carve(box_images, 0)
+
+
+def test_occupied_voxels_hold_every_carved_voxel_centre(sphere_images):
+    """A voxel whose centre is inside (the crude carve) meets the object's box there."""
+    from reliefkit.techniques.slicing.reference import occupied_voxels
+
+    occupied = occupied_voxels(sphere_images).transpose(2, 1, 0)  # [z, y, x] like the carve
+    carved = voxel_carve(sphere_images, N)
+    assert carved.sum() > 1000
+    assert not (carved & ~occupied).any()
+    # and only the boundary layer differs: a box meeting a voxel without its centre
+    assert occupied.sum() - carved.sum() < 0.1 * carved.sum()

@@ -213,3 +213,51 @@ def voxel_carve(images: DepthImages, n: int) -> np.ndarray:
     z, y, x = np.meshgrid(centres, centres, centres, indexing="ij")
     world = transform_points(images.cube_to_world, np.stack([x, y, z], axis=-1))
     return inside(images, world)
+
+
+def occupied_voxels(images: DepthImages) -> np.ndarray:
+    """(N, N, N) bool [x, y, z]: the cube voxels where the nearest-texel object is not
+    empty (its box there meets the voxel with a positive or zero extent on every axis)."""
+    _check(images)
+    n = images.resolution
+    b = images.column_bounds()  # (axis, lo/hi, i, j): x: [y, z], y: [x, z], z: [x, y]
+    edges = np.arange(n + 1) / n
+    lo_cell, hi_cell = edges[:-1], edges[1:]
+
+    def fits(lo, hi, cell_axis_shape):
+        lo_c = lo_cell.reshape(cell_axis_shape)
+        hi_c = hi_cell.reshape(cell_axis_shape)
+        return (np.maximum(lo, lo_c) <= np.minimum(hi, hi_c))
+
+    x = fits(b[0, 0][None, :, :], b[0, 1][None, :, :], (n, 1, 1))   # [x, y, z]
+    y = fits(b[1, 0][:, None, :], b[1, 1][:, None, :], (1, n, 1))
+    z = fits(b[2, 0][:, :, None], b[2, 1][:, :, None], (1, 1, n))
+    return x & y & z
+
+
+def carved_fraction(images: DepthImages) -> np.ndarray:
+    """(6,) per face: the fraction of its silhouette whose texel column holds no part of the
+    object, i.e. what the other images carve away (open or paper-thin surfaces seen edge-on
+    by them: a ground plane, a sheet). Closed solids give about 0."""
+    occupied = occupied_voxels(images)
+    from .depth_images import FACE_INDEX
+
+    out = np.zeros(6)
+    for face, k in FACE_INDEX.items():
+        mask = images.mask[k]
+        if not mask.any():
+            continue
+        axis = "xyz".index(face[-1])
+        column = occupied.any(axis=axis)  # indexed by the other two axes in order
+        rows, cols = np.nonzero(mask)
+        from ...bake.project import axis_frame
+
+        frame = axis_frame(face)
+        corner = 0.5 - 0.5 * frame.sum(axis=0)
+        u, v = (cols + 0.5) / images.resolution, (rows + 0.5) / images.resolution
+        q = corner + u[:, None] * frame[0] + v[:, None] * frame[1]
+        others = [a for a in range(3) if a != axis]
+        ib = np.floor(q[:, others[0]] * images.resolution).astype(int)
+        ic = np.floor(q[:, others[1]] * images.resolution).astype(int)
+        out[k] = float((~column[ib, ic]).mean())
+    return out

@@ -16,6 +16,10 @@ import numpy as np
 from ...errors import UsageError
 from .depth_images import DepthImages, visual_hull
 
+#: `DepthObject.bake_report` warns when more of one image's silhouette than this is carved
+#: away by the other images (`reference.carved_fraction`).
+CARVED_WARNING = 0.05
+
 
 @dataclass(eq=False)
 class DepthObject:
@@ -77,12 +81,23 @@ class DepthObject:
         return (0, 2, 4) if self.hull else tuple(range(6))
 
     def bake_report(self) -> list[str]:
+        from .reference import carved_fraction
+
         n = self.resolution
         covered = [f"{100 * float(m.mean()):.0f}%" for m in self.images.mask]
         kind = "visual hull" if self.hull else "depth object"
-        return [f"{kind}: six {n}x{n} depth images on a cube of side "
-                f"{self.images.side:.4g} (texel {self.images.texel:.3g}); silhouette cover "
-                f"per face (+x -x +y -y +z -z): {' '.join(covered)}"]
+        lines = [f"{kind}: six {n}x{n} depth images on a cube of side "
+                 f"{self.images.side:.4g} (texel {self.images.texel:.3g}); silhouette cover "
+                 f"per face (+x -x +y -y +z -z): {' '.join(covered)}"]
+        carved = carved_fraction(self.images)
+        worst = int(np.argmax(carved))
+        if carved[worst] > CARVED_WARNING:
+            names = ("+x", "-x", "+y", "-y", "+z", "-z")
+            lines.append(f"warning: {carved[worst]:.0%} of what the {names[worst]} image sees "
+                         "is carved away by the other images: open or paper-thin parts (a "
+                         "ground plane, a sheet) seen edge-on cannot be part of a depth "
+                         "object; bake a closed mesh, or the flat part as a relief texture")
+        return lines
 
 
 @dataclass(eq=False)
