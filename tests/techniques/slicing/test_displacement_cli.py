@@ -160,3 +160,41 @@ def test_a_projected_mesh_covers_what_the_mesh_covers_from_above(gl, baked):
     # the top of the sphere (y = 1) is where the displacement puts it
     top = got.mask & want.mask
     assert np.nanmax(got.position[top][:, 1]) == pytest.approx(1.0, abs=0.05)
+
+
+def test_an_rgba_displacement_texture_keeps_its_colours_and_alpha_heights(tmp_path):
+    """The paper's displacement texture: colour in RGB, displacement in alpha. Left half
+    alpha 0 (no displacement: masked out by orthogonal slicing), right half alpha 1 in red."""
+    from PIL import Image
+
+    rgba = np.zeros((16, 16, 4), np.uint8)
+    rgba[:, :8] = (0, 0, 255, 0)
+    rgba[:, 8:] = (255, 0, 0, 255)
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "tex.png")
+    path = tmp_path / "tex.rk"
+    out = run_cli("bake", "demo:plane", "--as", "displacement", "--displacement",
+                  tmp_path / "tex.png", "--displacement-scale", "0.2", "-o", path)
+    assert out.returncode == 0, out.stderr
+    rep = rk.load(path)
+    assert rep.height[:, :8].max() == 0 and rep.height[:, 8:].min() == 1
+    assert np.allclose(rep.color[0, 12, :3], (1, 0, 0), atol=1e-6)
+    out = run_cli("render", path, "--size", "48x48", "--view", "0,89.9,2.5", "--unlit",
+                  "--slicing", "orthogonal", "--slices", "16", "-o", tmp_path / "t.png",
+                  "--aovs", tmp_path / "t.npz")
+    assert out.returncode == 0, out.stderr
+    aovs = np.load(tmp_path / "t.npz")
+    mask, pos, color = aovs["mask"], aovs["position"], aovs["color"]
+    assert mask.sum() > 200
+    assert (pos[mask][:, 0] > -0.15).all()  # nothing left of the middle (u < 0.5)
+    # the top (the highest slice, h = 15.5 / 16), bar the bilinear ramp at the step
+    assert (np.abs(pos[mask][:, 1] - 0.2) < 0.02).mean() > 0.85
+    assert pos[mask][:, 1].max() <= 0.2 + 1e-4
+    assert (np.abs(color[mask][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.95
+
+
+def test_a_bad_rgba_npy_texture_is_a_one_line_error(tmp_path):
+    np.save(tmp_path / "bad.npy", np.zeros((8, 8, 3), np.float32))
+    out = run_cli("bake", "demo:plane", "--as", "displacement", "--displacement",
+                  tmp_path / "bad.npy", "-o", tmp_path / "x.rk")
+    assert_one_line_error(out, "(H, W, 4)")
+    assert not (tmp_path / "x.rk").exists()

@@ -88,14 +88,66 @@ def _scale(p: DisplacementParams, fallback: float) -> float:
 
 
 def _file_texture(spec: str):
+    """(colour, height) of a file: the paper's displacement texture (an RGBA .png, or an
+    (H, W, 4) .npy of linear floats, with the displacement in alpha) or a grey heightmap
+    (.png or a 2D .npy; colours from the terrain palette)."""
     from ...scene.heightmap import is_heightmap, load_heightmap
 
     if not is_heightmap(spec):
         raise UsageError(f"--displacement {spec}: not one of {', '.join(TEXTURES)}, nor a "
-                         "heightmap (.png or .npy)")
+                         "heightmap or displacement texture (.png or .npy)")
+    rgba = _rgba_texture(spec)
+    if rgba is not None:
+        return rgba
     # load_heightmap: row 0 is the image's top row; texture rows run along +v
     height = normalised_heights(load_heightmap(spec))
     return terrain_colors(height), height
+
+
+def _rgba_texture(spec: str):
+    """An RGBA displacement texture's (linear colour with alpha 1, height = alpha), or None
+    for a file without an alpha channel (then it is a heightmap)."""
+    from pathlib import Path
+
+    from ...colorspace import srgb_decode
+    from ...errors import FormatError
+
+    path = Path(spec)
+    if path.suffix.lower() == ".png":
+        from PIL import Image, UnidentifiedImageError
+
+        try:
+            with Image.open(path) as image:
+                if image.mode not in ("RGBA", "LA", "PA") and not (
+                        image.mode == "P" and "transparency" in image.info):
+                    return None
+                rgba = np.asarray(image.convert("RGBA"), np.float64) / 255.0
+        except (OSError, UnidentifiedImageError) as exc:
+            raise FormatError(f"{path}: not a readable PNG ({exc})") from None
+        color = srgb_decode(rgba[..., :3])
+    else:
+        try:
+            with open(path, "rb") as fh:
+                version = np.lib.format.read_magic(fh)
+                read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                        else np.lib.format.read_array_header_2_0)
+                shape, _, dtype = read(fh)
+        except (OSError, ValueError) as exc:
+            raise FormatError(f"{path}: not a readable .npy array ({exc})") from None
+        if len(shape) != 3:
+            return None
+        if shape[2] != 4 or dtype.kind != "f" or max(shape[:2]) > 8192:
+            raise FormatError(f"{path}: a displacement texture .npy must be (H, W, 4) float "
+                              f"RGBA (at most 8192 per side), got {shape} {dtype}")
+        rgba = np.load(path, allow_pickle=False).astype(np.float64)
+        if not np.isfinite(rgba).all():
+            raise FormatError(f"{path}: the texture contains NaN or Inf values")
+        color = np.clip(rgba[..., :3], 0.0, 1.0)
+    if min(rgba.shape[:2]) < 2:
+        raise FormatError(f"{path}: a displacement texture needs at least 2x2 texels")
+    height = np.clip(rgba[..., 3], 0.0, 1.0).astype(np.float32)
+    color = np.concatenate([color, np.ones((*height.shape, 1))], axis=-1).astype(np.float32)
+    return color, height
 
 
 def bake_displacement(source, p: DisplacementParams, progress=None) -> DisplacementMap:
