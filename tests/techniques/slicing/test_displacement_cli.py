@@ -189,7 +189,7 @@ def test_an_rgba_displacement_texture_keeps_its_colours_and_alpha_heights(tmp_pa
     # the top (the highest slice, h = 15.5 / 16), bar the bilinear ramp at the step
     assert (np.abs(pos[mask][:, 1] - 0.2) < 0.02).mean() > 0.85
     assert pos[mask][:, 1].max() <= 0.2 + 1e-4
-    assert (np.abs(color[mask][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.95
+    assert (np.abs(color[mask][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.85
 
 
 def test_a_bad_rgba_npy_texture_is_a_one_line_error(tmp_path):
