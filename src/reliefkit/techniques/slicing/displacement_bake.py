@@ -30,7 +30,11 @@ from .displacement_textures import (
     terrain_colors,
 )
 
-DEFAULT_SCALE = 0.1  # of the base's bounding-box diagonal, when --displacement-scale is not given
+#: Without --displacement-scale: a heightmap's square rises by this much of its diagonal ...
+DEFAULT_SCALE = 0.1
+#: ... and a mesh base by this much of its bounding-box diagonal (a skin like fur or bumps,
+#: as thick as a shell volume's default)
+DEFAULT_MESH_SCALE = 0.05
 SQUARE = 2.0         # side of a heightmap's polygon
 
 
@@ -38,7 +42,8 @@ SQUARE = 2.0         # side of a heightmap's polygon
 class DisplacementParams:
     displacement_scale: float | None = param(
         None, "world length of height 1 along the normals (none: the box height for a "
-        f"projected mesh, else {DEFAULT_SCALE:g} of the bounding-box diagonal)",
+        f"projected mesh, {DEFAULT_MESH_SCALE:g} of a mesh base's bounding-box diagonal, "
+        f"{DEFAULT_SCALE:g} of a heightmap square's)",
         kind="float", lo=1e-12)
     res: int = param(256, "displacement texture resolution (texels per side)", lo=2,
                      hi=8192)
@@ -171,7 +176,7 @@ def bake_displacement(source, p: DisplacementParams, progress=None) -> Displacem
     else:
         color, height = _file_texture(p.displacement)
         wrap = tile != (1.0, 1.0)
-    scale = _scale(p, DEFAULT_SCALE * _diagonal(source.bounds))
+    scale = _scale(p, DEFAULT_MESH_SCALE * _diagonal(source.bounds))
     base = _usable(source)
     return DisplacementMap(base, color, height, scale, tile, wrap,
                            params={"source": source.name, "texture": p.displacement})
