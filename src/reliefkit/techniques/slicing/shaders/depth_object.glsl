@@ -63,6 +63,8 @@ bool inside_all(vec3 q) {
 // An exact hit lies on a column's boundary, where a texel lookup could pick either side:
 // the images are read this far (in texels) further along the ray, inside the hit box.
 #define INSIDE_TEXELS 0.05
+// Hard cap of the voxel walk: 3 N + 3 steps at the largest N (depth_images.MAX_RESOLUTION).
+#define MAX_WALK 24579
 
 // [lo, hi] of axis a inside voxel v: the two images looking along a, at v's column.
 vec2 column(int a, ivec3 v) {
@@ -87,7 +89,7 @@ bool raycast(vec3 q0, vec3 dq, out vec3 hit, out int steps) {
     vec3 delta = abs(inv);
     float t = 0.0;
     steps = 0;
-    for (int i = 0; i < u_max_steps; ++i) {
+    for (int i = 0; i < min(u_max_steps, MAX_WALK); ++i) {
         ++steps;
         float t_next = min(min(next.x, next.y), next.z);
         float t1 = min(t_next, 1.0);
