@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FormatError
+from ..io.npy import npy_header
 
 HEIGHTMAP_SUFFIXES = (".png", ".npy")
 MAX_SIDE = 8192
@@ -34,10 +35,7 @@ def load_heightmap(path) -> np.ndarray:
 def _load_npy(path: Path) -> np.ndarray:
     try:
         with open(path, "rb") as fh:
-            version = np.lib.format.read_magic(fh)
-            read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
-                           else np.lib.format.read_array_header_2_0)
-            shape, _, dtype = read_header(fh)
+            shape, _, dtype = npy_header(fh)
             if dtype.hasobject or dtype.kind not in "biuf":
                 raise FormatError(f"{path}: heightmap must be a numeric array, got {dtype}")
             if len(shape) != 2 or max(shape, default=0) > MAX_SIDE:

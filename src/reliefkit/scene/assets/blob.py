@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import RenderMesh, vertex_normals
+from ..mesh import RenderMesh
 from .colors import mix, rgb, smoothstep
-from .geometry import Geometry, MeshBuilder, normalize
+from .geometry import Geometry, MeshBuilder, isosurface, normalize
 from .params import check_int
 
 
@@ -125,22 +125,11 @@ def blob(seed: int = 0, subdivisions: int = 4) -> RenderMesh:
         One closed part ``"blob"``; colours go from coral at the bottom to gold at the top,
         with dimples and creases tinted plum.
     """
-    from skimage.measure import marching_cubes  # heavy import, only needed here
-
     n = 5 * 2 ** check_int("subdivisions", subdivisions, 1, 5)
     rng = np.random.default_rng(seed)
     axis = np.linspace(-1.0, 1.0, n)
     grid = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1).astype(np.float32)
-    field = np.pad(_blob_field(grid, rng), 1, constant_values=1.0)  # closed at the border
-    step = axis[1] - axis[0]
-    verts, faces, _, _ = marching_cubes(field, level=0.0, spacing=(step, step, step))
-    positions = verts - (1.0 + step)
-    faces = faces.astype(np.int64)
-    corners = positions[faces]
-    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
-    if volume < 0:
-        faces = faces[:, ::-1]
-    normals = vertex_normals(positions, faces).astype(np.float64)
+    positions, faces, normals = isosurface(_blob_field(grid, rng), 1.0)
 
     height = smoothstep(positions[:, 1].min(), positions[:, 1].max(), positions[:, 1])
     around = 0.5 + 0.5 * np.sin(3.0 * np.arctan2(positions[:, 2], positions[:, 0]))

@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mesh import vertex_normals
 from .colors import mix, rgb, smoothstep
-from .geometry import Geometry, MeshBuilder
+from .geometry import Geometry, MeshBuilder, isosurface
 from .params import check_int
 
 OUTER_RADIUS, INNER_RADIUS = 0.62, 0.52
@@ -38,21 +37,10 @@ def cup(subdivisions: int = 4):
         Level of detail in [1, 5]: the field is sampled on ``5 * 2**subdivisions`` points per
         axis over [-1.1, 1.1].
     """
-    from skimage.measure import marching_cubes
-
     n = 5 * 2 ** check_int("subdivisions", subdivisions, 1, 5)
     axis = np.linspace(-1.1, 1.1, n)
     grid = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1)
-    field = np.pad(_cup_field(grid), 1, constant_values=1.0)
-    step = axis[1] - axis[0]
-    verts, faces, _, _ = marching_cubes(field, level=0.0, spacing=(step, step, step))
-    positions = verts - (1.1 + step)
-    faces = faces.astype(np.int64)
-    corners = positions[faces]
-    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
-    if volume < 0:
-        faces = faces[:, ::-1]
-    normals = vertex_normals(positions, faces).astype(np.float64)
+    positions, faces, normals = isosurface(_cup_field(grid), 1.1)
     inside = np.hypot(positions[:, 0], positions[:, 2]) < 0.5 * (INNER_RADIUS + OUTER_RADIUS)
     inside &= (positions[:, 1] > FLOOR - 0.03) & (positions[:, 1] < RIM - 0.01)
     color = mix(rgb(70, 110, 190), rgb(120, 170, 230),

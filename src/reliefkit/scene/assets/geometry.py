@@ -257,3 +257,24 @@ def slab(polygon, z_range) -> Geometry:
     polygon = np.asarray(polygon, dtype=np.float64)
     layers = [np.column_stack([polygon, np.full(len(polygon), z)]) for z in z_range]
     return _hull(np.concatenate(layers))
+
+
+def isosurface(field: np.ndarray, half_extent: float) -> Geometry:
+    """The zero level set (negative inside) of ``field`` sampled on a regular grid over
+    [-half_extent, half_extent]^3 ([i, j, k] = x, y, z), by marching cubes: a closed,
+    outward-facing surface (the grid is padded with outside values) with smooth normals."""
+    from skimage.measure import marching_cubes  # heavy import, only needed here
+
+    from ..mesh import vertex_normals
+
+    n = field.shape[0]
+    step = 2.0 * half_extent / (n - 1)
+    padded = np.pad(field, 1, constant_values=1.0)  # closed at the border
+    verts, faces, _, _ = marching_cubes(padded, level=0.0, spacing=(step, step, step))
+    positions = verts - (half_extent + step)
+    faces = faces.astype(np.int64)
+    corners = positions[faces]
+    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
+    if volume < 0:
+        faces = faces[:, ::-1]
+    return Geometry(positions, faces, vertex_normals(positions, faces).astype(np.float64))

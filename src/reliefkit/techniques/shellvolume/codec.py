@@ -14,18 +14,12 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FormatError, MeshError, UsageError
+from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
 from ...io.rk import ArraySpec, Codec
 from .representation import TexturedShell
 from .textures import MAX_VOXELS, VolumeTexture
 
-MAX_BASE_VERTICES = 1 << 22
-MAX_BASE_TRIANGLES = 1 << 22
-
-ARRAYS = {
-    "positions": ArraySpec(("float64",), ndim=2, trailing=(3,), finite=True),
-    "indices": ArraySpec(("int32",), ndim=2, trailing=(3,)),
-    "normals": ArraySpec(("float32",), ndim=2, trailing=(3,), finite=True),
-    "uvs": ArraySpec(("float32",), ndim=2, trailing=(2,), finite=True),
+ARRAYS = BASE_MESH_ARRAYS | {
     "thickness": ArraySpec(("float64",), ndim=1, finite=True),
     "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True),
     "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True),
@@ -61,14 +55,7 @@ def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
             and all(isinstance(t, int) and not isinstance(t, bool) for t in tile)):
         raise FormatError(f"shell-volume param 'tile' must be two whole numbers, got {tile!r}")
     positions = arrays["positions"]
-    count = len(positions)
-    if count > MAX_BASE_VERTICES or len(arrays["indices"]) > MAX_BASE_TRIANGLES:
-        raise FormatError(f"a shell's base has at most {MAX_BASE_VERTICES} vertices and "
-                          f"{MAX_BASE_TRIANGLES} triangles")
-    for key in ("normals", "uvs", "thickness"):
-        if len(arrays[key]) != count:
-            raise FormatError(f"shell-volume array '{key}' has {len(arrays[key])} rows, the "
-                              f"base has {count} vertices")
+    count = check_base_arrays(arrays, "shell-volume", ("normals", "uvs", "thickness"))
     rgba = arrays["texture_rgba"]
     if int(np.prod(rgba.shape[:3])) > MAX_VOXELS:
         raise FormatError(f"a shell's texture has at most {MAX_VOXELS} voxels, got "

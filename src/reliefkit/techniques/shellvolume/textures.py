@@ -30,6 +30,7 @@ import numpy as np
 from scipy import ndimage
 
 from ...errors import UsageError
+from ...io.npy import npy_header
 
 #: Largest voxel count ``load_texture_npy`` accepts (256^3 voxels).
 MAX_VOXELS = 256**3
@@ -405,13 +406,7 @@ def load_texture_npy(path, name: str | None = None) -> VolumeTexture:
         raise UsageError(f"texture {path} is not a regular file; give a .npy file")
     with os.fdopen(fd, "rb") as f:
         try:
-            version = np.lib.format.read_magic(f)
-            if version == (1, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
-            elif version == (2, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
-            else:
-                raise ValueError(f"unsupported .npy version {version}")
+            shape, fortran, dtype = npy_header(f)
         except ValueError as exc:
             raise UsageError(f"texture {path} is not a valid .npy file ({exc})") from None
         if len(shape) != 4 or shape[3] != 4 or min(shape) < 1:

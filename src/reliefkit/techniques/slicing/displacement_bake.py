@@ -116,6 +116,7 @@ def _rgba_texture(spec: str):
 
     from ...colorspace import srgb_decode
     from ...errors import FormatError
+    from ...io.npy import npy_header
 
     path = Path(spec)
     if path.suffix.lower() == ".png":
@@ -133,10 +134,7 @@ def _rgba_texture(spec: str):
     else:
         try:
             with open(path, "rb") as fh:
-                version = np.lib.format.read_magic(fh)
-                read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
-                        else np.lib.format.read_array_header_2_0)
-                shape, _, dtype = read(fh)
+                shape, _, dtype = npy_header(fh)
         except (OSError, ValueError) as exc:
             raise FormatError(f"{path}: not a readable .npy array ({exc})") from None
         if len(shape) != 3:

@@ -12,17 +12,11 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FormatError, MeshError, UsageError
+from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
 from ...io.rk import ArraySpec, Codec
 from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
-MAX_BASE_VERTICES = 1 << 22
-MAX_BASE_TRIANGLES = 1 << 22
-
-ARRAYS = {
-    "positions": ArraySpec(("float64",), ndim=2, trailing=(3,), finite=True),
-    "indices": ArraySpec(("int32",), ndim=2, trailing=(3,)),
-    "normals": ArraySpec(("float32",), ndim=2, trailing=(3,), finite=True),
-    "uvs": ArraySpec(("float32",), ndim=2, trailing=(2,), finite=True),
+ARRAYS = BASE_MESH_ARRAYS | {
     "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True),
     "height": ArraySpec(("float32",), ndim=2, finite=True),
 }
@@ -58,14 +52,7 @@ def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
     if not isinstance(wrap, bool):
         raise FormatError(f"displacement param 'wrap' must be true or false, got {wrap!r}")
     positions = arrays["positions"]
-    count = len(positions)
-    if count > MAX_BASE_VERTICES or len(arrays["indices"]) > MAX_BASE_TRIANGLES:
-        raise FormatError(f"a displacement map's base has at most {MAX_BASE_VERTICES} "
-                          f"vertices and {MAX_BASE_TRIANGLES} triangles")
-    for key in ("normals", "uvs"):
-        if len(arrays[key]) != count:
-            raise FormatError(f"displacement array '{key}' has {len(arrays[key])} rows, the "
-                              f"base has {count} vertices")
+    count = check_base_arrays(arrays, "displacement map")
     height, color = arrays["height"], arrays["color"]
     if height.size > MAX_TEXELS or color.shape != (*height.shape, 4):
         raise FormatError(f"displacement arrays 'color' {color.shape} and 'height' "

@@ -2,10 +2,7 @@
 // triangle adds a peeled layer's premultiplied colour under what is in front of it.
 
 #if defined VERTEX_SHADER
-void main() {
-    vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
-}
+#include "core:include/fullscreen.glsl"
 #endif
 
 #if defined FRAGMENT_SHADER

@@ -1,10 +1,7 @@
 // Copies a frame drawn elsewhere (the stencil multi-pass target) into the frame's own
 // target: colour, position and normal per pixel, the depth recomputed from the position.
 #if defined VERTEX_SHADER
-void main() {
-    vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
-}
+#include "core:include/fullscreen.glsl"
 #endif
 
 #if defined FRAGMENT_SHADER
