@@ -66,9 +66,9 @@ def _demo_tiles() -> list[DemoTile]:
     return [DemoTile("depth object: vehicle", "depth-object-vehicle", baked("vehicle", False),
                      (40.0, 20.0, None)),
             DemoTile("depth object: blob", "depth-object-blob", baked("blob", False),
-                     (35.0, 30.0, None)),
+                     (35.0, 25.0, 2.5)),
             DemoTile("visual hull: blob", "visual-hull-blob", baked("blob", True),
-                     (35.0, 30.0, None))]
+                     (35.0, 25.0, 2.5))]
 
 
 PART = Part(

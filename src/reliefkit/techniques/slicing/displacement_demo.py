@@ -40,6 +40,6 @@ def demo_tiles() -> list[DemoTile]:
                       {"slicing": "orthogonal", "slices": DONUT_SLICES})]
     for mode in ("surface", "orthogonal", "screen"):
         tiles.append(DemoTile(f"displacement: bumps, {mode} slicing", f"displacement-{mode}",
-                              bumpy_square, (20.0, 15.0, 2.2),
+                              bumpy_square, (20.0, 15.0, 2.7),
                               {"slicing": mode, "slices": 32}))
     return tiles
