@@ -61,6 +61,37 @@ def texture2d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "l
     return tex
 
 
+def texture_levels(ctx, levels: list, *, what: str = "texture"):
+    """Upload a full mip chain of float32 (H, W) arrays, each half the size of the one
+    before down to 1 x 1 (a max pyramid, say), into one R32F texture sampled with
+    ``texelFetch(tex, p, level)``; sizes are checked before anything is allocated."""
+    import moderngl
+
+    arrays = [np.ascontiguousarray(a, dtype=np.float32) for a in levels]
+    if not arrays or any(a.ndim != 2 for a in arrays):
+        raise GPUError(f"{what}: expected a list of (H, W) levels")
+    height, width = arrays[0].shape
+    for k, a in enumerate(arrays):
+        expected = (max(height >> k, 1), max(width >> k, 1))
+        if a.shape != expected:
+            raise GPUError(f"{what}: level {k} must be {expected}, got {a.shape}")
+    if arrays[-1].shape != (1, 1):
+        raise GPUError(f"{what}: the chain must end at 1 x 1, got {arrays[-1].shape}")
+    _check_2d(ctx, width, height, what)
+    tex = ctx.texture((width, height), 1, arrays[0].tobytes(), dtype="f4")
+    try:
+        tex.build_mipmaps(0, len(arrays) - 1)  # allocates the levels; overwritten below
+        for k, a in enumerate(arrays[1:], start=1):
+            tex.write(a.tobytes(), level=k)
+        tex.filter = (moderngl.NEAREST_MIPMAP_NEAREST, moderngl.NEAREST)
+        tex.repeat_x = tex.repeat_y = False
+        check_gl_error(ctx, f"creating {what} ({width}x{height}, {len(arrays)} levels)")
+    except BaseException:
+        tex.release()
+        raise
+    return tex
+
+
 def render_target(ctx, width: int, height: int, color_attachments: int):
     """A framebuffer of ``color_attachments`` RGBA32F textures plus a float depth texture."""
     check_framebuffer_size(ctx, width, height)

@@ -45,10 +45,10 @@ def fields():
 
 @pytest.mark.parametrize("name", ["smooth", "rough", "peaks"])
 @pytest.mark.parametrize("az, el", VIEWS)
-def test_exact_and_robust_match_reference(gl, fields, name, az, el):
+def test_exact_robust_and_maxmip_match_reference(gl, fields, name, az, el):
     relief = fields[name]
     camera = Camera.orbit((0, 0.5, 0), az, el, 3.0, size=(96, 96))
-    for method, budget in (("exact", 0.001), ("robust", 0.005)):
+    for method, budget in (("exact", 0.001), ("robust", 0.005), ("maxmip", 0.001)):
         frame = render(relief, camera, method=method)
         result = wrong_hits(frame, relief, camera)
         assert result["reference_pixels"] > 1000
@@ -75,9 +75,28 @@ def test_iteration_counts_reported(gl, fields):
     relief = fields["smooth"]
     camera = Camera.orbit((0, 0.5, 0), 30, 30, 3.0, size=(64, 64))
     stats = {m: render(relief, camera, method=m, count_iterations=True).stats
-             for m in ("binary", "exact", "robust")}
+             for m in ("binary", "exact", "robust", "maxmip")}
     for s in stats.values():
         assert s["fragments"] >= s["covered"] > 500
         assert 1 <= s["iterations_mean"] <= s["iterations_max"]
     # binary does a fixed 16 + 8 steps at most per hit
     assert stats["binary"]["iterations_max"] <= 16 + 8
+
+
+def test_maxmip_iterations_grow_like_the_log_of_the_resolution(gl):
+    """The exact walk's iterations grow with the resolution (it crosses every centreline);
+    the max-pyramid descent's barely do: <= 2x from 32² to 512² (the issue: 64² to 1024²)."""
+    from reliefkit.scene.assets import terrain_heights
+
+    camera = Camera.orbit((0, 0.5, 0), 30, 30, 3.0, size=(48, 48))
+    means = {}
+    for res in (32, 512):
+        h = terrain_heights(res).astype(np.float32)
+        h = (h - h.min()) / (h.max() - h.min()) * 0.9 + 0.05
+        relief = make_relief(h)
+        for method in ("exact", "maxmip"):
+            frame = render(relief, camera, method=method, count_iterations=True)
+            means[method, res] = frame.stats["iterations_mean_covered"]
+        assert wrong_hits(frame, relief, camera)["wrong_fraction"] <= 0.001
+    assert means["maxmip", 512] <= 2 * means["maxmip", 32], means
+    assert means["exact", 512] >= 6 * means["exact", 32], means

@@ -10,13 +10,14 @@ from ...core.params import param
 from ...errors import UsageError
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
-from ...gl.textures import texture2d
+from ...gl.textures import texture2d, texture_levels
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
 from ...render.proxy import aabb_planes, box_planes, convex_proxy, cull_face
+from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
-METHODS = ("binary", "exact", "robust")
+METHODS = ("binary", "exact", "robust", "maxmip")
 PROGRAM = "relief:relief.glsl"
 
 
@@ -24,8 +25,9 @@ PROGRAM = "relief:relief.glsl"
 class ReliefRenderOptions:
     """The render options of relief textures (``reliefkit render --help`` shows them)."""
 
-    method: str = param("robust", "ray/heightfield intersection (robust needs safety radii)",
-                        choices=METHODS)
+    method: str = param("robust", "ray/heightfield intersection: binary search, the exact "
+                        "walk, safety radii (robust: needs them baked), or a maximum mipmap "
+                        "(maxmip: exact, built when drawn)", choices=METHODS)
     depth_mode: str = param("conservative", "keep the box depth in the Z-buffer, or write "
                             "the hit's depth (exact: correct with other objects)",
                             choices=("conservative", "exact"))
@@ -81,6 +83,10 @@ class ReliefDrawable:
             if opts.method == "robust":
                 self.textures["u_safety"] = texture2d(ctx, relief.safety.astype(np.float32),
                                                       what="safety", filter="nearest")
+            if opts.method == "maxmip":
+                levels = max_pyramid(relief.height)
+                self.textures["u_maxmip"] = texture_levels(ctx, levels, what="max pyramid")
+                self.top_level = len(levels) - 1
             self.proxy = relief_proxy(relief)
             self.vbo = ctx.buffer(self.proxy.positions.tobytes())
             self.ibo = ctx.buffer(self.proxy.triangles.tobytes())
@@ -95,6 +101,7 @@ class ReliefDrawable:
             "u_max_iterations": opts.max_iterations or 4 * (w + h) + 64,
             "u_zero_exact": opts.zero_radius == "exact",
             "u_quadratic_cells": opts.cell_test == "quadratic",
+            "u_top_level": getattr(self, "top_level", 0),
         }
         check_gl_error(ctx, "uploading a relief texture")
 

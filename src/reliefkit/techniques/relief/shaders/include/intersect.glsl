@@ -3,6 +3,7 @@
 //   METHOD_BINARY  fixed linear steps, then binary search (Policarpo et al. 2005)
 //   METHOD_EXACT   walk from centreline to centreline (Amanatides-Woo in 2D, section 3.3)
 //   METHOD_ROBUST  jump by safety radii along the major axis, then binary search (section 3.4)
+//   METHOD_MAXMIP  descend a maximum mipmap (Tevs et al. 2008), the exact walk in its cells
 // `iters` counts loop iterations (one height evaluation each) for the benchmarks.
 #include "core:include/heightfield.glsl"
 
@@ -42,7 +43,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 }
 #endif
 
-#if defined METHOD_EXACT || defined METHOD_ROBUST
+#if defined METHOD_EXACT || defined METHOD_ROBUST || defined METHOD_MAXMIP
 // Parameter of the next centreline (x = k + 0.5) strictly after coordinate x moving with dx.
 float next_centerline(float x, float ox, float dx) {
     if (dx == 0.0) return 3.0e38;
@@ -145,6 +146,77 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
         if (s_new >= s1) return false;
         sa = s_new;
     }
+    return false;
+}
+#endif
+
+#if defined METHOD_MAXMIP
+uniform sampler2D u_maxmip;   // R32F max pyramid (maxmip.py): level L node = 2^L texels
+uniform int u_top_level;      // its 1 x 1 level
+
+// Parameter where the ray leaves the node [lo, lo + size]^2 (texel coordinates).
+float node_exit(vec3 o, vec3 d, vec2 lo, float size) {
+    float tx = d.x > 0.0 ? (lo.x + size - o.x) / d.x : (d.x < 0.0 ? (lo.x - o.x) / d.x : 3.0e38);
+    float ty = d.y > 0.0 ? (lo.y + size - o.y) / d.y : (d.y < 0.0 ? (lo.y - o.y) / d.y : 3.0e38);
+    return min(tx, ty);
+}
+
+// Quadtree traversal: a node whose maximum stays below the ray over the ray's span in it is
+// skipped whole (and the walk climbs a level); otherwise the walk descends to the child the
+// ray is in, first moving down to where the ray meets the node's maximum. In a level-0
+// node (one texel square) the exact walk tests the bilinear cells exactly.
+bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
+    s_hit = s0;
+    if (hf_above(o + s0 * d) < 0.0) return true;
+    int level = u_top_level;
+    ivec2 node = ivec2(0);
+    ivec2 step = ivec2(d.x >= 0.0 ? 1 : -1, d.y >= 0.0 ? 1 : -1);
+    float s = s0;
+    for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
+        iters++;
+        float size = float(1 << level);
+        vec2 lo = vec2(node) * size;
+        float s_exit = min(node_exit(o, d, lo, size), s1);
+        float top = texelFetch(u_maxmip, node, level).r;
+        bool skip = min(o.z + s * d.z, o.z + s_exit * d.z) > top;
+        if (!skip && level == 0) {
+            if (walk_exact(o, d, s, s_exit, s_hit, iters)) return true;
+            skip = true;
+        }
+        if (!skip) {
+            // descend: first down to where the ray meets the node's maximum
+            if (d.z < 0.0 && o.z + s * d.z > top) s = max(s, (top - o.z) / d.z);
+            skip = s >= s_exit;
+        }
+        if (!skip) {
+            level--;
+            vec2 p = o.xy + s * d.xy;
+            vec2 mid = lo + 0.5 * size;
+            ivec2 child = ivec2(p.x > mid.x || (p.x == mid.x && d.x > 0.0) ? 1 : 0,
+                                p.y > mid.y || (p.y == mid.y && d.y > 0.0) ? 1 : 0);
+            node = node * 2 + child;
+            continue;
+        }
+        if (s_exit >= s1) return false;
+        s = s_exit;
+        // into the neighbour the ray enters (across the side it leaves by), then up a level
+        // when that neighbour has another parent
+        float tx = d.x != 0.0 ? (lo.x + (step.x > 0 ? size : 0.0) - o.x) / d.x : 3.0e38;
+        float ty = d.y != 0.0 ? (lo.y + (step.y > 0 ? size : 0.0) - o.y) / d.y : 3.0e38;
+        ivec2 next = node;
+        if (tx <= ty) next.x += step.x; else next.y += step.y;
+        int count = 1 << (u_top_level - level);
+        if (any(lessThan(next, ivec2(0))) || any(greaterThanEqual(next, ivec2(count))))
+            return false;
+        bool other_parent = (next.x >> 1) != (node.x >> 1) || (next.y >> 1) != (node.y >> 1);
+        if (level < u_top_level && other_parent) {
+            node = next >> 1;
+            level++;
+        } else {
+            node = next;
+        }
+    }
+    s_hit = s1;
     return false;
 }
 #endif
