@@ -75,7 +75,7 @@ def test_iteration_counts_reported(gl, fields):
     relief = fields["smooth"]
     camera = Camera.orbit((0, 0.5, 0), 30, 30, 3.0, size=(64, 64))
     stats = {m: render(relief, camera, method=m, count_iterations=True).stats
-             for m in ("binary", "exact", "robust", "maxmip")}
+             for m in ("binary", "exact", "robust", "maxmip", "cone")}
     for s in stats.values():
         assert s["fragments"] >= s["covered"] > 500
         assert 1 <= s["iterations_mean"] <= s["iterations_max"]

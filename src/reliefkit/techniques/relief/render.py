@@ -14,10 +14,11 @@ from ...gl.textures import texture2d, texture_levels
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
 from ...render.proxy import aabb_planes, box_planes, convex_proxy, cull_face
+from .cone import relaxed_cone_ratios
 from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
-METHODS = ("binary", "exact", "robust", "maxmip")
+METHODS = ("binary", "exact", "robust", "maxmip", "cone")
 PROGRAM = "relief:relief.glsl"
 
 
@@ -26,8 +27,9 @@ class ReliefRenderOptions:
     """The render options of relief textures (``reliefkit render --help`` shows them)."""
 
     method: str = param("robust", "ray/heightfield intersection: binary search, the exact "
-                        "walk, safety radii (robust: needs them baked), or a maximum mipmap "
-                        "(maxmip: exact, built when drawn)", choices=METHODS)
+                        "walk, safety radii (robust: needs them baked), a maximum mipmap "
+                        "(maxmip: exact, built when drawn) or relaxed cone stepping (cone: "
+                        "its cone map computed when drawn)", choices=METHODS)
     depth_mode: str = param("conservative", "keep the box depth in the Z-buffer, or write "
                             "the hit's depth (exact: correct with other objects)",
                             choices=("conservative", "exact"))
@@ -40,6 +42,9 @@ class ReliefRenderOptions:
                            choices=("quadratic", "linear"))
     linear_steps: int = param(16, "binary: fixed pre-steps", lo=1, hi=4096)
     binary_steps: int = param(8, "binary search steps once a hit is bracketed", lo=1, hi=4096)
+    cone_steps: int = param(32, "cone: steps before the ray stops where it is (GPU Gems 3 "
+                            "uses 15)",
+                            lo=1, hi=4096)
     max_iterations: int = param(0, "bound on every walk (0: 4 (W + H) + 64)", lo=0,
                                 hi=16384)
 
@@ -83,6 +88,9 @@ class ReliefDrawable:
             if opts.method == "robust":
                 self.textures["u_safety"] = texture2d(ctx, relief.safety.astype(np.float32),
                                                       what="safety", filter="nearest")
+            if opts.method == "cone":
+                self.textures["u_cone"] = texture2d(ctx, relaxed_cone_ratios(relief.height),
+                                                    what="cone ratios", filter="nearest")
             if opts.method == "maxmip":
                 levels = max_pyramid(relief.height)
                 self.textures["u_maxmip"] = texture_levels(ctx, levels, what="max pyramid")
@@ -102,6 +110,7 @@ class ReliefDrawable:
             "u_zero_exact": opts.zero_radius == "exact",
             "u_quadratic_cells": opts.cell_test == "quadratic",
             "u_top_level": getattr(self, "top_level", 0),
+            "u_cone_steps": opts.cone_steps,
         }
         check_gl_error(ctx, "uploading a relief texture")
 

@@ -4,6 +4,7 @@
 //   METHOD_EXACT   walk from centreline to centreline (Amanatides-Woo in 2D, section 3.3)
 //   METHOD_ROBUST  jump by safety radii along the major axis, then binary search (section 3.4)
 //   METHOD_MAXMIP  descend a maximum mipmap (Tevs et al. 2008), the exact walk in its cells
+//   METHOD_CONE    relaxed cone stepping (Policarpo & Oliveira, GPU Gems 3 ch. 18)
 // `iters` counts loop iterations (one height evaluation each) for the benchmarks.
 #include "core:include/heightfield.glsl"
 
@@ -43,7 +44,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 }
 #endif
 
-#if defined METHOD_EXACT || defined METHOD_ROBUST || defined METHOD_MAXMIP
+#if defined METHOD_EXACT || defined METHOD_ROBUST || defined METHOD_MAXMIP || defined METHOD_CONE
 // Parameter of the next centreline (x = k + 0.5) strictly after coordinate x moving with dx.
 float next_centerline(float x, float ox, float dx) {
     if (dx == 0.0) return 3.0e38;
@@ -218,5 +219,46 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
     }
     s_hit = s1;
     return false;
+}
+#endif
+
+#if defined METHOD_CONE
+uniform sampler2D u_cone;      // R32F relaxed cone ratios, texels per unit height (cone.py)
+uniform int u_cone_steps;      // cone steps, then the ray stops where it is
+
+// Step to where the ray leaves the relaxed cone under it, until a step ends inside the
+// solid (at most one crossing lies in it: bisect it). As in the chapter, a ray still above
+// the surface after u_cone_steps steps stops where it is: a hit there, unless no surface
+// lies under it (height 0 is empty here). Rays going up (shadow rays from below, side
+// entries) are walked exactly: the cones only bound descents.
+bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
+    s_hit = s0;
+    if (hf_above(o + s0 * d) < 0.0) return true;
+    if (d.z >= 0.0) return walk_exact(o, d, s0, s1, s_hit, iters);
+    float ray_ratio = length(d.xy) / -d.z;   // texels travelled per unit of descent
+    float s = s0, s_prev = s0;
+    for (int k = 0; k < HARD_CAP && k < u_cone_steps; ++k) {
+        iters++;
+        vec3 p = o + s * d;
+        float above = hf_above(p);
+        if (above < 0.0) {
+            s_hit = refine_hit(o, d, s_prev, s, iters);
+            return true;
+        }
+        ivec2 texel = clamp(ivec2(floor(p.xy)), ivec2(0), u_hf_size - 1);
+        float c = texelFetch(u_cone, texel, 0).r;
+        float descent = c * above / (ray_ratio + c);
+        s_prev = s;
+        s += descent / -d.z;
+        if (s >= s1) {
+            if (hf_above(o + s1 * d) < 0.0) {
+                s_hit = refine_hit(o, d, s_prev, s1, iters);
+                return true;
+            }
+            return false;
+        }
+    }
+    s_hit = s;
+    return hf_height((o + s * d).xy) > 0.0;
 }
 #endif
