@@ -39,7 +39,8 @@ def add_options(p: argparse.ArgumentParser, owners: list[tuple[str, tuple]], tit
             group.add_argument(flag, dest=OPTION_PREFIX + name, default=None,
                                action=argparse.BooleanOptionalAction, help=_option_help(decls))
             continue
-        metavar = "|".join(map(str, first.choices)) if first.choices else (
+        choices = dict.fromkeys(str(c) for _, opt in decls for c in (opt.choices or ()))
+        metavar = "|".join(choices) if choices else (
             ",".join(["X"] * (first.count or 2)) if first.kind == "floats" else first.kind.upper())
         add_flag(p, flag, within=group, dest=OPTION_PREFIX + name, default=None,
                   metavar=metavar, help=_option_help(decls),
@@ -61,8 +62,10 @@ def _option_help(decls: list) -> str:
     texts: dict[str, list[str]] = {}
     defaults: dict[str, list[str]] = {}
     for owner, opt in decls:
-        texts.setdefault(opt.help, []).append(owner)
-        defaults.setdefault(describe_default(opt), []).append(owner)
+        for table, key in ((texts, opt.help), (defaults, describe_default(opt))):
+            owners = table.setdefault(key, [])
+            if owner not in owners:
+                owners.append(owner)
     single = len(texts) == 1
     parts = [text if single else f"{', '.join(owners)}: {text}" for text, owners in texts.items()]
     owners_all = ", ".join(dict.fromkeys(o for o, _ in decls))
