@@ -154,8 +154,9 @@ def test_compare_writes_picture_and_metrics(gl, tmp_path):
     progress = [line for line in out.stderr.splitlines() if line.startswith("compare: ")]
     assert progress and "done in" in progress[-1], out.stderr
     report = json.loads((tmp_path / "cmp" / "metrics.json").read_text())
-    assert set(report["variants"]) == {"binary", "exact", "robust"}
+    assert set(report["variants"]) == {"binary", "exact", "robust", "maxmip", "cone"}
     assert report["variants"]["exact"]["wrong_hit_fraction"] <= 0.001
+    assert report["variants"]["maxmip"]["wrong_hit_fraction"] <= 0.001
     assert (tmp_path / "cmp" / "compare.png").stat().st_size > 1000
     assert "| robust |" in (tmp_path / "cmp" / "metrics.md").read_text()
 

@@ -48,8 +48,9 @@ def fields():
 def test_exact_robust_and_maxmip_match_reference(gl, fields, name, az, el):
     relief = fields[name]
     camera = Camera.orbit((0, 0.5, 0), az, el, 3.0, size=(96, 96))
-    for method, budget in (("exact", 0.001), ("robust", 0.005), ("maxmip", 0.001)):
-        frame = render(relief, camera, method=method)
+    for method, budget, extra in (("exact", 0.001, {}), ("robust", 0.005, {"exact_below": 0}),
+                                  ("robust", 0.005, {}), ("maxmip", 0.001, {})):
+        frame = render(relief, camera, method=method, **extra)
         result = wrong_hits(frame, relief, camera)
         assert result["reference_pixels"] > 1000
         assert result["wrong_fraction"] <= budget, (method, result["wrong_fraction"])
@@ -58,7 +59,7 @@ def test_exact_robust_and_maxmip_match_reference(gl, fields, name, az, el):
 def test_robust_with_clamped_radii_stays_close(gl, fields):
     relief = fields["smooth"]
     camera = Camera.orbit((0, 0.5, 0), 30, 30, 3.0, size=(96, 96))
-    frame = render(relief, camera, method="robust", zero_radius="clamp")
+    frame = render(relief, camera, method="robust", zero_radius="clamp", exact_below=0)
     assert wrong_hits(frame, relief, camera)["wrong_fraction"] <= 0.02
 
 
@@ -100,3 +101,16 @@ def test_maxmip_iterations_grow_like_the_log_of_the_resolution(gl):
         assert wrong_hits(frame, relief, camera)["wrong_fraction"] <= 0.001
     assert means["maxmip", 512] <= 2 * means["maxmip", 32], means
     assert means["exact", 512] >= 6 * means["exact", 32], means
+
+
+def test_robust_draws_a_small_field_with_the_exact_walk_and_the_same_hits(gl, fields):
+    """No ray of a 48² field crosses 128 texels: robust draws it with the exact program."""
+    relief = fields["rough"]
+    camera = Camera.orbit((0, 0.5, 0), 120, 20, 3.0, size=(64, 64))
+    robust = render(relief, camera, method="robust", count_iterations=True)
+    exact = render(relief, camera, method="exact", count_iterations=True)
+    jumps = render(relief, camera, method="robust", exact_below=0, count_iterations=True)
+    assert np.array_equal(robust.mask, exact.mask)
+    assert np.array_equal(robust.position[robust.mask], exact.position[exact.mask])
+    assert robust.stats["iterations_mean"] == exact.stats["iterations_mean"]
+    assert jumps.stats["iterations_mean"] != exact.stats["iterations_mean"]

@@ -37,6 +37,9 @@ class ReliefRenderOptions:
     zero_radius: str = param("exact", "robust method at a zero safety radius: walk exactly "
                              "to the next centreline, or clamp the radius to 1",
                              choices=("exact", "clamp"))
+    exact_below: int = param(128, "robust: rays crossing fewer texels than this are walked "
+                             "exactly, which is cheaper for them (0: the paper's walk for every "
+                             "ray)", lo=0, hi=65536)
     cell_test: str = param("quadratic", "exact/robust: test each cell's exact quadratic, or "
                            "assume heights linear between centrelines as the paper does",
                            choices=("quadratic", "linear"))
@@ -74,8 +77,13 @@ class ReliefDrawable:
         self.ctx, self.relief, self.options = ctx, relief, opts
         self.extra_attachments = 1 if instrument else 0
         w, h = relief.depth_resolution
+        # robust walks every ray shorter than exact_below texels exactly: when no ray of this
+        # field can be longer (W + H bounds |dx| + |dy|), the exact walk's own program draws
+        # the same hits without the robust code around it
+        self.method = "exact" if opts.method == "robust" and w + h <= opts.exact_below \
+            else opts.method
         self.prog = program(ctx, PROGRAM, {
-            f"METHOD_{opts.method.upper()}": True, "WRITE_DEPTH": opts.depth_mode == "exact",
+            f"METHOD_{self.method.upper()}": True, "WRITE_DEPTH": opts.depth_mode == "exact",
             "SHADOWS": opts.shadows, "COUNT_ITERATIONS": instrument})
         self.textures = {}
         self.vao = self.vbo = self.ibo = None
@@ -85,13 +93,13 @@ class ReliefDrawable:
             self.textures["u_color"] = texture2d(ctx, relief.color, what="color", srgb=True,
                                                  mipmaps=True)
             self.textures["u_normal"] = texture2d(ctx, relief.normal, what="normal")
-            if opts.method == "robust":
+            if self.method == "robust":
                 self.textures["u_safety"] = texture2d(ctx, relief.safety.astype(np.float32),
                                                       what="safety", filter="nearest")
-            if opts.method == "cone":
+            if self.method == "cone":
                 self.textures["u_cone"] = texture2d(ctx, relaxed_cone_ratios(relief.height),
                                                     what="cone ratios", filter="nearest")
-            if opts.method == "maxmip":
+            if self.method == "maxmip":
                 levels = max_pyramid(relief.height)
                 self.textures["u_maxmip"] = texture_levels(ctx, levels, what="max pyramid")
                 self.top_level = len(levels) - 1
@@ -108,6 +116,7 @@ class ReliefDrawable:
             "u_binary_steps": opts.binary_steps,
             "u_max_iterations": opts.max_iterations or 4 * (w + h) + 64,
             "u_zero_exact": opts.zero_radius == "exact",
+            "u_exact_below": float(opts.exact_below),
             "u_quadratic_cells": opts.cell_test == "quadratic",
             "u_top_level": getattr(self, "top_level", 0),
             "u_cone_steps": opts.cone_steps,

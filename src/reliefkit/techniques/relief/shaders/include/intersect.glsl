@@ -109,43 +109,59 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 #if defined METHOD_ROBUST
 uniform sampler2D u_safety;   // R32F radii in texels (0: non-concave peak)
 uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (else clamp to 1)
+uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
+// The radius jumps stop at a texel of radius 0; the exact walk then covers up to the next
+// major centreline and the jumps resume. Short rays (fewer than u_exact_below texels: the
+// walk costs less than the lookups, the jumps' tests and the final bisection) and vertical
+// ones are walked exactly from the start. The exact walk has one call site, so the shader
+// inlines it once.
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
     bool x_major = abs(d.x) >= abs(d.y);
     float om = x_major ? o.x : o.y;
     float dm = x_major ? d.x : d.y;
-    if (dm == 0.0) return walk_exact(o, d, s0, s1, s_hit, iters);  // vertical ray
+    bool walk_all = dm == 0.0 || (abs(d.x) + abs(d.y)) * (s1 - s0) < u_exact_below;
     // index of the last major centreline (x = ci + 0.5) at or before the entry point
     float xm = om + s0 * dm;
     float dir = dm > 0.0 ? 1.0 : -1.0;
     float ci = dm > 0.0 ? floor(xm - 0.5) : ceil(xm - 0.5);
     float sa = s0;  // last parameter known to be above the surface
-    for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
-        float s = (ci + 0.5 - om) / dm;
-        float minor = x_major ? o.y + s * d.y : o.x + s * d.x;
-        ivec2 texel = x_major ? ivec2(int(ci), int(floor(minor)))
-                              : ivec2(int(floor(minor)), int(ci));
-        float r = texelFetch(u_safety, clamp(texel, ivec2(0), u_hf_size - 1), 0).r;
-        if (r < 0.5 && u_zero_exact) {  // exact walk up to the next major centreline
-            ci += dir;
-            float s_next = min((ci + 0.5 - om) / dm, s1);
-            if (walk_exact(o, d, max(s, s0), s_next, s_hit, iters)) return true;
-            if (s_next >= s1) return false;
-            sa = s_next;
-            continue;
+    int k = 0;
+    for (int round = 0; round < HARD_CAP && k < u_max_iterations; ++round) {
+        float walk_from = s0, walk_to = s1;
+        if (!walk_all) {
+            walk_from = -1.0;
+            for (; k < HARD_CAP && k < u_max_iterations; ++k) {
+                float s = (ci + 0.5 - om) / dm;
+                float minor = x_major ? o.y + s * d.y : o.x + s * d.x;
+                ivec2 texel = x_major ? ivec2(int(ci), int(floor(minor)))
+                                      : ivec2(int(floor(minor)), int(ci));
+                float r = texelFetch(u_safety, clamp(texel, ivec2(0), u_hf_size - 1), 0).r;
+                if (r < 0.5 && u_zero_exact) {  // walk exactly to the next major centreline
+                    ci += dir;
+                    walk_from = max(s, s0);
+                    walk_to = min((ci + 0.5 - om) / dm, s1);
+                    break;
+                }
+                ci += dir * max(r, 1.0);
+                float s_new = (ci + 0.5 - om) / dm;
+                float sb = min(s_new, s1);
+                iters++;
+                if (hf_above(o + sb * d) < 0.0) {
+                    s_hit = refine_hit(o, d, max(sa, s0), sb, iters);
+                    return true;
+                }
+                if (s_new >= s1) return false;
+                sa = s_new;
+            }
+            if (walk_from < 0.0) return false;
         }
-        ci += dir * max(r, 1.0);
-        float s_new = (ci + 0.5 - om) / dm;
-        float sb = min(s_new, s1);
-        iters++;
-        if (hf_above(o + sb * d) < 0.0) {
-            s_hit = refine_hit(o, d, max(sa, s0), sb, iters);
-            return true;
-        }
-        if (s_new >= s1) return false;
-        sa = s_new;
+        if (walk_exact(o, d, walk_from, walk_to, s_hit, iters)) return true;
+        if (walk_all || walk_to >= s1) return false;
+        sa = walk_to;
+        ++k;
     }
     return false;
 }
