@@ -114,3 +114,26 @@ def test_robust_draws_a_small_field_with_the_exact_walk_and_the_same_hits(gl, fi
     assert np.array_equal(robust.position[robust.mask], exact.position[exact.mask])
     assert robust.stats["iterations_mean"] == exact.stats["iterations_mean"]
     assert jumps.stats["iterations_mean"] != exact.stats["iterations_mean"]
+
+
+def test_octant_radii_take_fewer_iterations_with_the_same_hits(gl, fields):
+    h = fields["peaks"].height
+    relief = make_relief(h, safety=safety_radii(h, tolerance=0.01, octants=True))
+    single = make_relief(h, safety=safety_radii(h, tolerance=0.01))
+    camera = Camera.orbit((0, 0.5, 0), 120, 20, 3.0, size=(96, 96))
+    frames = {name: render(rep, camera, method="robust", exact_below=0, count_iterations=True)
+              for name, rep in (("octants", relief), ("single", single))}
+    assert wrong_hits(frames["octants"], relief, camera)["wrong_fraction"] <= 0.005
+    assert frames["octants"].stats["iterations_mean"] < \
+        0.8 * frames["single"].stats["iterations_mean"]
+
+
+def test_octant_radii_survive_the_rk_file(tmp_path, fields):
+    from reliefkit.io.rk import load, save
+
+    h = fields["smooth"].height
+    relief = make_relief(h, safety=safety_radii(h, octants=True))
+    save(tmp_path / "r.rk", relief)
+    back = load(tmp_path / "r.rk")
+    assert back.safety.shape == (8, *h.shape)
+    assert np.array_equal(back.safety, relief.safety)

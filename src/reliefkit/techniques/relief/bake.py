@@ -82,7 +82,7 @@ def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int,
 def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
                  safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
                  params: dict | None = None, zero_border: bool = True,
-                 clip_bounds=None, ctx=None) -> ReliefTexture:
+                 clip_bounds=None, ctx=None, octants: bool = False) -> ReliefTexture:
     """Bake ``mesh`` through any box/frustum matrix at the given resolutions.
 
     ``zero_border`` empties the outer ring of texels so every ray enters above the surface
@@ -104,25 +104,28 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
     if safety:
         from .safety import safety_radii
 
-        relief.safety = safety_radii(height, tolerance=tolerance, progress=progress)
+        relief.safety = safety_radii(height, tolerance=tolerance, progress=progress,
+                                     octants=octants)
         relief.params["safety_tolerance"] = float(tolerance)
     return relief
 
 
 def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = None,
                 axis: str = "y", *, safety: bool = True, tolerance: float = DEFAULT_TOLERANCE,
-                progress=None, ctx=None) -> ReliefTexture:
+                progress=None, ctx=None, octants: bool = False) -> ReliefTexture:
     """Orthographic relief texture of ``mesh`` seen from above along ``axis`` (§3)."""
     box_to_world, depth_size = ortho_box(mesh, axis, depth_res)
     color_size = _color_size(depth_size, depth_res, color_res)
     params = {"projection": "orthographic", "axis": axis, "depth_res": depth_res,
               "color_res": color_res or depth_res, "source": mesh.name}
     return bake_through(mesh, box_to_world, depth_size, color_size, safety=safety,
-                        tolerance=tolerance, progress=progress, params=params, ctx=ctx)
+                        tolerance=tolerance, progress=progress, params=params, ctx=ctx,
+                        octants=octants)
 
 
 def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bool = True,
-                        tolerance: float = DEFAULT_TOLERANCE, progress=None) -> ReliefTexture:
+                        tolerance: float = DEFAULT_TOLERANCE, progress=None,
+                        octants: bool = False) -> ReliefTexture:
     """A relief texture straight from a height array (values scaled to [0, 1]).
 
     Orientation is that of a map seen from above: row 0 (an image's top row) is the far
@@ -150,7 +153,8 @@ def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bo
     if safety:
         from .safety import safety_radii
 
-        relief.safety = safety_radii(h, tolerance=tolerance, progress=progress)
+        relief.safety = safety_radii(h, tolerance=tolerance, progress=progress,
+                                     octants=octants)
         relief.params["safety_tolerance"] = float(tolerance)
     return relief
 

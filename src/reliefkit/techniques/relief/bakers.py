@@ -60,6 +60,8 @@ class ReliefParams:
     color_res: int | None = _color_res()
     safety: bool = _safety()
     safety_tolerance: float = _tolerance()
+    safety_octants: bool = param(False, "safety radii per direction octant (8 per texel): "
+                                 "larger radii on rough fields, 8x the radii's memory")
     axis: str = _axis()
     box: tuple = param((2.0, 0.5, 2.0), "heightmaps: world size SX,SY,SZ of the box",
                        kind="floats", count=3, lo=1e-9)
@@ -90,9 +92,11 @@ def bake_orthographic(source, p: ReliefParams, progress=None):
         check_safety_work(side, side)
     if isinstance(source, np.ndarray):
         return relief_from_heights(source, size=p.box, safety=p.safety,
-                                   tolerance=p.safety_tolerance, progress=progress)
+                                   tolerance=p.safety_tolerance, progress=progress,
+                                   octants=p.safety_octants)
     return bake_relief(source, p.depth_res, p.color_res, p.axis, safety=p.safety,
-                       tolerance=p.safety_tolerance, progress=progress)
+                       tolerance=p.safety_tolerance, progress=progress,
+                       octants=p.safety_octants)
 
 
 def bake_frustum(source, p: ReliefFrustumParams, progress=None):

@@ -111,6 +111,7 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
 
 def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
     """Fig. 12: tolerance vs mean radius vs iterations vs silhouette (wrong-hit) error."""
+    from ...bench.timing import time_render
     from ...render import render
     from ...scene.assets import make_asset
     from .bake import bake_relief
@@ -122,18 +123,26 @@ def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
     camera = fit_camera(mesh.bounds, cfg.correctness_size, elevation=20.0)
     rows = []
     for tol in cfg.tolerances:
-        relief.safety = safety_radii(relief.height, tolerance=tol)
-        for zero in ("clamp", "exact"):
-            frame = render(relief, camera, method="robust", zero_radius=zero,
-                           count_iterations=True)
-            wrong = wrong_hits(frame, relief, camera)
-            rows.append({"tolerance": tol, "zero_radius": zero,
-                         "mean_radius": float(relief.safety.mean()),
-                         "zero_fraction": float((relief.safety == 0).mean()),
-                         "iterations_mean": frame.stats["iterations_mean"],
-                         "wrong_fraction": wrong["wrong_fraction"]})
-        log(f"fig 12: tolerance {tol}: mean radius {rows[-1]['mean_radius']:.2f}, "
-            f"iterations {rows[-2]['iterations_mean']:.1f} (clamp)")
+        for radii in ("single", "octants"):
+            start = time.perf_counter()
+            relief.safety = safety_radii(relief.height, tolerance=tol,
+                                         octants=radii == "octants")
+            seconds = time.perf_counter() - start
+            for zero in ("clamp", "exact"):
+                frame = render(relief, camera, method="robust", zero_radius=zero,
+                               exact_below=0, count_iterations=True)
+                ms = time_render(relief, camera, method="robust", zero_radius=zero,
+                                 exact_below=0, repeats=cfg.repeats)["wall_ms"]
+                wrong = wrong_hits(frame, relief, camera)
+                rows.append({"tolerance": tol, "radii": radii, "zero_radius": zero,
+                             "mean_radius": float(relief.safety.mean()),
+                             "zero_fraction": float((relief.safety == 0).mean()),
+                             "iterations_mean": frame.stats["iterations_mean"],
+                             "frame_ms": ms, "bake_s": seconds,
+                             "wrong_fraction": wrong["wrong_fraction"]})
+            log(f"fig 12: tolerance {tol}, {radii} radii: mean radius "
+                f"{rows[-1]['mean_radius']:.2f}, iterations {rows[-2]['iterations_mean']:.1f} "
+                "(clamp)")
     return rows
 
 
@@ -240,13 +249,15 @@ def markdown(results: dict) -> str:
         its = [f"{r[f'{k}_it_mean']:.1f} / {r[f'{k}_it_max']}" for k in METHODS]
         lines.append(f"| {r['model']} | {r['res']}² | {r['mesh_ms']:.1f} | " + " | ".join(times)
                      + " | " + " | ".join(its) + f" | {r['robust_ms'] / r['binary_ms']:.2f} |")
-    lines += ["", "#### Fig. 12: safety tolerance (terrain, robust method)", "",
-              "| tolerance | zero radius | mean radius | zero-radius texels | iterations | "
-              "wrong pixels |", "|---" * 6 + "|"]
+    lines += ["", "#### Fig. 12: safety tolerance, one radius per texel or one per direction "
+              "octant (terrain, robust method, every ray jumping)", "",
+              "| tolerance | radii | zero radius | mean radius | zero-radius texels | "
+              "iterations | frame ms | radii s | wrong pixels |", "|---" * 9 + "|"]
     for r in results["tolerance"]:
-        lines.append(f"| {r['tolerance']} | {r['zero_radius']} | {r['mean_radius']:.2f} | "
-                     f"{r['zero_fraction']:.1%} | {r['iterations_mean']:.1f} | "
-                     f"{r['wrong_fraction']:.3%} |")
+        lines.append(f"| {r['tolerance']} | {r.get('radii', 'single')} | {r['zero_radius']} | "
+                     f"{r['mean_radius']:.2f} | {r['zero_fraction']:.1%} | "
+                     f"{r['iterations_mean']:.1f} | {r.get('frame_ms', float('nan')):.1f} | "
+                     f"{r.get('bake_s', float('nan')):.2f} | {r['wrong_fraction']:.3%} |")
     lines += ["", "#### Correctness: wrong-hit fraction against the exact reference", "",
               "| model | view (az, el) | " + " | ".join(METHODS) + " |",
               "|---" * (2 + len(METHODS)) + "|"]
@@ -290,7 +301,8 @@ def plot(results: dict, path: Path) -> None:
     axes[0].set(xscale="log", yscale="log", xlabel="depth resolution",
                 ylabel="iterations per fragment (mean)", title="Table 1: iterations")
     axes[0].legend(fontsize=6, ncol=2)
-    tol = [r for r in results["tolerance"] if r["zero_radius"] == "clamp"]
+    tol = [r for r in results["tolerance"] if r["zero_radius"] == "clamp"
+           and r.get("radii", "single") == "single"]
     x = [max(r["tolerance"], 1e-4) for r in tol]
     axes[1].plot(x, [r["mean_radius"] for r in tol], "-o", label="mean safety radius")
     axes[1].plot(x, [r["iterations_mean"] for r in tol], "-s", label="robust iterations")

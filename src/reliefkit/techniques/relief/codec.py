@@ -18,7 +18,7 @@ RELIEF_ARRAYS = {
     "height": ArraySpec(("float32",), ndim=2, finite=True),
     "color": ArraySpec(("uint8",), ndim=3, trailing=(None, 4)),
     "normal": ArraySpec(("float32",), ndim=3, trailing=(None, 3), finite=True),
-    "safety": ArraySpec(("uint8", "uint16"), ndim=2, required=False),
+    "safety": ArraySpec(("uint8", "uint16"), ndim=(2, 3), required=False),
     "box_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
     "clip_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False, finite=True),
     "source_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False,

@@ -10,7 +10,7 @@ from ...core.params import param
 from ...errors import UsageError
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
-from ...gl.textures import texture2d, texture_levels
+from ...gl.textures import texture2d, texture_array, texture_levels
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
 from ...render.proxy import aabb_planes, box_planes, convex_proxy, cull_face
@@ -83,7 +83,9 @@ class ReliefDrawable:
         self.method = "exact" if opts.method == "robust" and w + h <= opts.exact_below \
             else opts.method
         self.prog = program(ctx, PROGRAM, {
-            f"METHOD_{self.method.upper()}": True, "WRITE_DEPTH": opts.depth_mode == "exact",
+            f"METHOD_{self.method.upper()}": True,
+            "SAFETY_OCTANTS": self.method == "robust" and relief.safety.ndim == 3,
+            "WRITE_DEPTH": opts.depth_mode == "exact",
             "SHADOWS": opts.shadows, "COUNT_ITERATIONS": instrument})
         self.textures = {}
         self.vao = self.vbo = self.ibo = None
@@ -93,7 +95,11 @@ class ReliefDrawable:
             self.textures["u_color"] = texture2d(ctx, relief.color, what="color", srgb=True,
                                                  mipmaps=True)
             self.textures["u_normal"] = texture2d(ctx, relief.normal, what="normal")
-            if self.method == "robust":
+            if self.method == "robust" and relief.safety.ndim == 3:
+                self.textures["u_safety_octants"] = texture_array(
+                    ctx, relief.safety.astype(np.float32), what="safety octants",
+                    filter="nearest")
+            elif self.method == "robust":
                 self.textures["u_safety"] = texture2d(ctx, relief.safety.astype(np.float32),
                                                       what="safety", filter="nearest")
             if self.method == "cone":

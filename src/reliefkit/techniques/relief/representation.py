@@ -34,8 +34,9 @@ class ReliefTexture:
     normal : (Hc, Wc, 3) float32 world-space unit normals, at the colour resolution.
     box_to_world : (4, 4) float64 map from box coordinates to world (projective for a
         reverse-perspective frustum; affine for a box).
-    safety : (H, W) uint8/uint16 safety radii in texels, or None (then only the binary and
-        exact methods can render it).
+    safety : (H, W) uint8/uint16 safety radii in texels, or (8, H, W): one radius per
+        projected-direction octant (`safety.octant`); or None (then the robust method
+        cannot render it).
     clip_bounds : (2, 3) float64 world box (min, max corner) that the drawn proxy is cut to
         (§4.1: fewer fragments for a frustum), or None to draw the whole box.
     source_bounds : (2, 3) float64 world bounding box of the mesh it was baked from, or None;
@@ -72,9 +73,10 @@ class ReliefTexture:
         self.box_to_world = _checked_box(self.box_to_world)
         if self.safety is not None:
             self.safety = np.ascontiguousarray(self.safety)
-            if self.safety.shape != self.height.shape or self.safety.dtype not in (
-                    np.uint8, np.uint16):
-                raise UsageError("safety must be uint8/uint16 with the height's shape")
+            if self.safety.shape not in (self.height.shape, (8, *self.height.shape)) or \
+                    self.safety.dtype not in (np.uint8, np.uint16):
+                raise UsageError("safety must be uint8/uint16 with the height's shape (H, W), "
+                                 "or (8, H, W) for one radius per direction octant")
             # a jump of max(W, H) centrelines crosses the whole field: larger radii are noise
             limit = max(MAX_UINT8_RADIUS, *self.height.shape)
             if int(self.safety.max()) > limit:

@@ -631,8 +631,19 @@ def checked_height(height) -> np.ndarray:
     return h
 
 
+def octant(x_major: bool, major_sign: float, minor_sign: float) -> int:
+    """The octant (index into `_FRAMES`, 0..7) of a projected direction, as the renderer
+    picks it: x-major when ``|dx| >= |dy|``; the signs of the major and the minor component
+    (a zero minor component counts as positive). The radii of octant k hold for every
+    direction of that octant, its boundary directions included."""
+    if x_major:
+        return 2 * int(major_sign < 0) + int(minor_sign < 0)
+    return 4 + 2 * int(major_sign < 0) + int(minor_sign < 0)
+
+
 def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
                  directions: int = 64, offsets: int = 4, margin: float = 0.25,
+                 octants: bool = False,
                  progress: Callable[[int, int], None] | None = None) -> np.ndarray:
     """Conservative safety radius of every texel (see the module docstring for the definition).
 
@@ -654,6 +665,10 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     margin : float
         Texels by which a found violation is moved closer to ``P`` (and the scan extended
         past the box exit) to cover violations between the samples; 0 disables it.
+    octants : bool
+        Direction-dependent radii: one radius per texel and projected-direction octant
+        (45 degrees each, `octant`), shape (8, H, W), instead of the smallest over all
+        directions. A rough field's radius is often limited by a few directions only.
     progress : callable, optional
         ``progress(done, total)`` called after each batch of work (one direction in one of
         the eight octant frames: ``total = 8 * (directions // 2 + 1)``), for a progress bar.
@@ -661,7 +676,7 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     Returns
     -------
     numpy.ndarray
-        (H, W) radii in texels, uint8 or uint16.
+        (H, W) radii in texels, uint8 or uint16; (8, H, W) with ``octants``.
 
     Raises
     ------
@@ -684,25 +699,29 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
         raise UsageError(f"margin must be within [0, 4] texels, got {margin!r}")
     dtype = np.uint8 if int(max_radius) <= 255 else np.uint16
     nthreads = numba.get_num_threads()
-    bufs = np.full((nthreads,) + h.shape, int(max_radius), dtype=np.int32)
+    per_frame = len(_FRAMES) if octants else 1
+    bufs = np.full((per_frame, nthreads) + h.shape, int(max_radius), dtype=np.int32)
     slopes = _slopes(int(directions))
     frames = [_frame(h, *f) for f in _FRAMES]
     eps = float(tolerance) * (1.0 - TOLERANCE_SLACK)
     total = len(_FRAMES) * len(slopes)
     done = 0
     for si in _coarse_to_fine(len(slopes)):
-        for (transpose, flipx, flipy), frame in zip(_FRAMES, frames, strict=True):
+        for f, ((transpose, flipx, flipy), frame) in enumerate(zip(_FRAMES, frames,
+                                                                    strict=True)):
             previous = numba.get_parallel_chunksize()
             numba.set_parallel_chunksize(1)
             try:
                 _sweep_direction(frame, float(slopes[si]), int(offsets), eps, NUMERIC_FLOOR,
-                                 float(margin), bufs, transpose, flipx, flipy)
+                                 float(margin), bufs[f if octants else 0], transpose, flipx,
+                                 flipy)
             finally:
                 numba.set_parallel_chunksize(previous)
             done += 1
             if progress is not None:
                 progress(done, total)
-    return bufs.min(axis=0).astype(dtype)
+    radii = bufs.min(axis=1).astype(dtype)
+    return radii if octants else radii[0]
 
 
 def zero_radius_fraction(safety) -> float:

@@ -24,7 +24,7 @@ from ...reference.heightfield import (
     surface_at,
     walk_segments,
 )
-from .safety import checked_height, hull_push, tangent_vertex
+from .safety import checked_height, hull_push, octant, tangent_vertex
 
 __all__ = ["CHECK_FLOOR", "Violation", "check_safety"]
 
@@ -230,10 +230,10 @@ def _check_one_ray(height, radius, j, i, major, sign, off, slope, kz, lift, mode
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _check_batch(height, safety, rows, cols, majors, signs, offs, slopes, ks, lifts, modes, tol,
+def _check_batch(height, radii, rows, cols, majors, signs, offs, slopes, ks, lifts, modes, tol,
                  status, depth, origins, dirs):
     for r in prange(rows.shape[0]):
-        s, dep = _check_one_ray(height, int(safety[rows[r], cols[r]]), rows[r], cols[r],
+        s, dep = _check_one_ray(height, int(radii[r]), rows[r], cols[r],
                                 majors[r], signs[r], offs[r], slopes[r], ks[r], lifts[r],
                                 modes[r], tol, origins[r], dirs[r])
         status[r] = s
@@ -303,7 +303,8 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     ----------
     height : (H, W) array_like
     safety : (H, W) array_like of int
-        Radii to check.
+        Radii to check; or (8, H, W), one per direction octant (`safety.octant`): each ray
+        is checked against its own octant's radius.
     tolerance : float
         The tolerance the radii were baked with.
     rays : int
@@ -320,21 +321,29 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     """
     h = checked_height(height)
     s = np.asarray(safety)
-    if s.shape != h.shape:
-        raise UsageError(f"safety shape {s.shape} does not match height shape {h.shape}")
+    if s.shape not in (h.shape, (8, *h.shape)):
+        raise UsageError(f"safety shape {s.shape} does not match height shape {h.shape} "
+                         "(or (8, H, W) per direction octant)")
     s = np.ascontiguousarray(s, dtype=np.int64)
     rng = np.random.default_rng(seed)
     params = _ray_parameters(h.shape, rays, rng, adversarial)
     rows, cols, majors = params[:3]
+    if s.ndim == 3:  # each ray checks the radius of its direction's octant
+        signs, slopes = params[3], params[5]
+        octants = np.array([octant(m == 0, sg, sg * sl)
+                            for m, sg, sl in zip(majors, signs, slopes, strict=True)])
+        radii = s[octants, rows, cols]
+    else:
+        radii = s[rows, cols]
     n = rows.shape[0]
     status = np.zeros(n, np.int64)
     depth = np.zeros(n)
     origins = np.zeros((n, 3))
     dirs = np.zeros((n, 3))
-    _check_batch(h, s, *params, float(tolerance), status, depth, origins, dirs)
+    _check_batch(h, radii, *params, float(tolerance), status, depth, origins, dirs)
     out = []
     for r in np.nonzero(status == 2)[0]:
-        radius = int(s[rows[r], cols[r]])
+        radius = int(radii[r])
         cr = crossings_between(h, origins[r], dirs[r], 0.0, float(radius))
         out.append(Violation(int(rows[r]), int(cols[r]), radius, "xy"[int(majors[r])],
                              tuple(float(v) for v in origins[r]),

@@ -1,6 +1,6 @@
 // Relief texture (Baboud & Decoret 2006): rasterize the box (or reverse frustum) and
 // intersect each pixel's ray with the heightfield in normalized box coordinates.
-//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST METHOD_MAXMIP METHOD_CONE WRITE_DEPTH SHADOWS
+//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST METHOD_MAXMIP METHOD_CONE SAFETY_OCTANTS WRITE_DEPTH SHADOWS
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"

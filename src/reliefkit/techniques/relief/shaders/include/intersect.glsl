@@ -107,7 +107,11 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 #endif
 
 #if defined METHOD_ROBUST
+#if defined SAFETY_OCTANTS
+uniform highp sampler2DArray u_safety_octants;  // R32F radii per direction octant (safety.py)
+#else
 uniform sampler2D u_safety;   // R32F radii in texels (0: non-concave peak)
+#endif
 uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (else clamp to 1)
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
@@ -128,6 +132,11 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
     float dir = dm > 0.0 ? 1.0 : -1.0;
     float ci = dm > 0.0 ? floor(xm - 0.5) : ceil(xm - 0.5);
     float sa = s0;  // last parameter known to be above the surface
+#if defined SAFETY_OCTANTS
+    // the octant of this ray's direction (safety.octant): major axis, its sign, the minor's
+    float minor_d = x_major ? d.y : d.x;
+    int octant = (x_major ? 0 : 4) + (dm < 0.0 ? 2 : 0) + (minor_d < 0.0 ? 1 : 0);
+#endif
     int k = 0;
     for (int round = 0; round < HARD_CAP && k < u_max_iterations; ++round) {
         float walk_from = s0, walk_to = s1;
@@ -138,7 +147,12 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
                 float minor = x_major ? o.y + s * d.y : o.x + s * d.x;
                 ivec2 texel = x_major ? ivec2(int(ci), int(floor(minor)))
                                       : ivec2(int(floor(minor)), int(ci));
+#if defined SAFETY_OCTANTS
+                float r = texelFetch(u_safety_octants,
+                                     ivec3(clamp(texel, ivec2(0), u_hf_size - 1), octant), 0).r;
+#else
                 float r = texelFetch(u_safety, clamp(texel, ivec2(0), u_hf_size - 1), 0).r;
+#endif
                 if (r < 0.5 && u_zero_exact) {  // walk exactly to the next major centreline
                     ci += dir;
                     walk_from = max(s, s0);
