@@ -19,6 +19,7 @@ from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
 METHODS = ("binary", "exact", "robust", "maxmip", "cone")
+SMALL_FIELD = 64  # robust draws fields with W + H <= this with the exact walk's program
 PROGRAM = "relief:relief.glsl"
 
 
@@ -37,9 +38,8 @@ class ReliefRenderOptions:
     zero_radius: str = param("exact", "robust method at a zero safety radius: walk exactly "
                              "to the next centreline, or clamp the radius to 1",
                              choices=("exact", "clamp"))
-    exact_below: int = param(128, "robust: rays crossing fewer texels than this are walked "
-                             "exactly, which is cheaper for them (0: the paper's walk for every "
-                             "ray)", lo=0, hi=65536)
+    exact_below: int = param(0, "robust: rays crossing fewer texels than this are walked "
+                             "exactly (0: the paper's walk for every ray)", lo=0, hi=65536)
     cell_test: str = param("quadratic", "exact/robust: test each cell's exact quadratic, or "
                            "assume heights linear between centrelines as the paper does",
                            choices=("quadratic", "linear"))
@@ -79,9 +79,10 @@ class ReliefDrawable:
         w, h = relief.depth_resolution
         # robust walks every ray shorter than exact_below texels exactly: when no ray of this
         # field can be longer (W + H bounds |dx| + |dy|), the exact walk's own program draws
-        # the same hits without the robust code around it
-        self.method = "exact" if opts.method == "robust" and w + h <= opts.exact_below \
-            else opts.method
+        # the same hits without the robust code around it; so does a field so small
+        # (SMALL_FIELD) that the exact walk is the cheaper one (32² here: 53 against 70 ms)
+        small = w + h <= SMALL_FIELD or w + h < opts.exact_below
+        self.method = "exact" if opts.method == "robust" and small else opts.method
         self.prog = program(ctx, PROGRAM, {
             f"METHOD_{self.method.upper()}": True,
             "SAFETY_OCTANTS": self.method == "robust" and relief.safety.ndim == 3,

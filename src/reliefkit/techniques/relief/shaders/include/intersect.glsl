@@ -116,10 +116,10 @@ uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (el
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
 // The radius jumps stop at a texel of radius 0; the exact walk then covers up to the next
-// major centreline and the jumps resume. Short rays (fewer than u_exact_below texels: the
-// walk costs less than the lookups, the jumps' tests and the final bisection) and vertical
-// ones are walked exactly from the start. The exact walk has one call site, so the shader
-// inlines it once.
+// major centreline and the jumps resume. Rays shorter than u_exact_below texels (an option,
+// 0 by default) and vertical ones are walked exactly from the start. The exact walk has one
+// call site, so the shader inlines it once: with the walk nested in the jumps (inlined
+// twice) robust ran 1.1-1.5x slower than the exact walk at 32²-128² on llvmpipe.
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
