@@ -28,6 +28,7 @@ from numba import njit
 
 from ...core.transforms import transform_points
 from ...errors import UsageError
+from ...reference.heightfield import clip_box
 from ...scene.camera import pixel_segments
 from .depth_images import DepthImages
 
@@ -130,18 +131,7 @@ def _trace_all(bounds, n, q_near, q_far, hit_t, hit_q, hit_face):
             for a in range(3):
                 q0[a] = q_near[r, c, a]
                 dq[a] = q_far[r, c, a] - q_near[r, c, a]
-            t_in, t_out = 0.0, 1.0
-            for a in range(3):  # clip the segment to the cube [0, 1]^3
-                if dq[a] == 0.0:
-                    if q0[a] < 0.0 or q0[a] > 1.0:
-                        t_out = -1.0
-                else:
-                    s1 = (0.0 - q0[a]) / dq[a]
-                    s2 = (1.0 - q0[a]) / dq[a]
-                    if s1 > s2:
-                        s1, s2 = s2, s1
-                    t_in = max(t_in, s1)
-                    t_out = min(t_out, s2)
+            t_in, t_out = clip_box(q0, dq, 0.0, 1.0)  # the segment inside the cube
             if t_in > t_out:
                 continue
             t, face = _trace(bounds, n, q0, dq, t_in, t_out, out_q)
