@@ -24,7 +24,7 @@ from ...reference.heightfield import (
     surface_at,
     walk_segments,
 )
-from .safety import checked_height, hull_push, octant, tangent_vertex
+from .safety import checked_height, hull_push, tangent_vertex
 
 __all__ = ["CHECK_FLOOR", "Violation", "check_safety"]
 
@@ -330,8 +330,8 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     rows, cols, majors = params[:3]
     if s.ndim == 3:  # each ray checks the radius of its direction's octant
         signs, slopes = params[3], params[5]
-        octants = np.array([octant(m == 0, sg, sg * sl)
-                            for m, sg, sl in zip(majors, signs, slopes, strict=True)])
+        # safety.octant, for all rays at once
+        octants = 4 * (majors != 0) + 2 * (signs < 0) + (signs * slopes < 0)
         radii = s[octants, rows, cols]
     else:
         radii = s[rows, cols]
