@@ -345,6 +345,10 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor):
     Two states alternate:
 
     * tracking (``k(a)`` is the running maximum and increasing): no violation is possible;
+      on a convex or straight piece where ``k`` rises at the start it rises to the end (each
+      slope ``g_v(a)`` from a hull vertex ``v`` is then decreasing-then-increasing, and one
+      still decreasing lies above ``f'(a)``, above the rising minimiser), so such a piece is
+      skipped whole and the tangent vertex found again by bisection where it is next needed;
       the tangent vertex ``t`` of the moving point is followed exactly (it switches where the
       point crosses a hull edge extension) and ``k(a) = phi_t(a)`` stops increasing where
       ``N_t(a) = f'(a)(a - x_t) - (f(a) - eps - z_t)`` reaches 0 (both are quadratics);
@@ -371,12 +375,22 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor):
         done = False
         for _ in range(4 * nh + 16):
             if tracking:
+                if t < 0:
+                    t = _vertex_at(u, x0, c0, c1, c2, work, nh, eps)
                 xt = work[4, t]
                 zt = work[5, t]
                 d = x0 - xt
                 nc = c1 * d - c0 + eps + zt
                 nu = _qv(c2, 2.0 * c2 * d, nc, u)
-                rising = nu > _ZERO or (nu > -_ZERO and c2 > 0.0) or resumed_at == u
+                surely_rising = nu > _ZERO or (nu > -_ZERO and c2 > 0.0)
+                if surely_rising and c2 >= 0.0:
+                    # convex or straight piece: k rises on to its end (see _scan); the
+                    # tangent vertex is found again where it is next needed
+                    t = -1
+                    came_from = -1
+                    done = True
+                    break
+                rising = surely_rising or resumed_at == u
                 if not rising:
                     k = _phi(u, x0, c0, c1, c2, xt, zt, eps)
                     tk = t
