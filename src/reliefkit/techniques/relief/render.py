@@ -40,14 +40,17 @@ class ReliefRenderOptions:
                              choices=("exact", "clamp"))
     exact_below: int = param(0, "robust: rays crossing fewer texels than this are walked "
                              "exactly (0: the paper's walk for every ray)", lo=0, hi=65536)
-    cell_test: str = param("quadratic", "exact/robust: test each cell's exact quadratic, or "
-                           "assume heights linear between centrelines as the paper does",
+    cell_test: str = param("quadratic", "exact walk: test each cell's exact quadratic, or "
+                           "only its far end as the paper does",
                            choices=("quadratic", "linear"))
     linear_steps: int = param(16, "binary: fixed pre-steps", lo=1, hi=4096)
-    binary_steps: int = param(8, "binary search steps once a hit is bracketed", lo=1, hi=4096)
+    binary_steps: int = param(8, "binary, cone: binary search steps once a hit is bracketed",
+                              lo=1, hi=4096)
     cone_steps: int = param(32, "cone: steps before the ray stops where it is (GPU Gems 3 "
                             "uses 15)",
                             lo=1, hi=4096)
+    maxmip_leaf: int = param(2, "maxmip: nodes of 2^L texels are walked cell by cell "
+                             "(0: descend to single texels, as Tevs et al.)", lo=0, hi=15)
     max_iterations: int = param(0, "bound on every walk (0: 4 (W + H) + 64)", lo=0,
                                 hi=16384)
 
@@ -63,9 +66,10 @@ def relief_proxy(relief: ReliefTexture):
 class ReliefDrawable:
     """GPU textures and proxy of one ReliefTexture, drawn with one intersection method.
 
-    ``cell_test="linear"`` is the paper's exact walk (heights linear between centreline
-    crossings, §3.3); ``"quadratic"`` (default) also tests the exact quadratic inside each
-    cell with one more fetch per step, so saddle grazes (Fig. 3) are found too.
+    The exact walk takes one bilinear cell per step (its four corners, the ray's exact
+    quadratic in it, the exact root). ``cell_test="linear"`` is the paper's walk (a cell is
+    hit only when its far end is below, §3.3); ``"quadratic"`` (default) also finds the
+    saddle grazes inside a cell (Fig. 3).
     """
 
     def __init__(self, ctx, relief: ReliefTexture, options: ReliefRenderOptions | None = None,
@@ -127,6 +131,7 @@ class ReliefDrawable:
             "u_quadratic_cells": opts.cell_test == "quadratic",
             "u_top_level": getattr(self, "top_level", 0),
             "u_cone_steps": opts.cone_steps,
+            "u_leaf_level": min(opts.maxmip_leaf, getattr(self, "top_level", 0)),
         }
         check_gl_error(ctx, "uploading a relief texture")
 

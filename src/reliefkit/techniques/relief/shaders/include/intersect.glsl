@@ -54,44 +54,70 @@ float next_centerline(float x, float ox, float dx) {
 
 uniform bool u_quadratic_cells;  // test the exact quadratic inside each cell (see below)
 
-// Inside one cell the bilinear surface along the ray is a quadratic in s, so F = above()
-// sampled at both ends and the middle is known exactly on [sa, sb]. Returns the parameter
-// of a point below the surface if the parabola dips below zero between the samples, else -1.
-// The paper's exact walk (section 3.3) assumes F linear there and misses such grazes (Fig. 3).
-float cell_dip(vec3 o, vec3 d, float sa, float fa, float sb, float fb) {
-    float fm = hf_above(o + 0.5 * (sa + sb) * d);
-    float a = 2.0 * fa - 4.0 * fm + 2.0 * fb;   // F(tau) = fa + b tau + a tau^2, tau in [0,1]
-    float b = -3.0 * fa + 4.0 * fm - fb;
-    if (fm < 0.0) return 0.5 * (sa + sb);
-    if (a <= 0.0) return -1.0;
-    float tau = -b / (2.0 * a);
-    if (tau <= 0.0 || tau >= 1.0 || fa + tau * (b + a * tau) >= 0.0) return -1.0;
-    return sa + tau * (sb - sa);
+// F(s) = z(s) - height(s) on the bilinear cell that holds the ray between two consecutive
+// centreline crossings sa < sb: F = c.x + c.y t + c.z t^2 with t = s - sa, exactly (the
+// four corners fetched once; in the border strips the clamped coordinate is constant). A cell
+// whose corners are all 0 is empty space (hf_above): it is never hit.
+vec3 cell_poly(vec3 o, vec3 d, float sa, float sb) {
+    vec2 last = vec2(u_hf_size) - 1.0;
+    vec2 qm = o.xy + 0.5 * (sa + sb) * d.xy - 0.5;          // the segment's middle
+    vec2 c = floor(clamp(qm, vec2(0.0), last));
+    bvec2 strip = bvec2(qm.x <= 0.0 || qm.x >= last.x, qm.y <= 0.0 || qm.y >= last.y);
+    vec2 a = o.xy + sa * d.xy - 0.5 - c;                     // cell coordinates at sa
+    vec2 dd = d.xy;
+    if (strip.x) { a.x = 0.0; dd.x = 0.0; }
+    if (strip.y) { a.y = 0.0; dd.y = 0.0; }
+    int i = int(c.x), j = int(c.y);
+    int i1 = strip.x ? i : i + 1, j1 = strip.y ? j : j + 1;  // a strip has one column (row)
+    float h00 = hf_texel(i, j), h10 = hf_texel(i1, j);
+    float h01 = hf_texel(i, j1), h11 = hf_texel(i1, j1);
+    if (max(max(h00, h10), max(h01, h11)) <= 0.0) return vec3(1.0, 0.0, 0.0);  // empty
+    float ex = h10 - h00, ey = h01 - h00, g = h11 - h10 - h01 + h00;
+    float za = o.z + sa * d.z;
+    return vec3(za - (h00 + ex * a.x + ey * a.y + g * a.x * a.y),
+                d.z - (ex * dd.x + ey * dd.y + g * (a.x * dd.y + a.y * dd.x)),
+                -g * dd.x * dd.y);
 }
 
-// Walk centreline crossings from sa (above) to s_end; true with s_hit on the first hit.
+// First t in [0, len] where the quadratic c goes below zero, or -1. With `ends_only` the
+// cell counts as hit only when its far end is below (the paper's walk, section 3.3, which
+// takes F linear between crossings and misses grazes, Fig. 3); the hit is still the exact
+// root. A start value below zero by rounding counts as zero.
+float cell_hit(vec3 c, float len, bool ends_only) {
+    c.x = max(c.x, 0.0);
+    float f_end = c.x + len * (c.y + len * c.z);
+    bool end_below = f_end < 0.0;
+    if (!end_below) {
+        if (ends_only || c.z <= 0.0) return -1.0;
+        float tv = -c.y / (2.0 * c.z);                       // convex: the dip's bottom
+        if (tv <= 0.0 || tv >= len || c.x + tv * (c.y + tv * c.z) >= 0.0) return -1.0;
+    }
+    if (c.z == 0.0) return c.y < 0.0 ? clamp(-c.x / c.y, 0.0, len) : 0.0;
+    float disc = max(c.y * c.y - 4.0 * c.z * c.x, 0.0);
+    float q = -0.5 * (c.y + (c.y >= 0.0 ? sqrt(disc) : -sqrt(disc)));  // stable roots
+    float r1 = q / c.z, r2 = q != 0.0 ? c.x / q : 0.0;
+    float lo = min(r1, r2), hi = max(r1, r2);
+    float t = lo >= 0.0 ? lo : hi;                            // the first root at or after 0
+    return clamp(t, 0.0, len);
+}
+
+// Walk centreline crossings from sa (above) to s_end, one bilinear cell per iteration; true
+// with s_hit on the first hit.
 bool walk_exact(vec3 o, vec3 d, float sa, float s_end, out float s_hit, inout int iters) {
     vec3 p = o + sa * d;
-    float fa = hf_above(p);
     vec2 t = vec2(next_centerline(p.x, o.x, d.x), next_centerline(p.y, o.y, d.y));
     vec2 dt = vec2(d.x != 0.0 ? 1.0 / abs(d.x) : 3.0e38, d.y != 0.0 ? 1.0 / abs(d.y) : 3.0e38);
     for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
         float sb = min(min(t.x, t.y), s_end);
-        float fb = hf_above(o + sb * d);
         iters++;
-        if (fb < 0.0) {
-            s_hit = refine_hit(o, d, sa, sb, iters);
-            return true;
-        }
-        float s_dip = u_quadratic_cells ? cell_dip(o, d, sa, fa, sb, fb) : -1.0;
-        if (s_dip >= 0.0) {
-            s_hit = refine_hit(o, d, sa, s_dip, iters);
+        float th = cell_hit(cell_poly(o, d, sa, sb), sb - sa, !u_quadratic_cells);
+        if (th >= 0.0) {
+            s_hit = sa + th;
             return true;
         }
         if (sb >= s_end) break;
         if (t.x <= t.y) t.x += dt.x; else t.y += dt.y;
         sa = sb;
-        fa = fb;
     }
     s_hit = s_end;
     return false;
@@ -116,10 +142,12 @@ uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (el
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
 // The radius jumps stop at a texel of radius 0; the exact walk then covers up to the next
-// major centreline and the jumps resume. Rays shorter than u_exact_below texels (an option,
-// 0 by default) and vertical ones are walked exactly from the start. The exact walk has one
-// call site, so the shader inlines it once: with the walk nested in the jumps (inlined
-// twice) robust ran 1.1-1.5x slower than the exact walk at 32²-128² on llvmpipe.
+// major centreline and the jumps resume. A jump that ends below the surface is walked
+// exactly too (the paper bisects it; the cell walk finds the first crossing, also of a dip
+// the tolerance let the jumps pass, for fewer fetches). Rays shorter than u_exact_below
+// texels (an option, 0 by default) and vertical ones are walked exactly from the start. The
+// exact walk has one call site, so the shader inlines it once: with the walk nested in the
+// jumps (inlined twice) robust ran 1.1-1.5x slower than the exact walk on llvmpipe.
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
@@ -138,6 +166,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
     int octant = (x_major ? 0 : 4) + (dm < 0.0 ? 2 : 0) + (minor_d < 0.0 ? 1 : 0);
 #endif
     int k = 0;
+    bool bracketed = false;
     for (int round = 0; round < HARD_CAP && k < u_max_iterations; ++round) {
         float walk_from = s0, walk_to = s1;
         if (!walk_all) {
@@ -163,9 +192,11 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
                 float s_new = (ci + 0.5 - om) / dm;
                 float sb = min(s_new, s1);
                 iters++;
-                if (hf_above(o + sb * d) < 0.0) {
-                    s_hit = refine_hit(o, d, max(sa, s0), sb, iters);
-                    return true;
+                if (hf_above(o + sb * d) < 0.0) {  // the hit is in this jump: walk it exactly
+                    walk_from = max(sa, s0);
+                    walk_to = sb;
+                    bracketed = true;
+                    break;
                 }
                 if (s_new >= s1) return false;
                 sa = s_new;
@@ -173,6 +204,10 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
             if (walk_from < 0.0) return false;
         }
         if (walk_exact(o, d, walk_from, walk_to, s_hit, iters)) return true;
+        if (bracketed) {  // below at the jump's end, above in every cell by rounding
+            s_hit = walk_to;
+            return true;
+        }
         if (walk_all || walk_to >= s1) return false;
         sa = walk_to;
         ++k;
@@ -184,6 +219,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 #if defined METHOD_MAXMIP
 uniform sampler2D u_maxmip;   // R32F max pyramid (maxmip.py): level L node = 2^L texels
 uniform int u_top_level;      // its 1 x 1 level
+uniform int u_leaf_level;     // nodes at or below this level are walked cell by cell
 
 // Parameter where the ray leaves the node [lo, lo + size]^2 (texel coordinates).
 float node_exit(vec3 o, vec3 d, vec2 lo, float size) {
@@ -194,13 +230,18 @@ float node_exit(vec3 o, vec3 d, vec2 lo, float size) {
 
 // Quadtree traversal: a node whose maximum stays below the ray over the ray's span in it is
 // skipped whole (and the walk climbs a level); otherwise the walk descends to the child the
-// ray is in, first moving down to where the ray meets the node's maximum. In a level-0
-// node (one texel square) the exact walk tests the bilinear cells exactly.
+// ray is in, first moving down to where the ray meets the node's maximum. In a node at the
+// leaf level (2^L texels square; Tevs et al. descend to single texels, L = 0) the exact walk
+// tests the bilinear cells exactly: a few cells cost less than the descents and climbs.
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
-    int level = u_top_level;
-    ivec2 node = ivec2(0);
+    // start in the node of the entry point at the level of the ray's footprint: a short ray
+    // need not descend from the 1 x 1 top
+    float span = length(d.xy) * (s1 - s0);
+    int level = clamp(int(ceil(log2(max(span, 1.0)))), u_leaf_level, u_top_level);
+    ivec2 node = clamp(ivec2(floor((o.xy + s0 * d.xy) / float(1 << level))), ivec2(0),
+                       ivec2((1 << (u_top_level - level)) - 1));
     ivec2 step = ivec2(d.x >= 0.0 ? 1 : -1, d.y >= 0.0 ? 1 : -1);
     float s = s0;
     for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
@@ -210,7 +251,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
         float s_exit = min(node_exit(o, d, lo, size), s1);
         float top = texelFetch(u_maxmip, node, level).r;
         bool skip = min(o.z + s * d.z, o.z + s_exit * d.z) > top;
-        if (!skip && level == 0) {
+        if (!skip && level <= u_leaf_level) {
             if (walk_exact(o, d, s, s_exit, s_hit, iters)) return true;
             skip = true;
         }
