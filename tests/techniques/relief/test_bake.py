@@ -202,3 +202,27 @@ def test_bakes_that_would_run_for_many_minutes_are_refused_up_front(kind, res):
         bake(make_asset("blob"), kind, depth_res=res)
     with pytest.raises(UsageError, match="would take about"):
         bake(np.zeros((2048, 2048)), "relief")
+
+
+def test_a_frustum_takes_octant_radii_and_robust_keeps_the_reference_hits(gl):
+    """Rays are straight in a frustum's texel space, so the radii per direction octant hold
+    there as in an orthographic box: robust with every ray jumping meets the exact reference."""
+    from reliefkit.techniques.relief.reference import wrong_hits
+
+    rep = bake_relief_frustum(make_asset("vehicle"), depth_res=48, octants=True)
+    assert rep.safety.shape == (8, *rep.height.shape)
+    camera = orbit_bounds(rep.bounds, 30, 25, 2.6, size=(96, 96))
+    frame = render(rep, camera, method="robust", exact_field=0)
+    assert wrong_hits(frame, rep, camera)["wrong_fraction"] <= 0.005
+
+
+def test_a_cube_bakes_octant_radii_per_face(gl):
+    """Each of the six faces gets (8, H, W) radii; at 24² (W + H <= exact_field) robust draws
+    the faces with the exact walk, which meets the reference."""
+    from reliefkit.techniques.relief.reference import wrong_hits
+
+    rep = bake_relief_cube(make_asset("blob"), depth_res=24, octants=True)
+    assert all(p.safety.shape == (8, 24, 24) for p in rep.parts)
+    camera = orbit_bounds(rep.bounds, 30, 25, 2.6, size=(96, 96))
+    frame = render(rep, camera, method="robust")
+    assert wrong_hits(frame, rep, camera)["wrong_fraction"] <= 0.001

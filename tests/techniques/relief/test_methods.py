@@ -48,7 +48,7 @@ def fields():
 def test_exact_robust_and_maxmip_match_reference(gl, fields, name, az, el):
     relief = fields[name]
     camera = Camera.orbit((0, 0.5, 0), az, el, 3.0, size=(96, 96))
-    for method, budget, extra in (("exact", 0.001, {}), ("robust", 0.005, {"exact_below": 0}),
+    for method, budget, extra in (("exact", 0.001, {}), ("robust", 0.005, {"exact_field": 0}),
                                   ("robust", 0.005, {}), ("maxmip", 0.001, {})):
         frame = render(relief, camera, method=method, **extra)
         result = wrong_hits(frame, relief, camera)
@@ -59,7 +59,7 @@ def test_exact_robust_and_maxmip_match_reference(gl, fields, name, az, el):
 def test_robust_with_clamped_radii_stays_close(gl, fields):
     relief = fields["smooth"]
     camera = Camera.orbit((0, 0.5, 0), 30, 30, 3.0, size=(96, 96))
-    frame = render(relief, camera, method="robust", zero_radius="clamp", exact_below=0)
+    frame = render(relief, camera, method="robust", zero_radius="clamp", exact_field=0)
     assert wrong_hits(frame, relief, camera)["wrong_fraction"] <= 0.02
 
 
@@ -105,12 +105,16 @@ def test_maxmip_iterations_grow_like_the_log_of_the_resolution(gl):
 
 def test_robust_draws_a_small_field_with_the_exact_walk_and_the_same_hits(gl, fields):
     """No ray of a 40² field crosses 128 texels: with exact_below=128 robust draws it with the
-    exact program; by default (0) every ray jumps."""
+    exact program, as it does by default for a field with W + H <= 256 (exact_field); with
+    exact_field=0 and exact_below=0 every ray jumps."""
     relief = fields["rough"]
     camera = Camera.orbit((0, 0.5, 0), 120, 20, 3.0, size=(64, 64))
-    robust = render(relief, camera, method="robust", exact_below=128, count_iterations=True)
+    robust = render(relief, camera, method="robust", exact_below=128, exact_field=0,
+                    count_iterations=True)
+    default = render(relief, camera, method="robust", count_iterations=True)
+    assert default.stats["iterations_mean"] == robust.stats["iterations_mean"]
     exact = render(relief, camera, method="exact", count_iterations=True)
-    jumps = render(relief, camera, method="robust", count_iterations=True)
+    jumps = render(relief, camera, method="robust", exact_field=0, count_iterations=True)
     assert np.array_equal(robust.mask, exact.mask)
     assert np.array_equal(robust.position[robust.mask], exact.position[exact.mask])
     assert robust.stats["iterations_mean"] == exact.stats["iterations_mean"]
@@ -122,7 +126,7 @@ def test_octant_radii_take_fewer_iterations_with_the_same_hits(gl, fields):
     relief = make_relief(h, safety=safety_radii(h, tolerance=0.01, octants=True))
     single = make_relief(h, safety=safety_radii(h, tolerance=0.01))
     camera = Camera.orbit((0, 0.5, 0), 120, 20, 3.0, size=(96, 96))
-    frames = {name: render(rep, camera, method="robust", exact_below=0, count_iterations=True)
+    frames = {name: render(rep, camera, method="robust", exact_field=0, count_iterations=True)
               for name, rep in (("octants", relief), ("single", single))}
     assert wrong_hits(frames["octants"], relief, camera)["wrong_fraction"] <= 0.005
     assert frames["octants"].stats["iterations_mean"] < \

@@ -11,7 +11,7 @@ from reliefkit.scene.mesh import RenderMesh, vertex_normals
 
 METHODS = ["binary", "exact", "robust", "maxmip", "cone"]
 #: robust walks short rays exactly (the small test fields would never jump): off here
-OPTIONS = {"robust": {"exact_below": 0}}
+OPTIONS = {"robust": {"exact_field": 0}}
 
 
 def flat(level, n=32):

@@ -44,6 +44,11 @@ def _safety():
     return param(True, "bake safety radii (needed by the robust method)")
 
 
+def _octants():
+    return param(False, "safety radii per direction octant (8 per texel): larger radii on "
+                 "rough fields, 8x the radii's memory")
+
+
 def _tolerance():
     return param(DEFAULT_TOLERANCE, "safety radii: ignored dip depth (height units, Fig. 12); "
                  "larger radii and fewer iterations for a bounded silhouette error",
@@ -60,8 +65,7 @@ class ReliefParams:
     color_res: int | None = _color_res()
     safety: bool = _safety()
     safety_tolerance: float = _tolerance()
-    safety_octants: bool = param(False, "safety radii per direction octant (8 per texel): "
-                                 "larger radii on rough fields, 8x the radii's memory")
+    safety_octants: bool = _octants()
     axis: str = _axis()
     box: tuple = param((2.0, 0.5, 2.0), "heightmaps: world size SX,SY,SZ of the box",
                        kind="floats", count=3, lo=1e-9)
@@ -73,6 +77,7 @@ class ReliefFrustumParams:
     color_res: int | None = _color_res()
     safety: bool = _safety()
     safety_tolerance: float = _tolerance()
+    safety_octants: bool = _octants()
     axis: str = _axis()
     spread: float = param(30.0, "reverse frustum: side tilt in degrees", lo=1.0, hi=75.0)
     clip: bool = param(True, "cut the drawn frustum to the mesh's bounds (§4.1)")
@@ -84,6 +89,7 @@ class ReliefCubeParams:
     color_res: int | None = _color_res()
     safety: bool = _safety()
     safety_tolerance: float = _tolerance()
+    safety_octants: bool = _octants()
 
 
 def bake_orthographic(source, p: ReliefParams, progress=None):
@@ -104,11 +110,13 @@ def bake_frustum(source, p: ReliefFrustumParams, progress=None):
         check_safety_work(p.depth_res, p.depth_res)
     return bake_relief_frustum(source, depth_res=p.depth_res, color_res=p.color_res,
                                axis=p.axis, spread_deg=p.spread, clip=p.clip, safety=p.safety,
-                               tolerance=p.safety_tolerance, progress=progress)
+                               tolerance=p.safety_tolerance, progress=progress,
+                               octants=p.safety_octants)
 
 
 def bake_cube(source, p: ReliefCubeParams, progress=None):
     if p.safety:
         check_safety_work(p.depth_res, p.depth_res, parts=6)
     return bake_relief_cube(source, depth_res=p.depth_res, color_res=p.color_res,
-                            safety=p.safety, tolerance=p.safety_tolerance, progress=progress)
+                            safety=p.safety, tolerance=p.safety_tolerance, progress=progress,
+                            octants=p.safety_octants)

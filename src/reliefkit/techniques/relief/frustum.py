@@ -72,7 +72,7 @@ def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
                         depth_res: int = 256, color_res: int | None = None, axis: str = "y",
                         spread_deg: float = 30.0, clip: bool = True, safety: bool = True,
                         tolerance: float = DEFAULT_TOLERANCE, progress=None,
-                        ctx=None) -> ReliefTexture:
+                        ctx=None, octants: bool = False) -> ReliefTexture:
     """Relief texture through a reverse frustum (a user's box_to_world, or a fitted one).
 
     With ``clip`` the proxy drawn at render time is the frustum intersected with the
@@ -93,7 +93,8 @@ def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
               "depth_res": depth_res, "color_res": color_res or depth_res, "source": mesh.name}
     clip_bounds = np.stack([lo - pad, hi + pad]) if clip else None
     return bake_through(mesh, frustum, size, color_size, safety=safety, tolerance=tolerance,
-                        progress=progress, params=params, clip_bounds=clip_bounds, ctx=ctx)
+                        progress=progress, params=params, clip_bounds=clip_bounds, ctx=ctx,
+                        octants=octants)
 
 
 def cube_frusta(mesh: RenderMesh, margin: float = 0.02,
@@ -108,7 +109,7 @@ def cube_frusta(mesh: RenderMesh, margin: float = 0.02,
 
 def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int | None = None,
                      safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
-                     ctx=None) -> ReliefObject:
+                     ctx=None, octants: bool = False) -> ReliefObject:
     """Six reverse-perspective heightfields splitting the bounding cube (§4.2, Fig. 10)."""
     size = (depth_res, depth_res)
     color_size = size if color_res is None else (color_res, color_res)
@@ -120,6 +121,6 @@ def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int |
             lambda done, total, k=k: progress(k * total + done, 6 * total))
         parts.append(bake_through(mesh, box_to_world, size, color_size, safety=safety,
                                   tolerance=tolerance, progress=part_progress, params=params,
-                                  zero_border=False, ctx=ctx))
+                                  zero_border=False, ctx=ctx, octants=octants))
     return ReliefObject(parts=parts, params={"projection": "cube", "source": mesh.name},
                         source_bounds=mesh.bounds)

@@ -19,7 +19,6 @@ from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
 METHODS = ("binary", "exact", "robust", "maxmip", "cone")
-SMALL_FIELD = 64  # robust draws fields with W + H <= this with the exact walk's program
 PROGRAM = "relief:relief.glsl"
 
 
@@ -40,6 +39,9 @@ class ReliefRenderOptions:
                              choices=("exact", "clamp"))
     exact_below: int = param(0, "robust: rays crossing fewer texels than this are walked "
                              "exactly (0: the paper's walk for every ray)", lo=0, hi=65536)
+    exact_field: int = param(256, "robust: fields with W + H <= N are drawn with the exact "
+                             "walk's program, the cheaper one there (0: every field jumps)",
+                             lo=0, hi=65536)
     cell_test: str = param("quadratic", "exact walk: test each cell's exact quadratic, or "
                            "only its far end as the paper does",
                            choices=("quadratic", "linear"))
@@ -84,8 +86,9 @@ class ReliefDrawable:
         # robust walks every ray shorter than exact_below texels exactly: when no ray of this
         # field can be longer (W + H bounds |dx| + |dy|), the exact walk's own program draws
         # the same hits without the robust code around it; so does a field so small
-        # (SMALL_FIELD) that the exact walk is the cheaper one (32² here: 53 against 70 ms)
-        small = w + h <= SMALL_FIELD or w + h < opts.exact_below
+        # (exact_field) that the exact walk is the cheaper one (up to 128² on llvmpipe: the
+        # terrain at 64² takes 44 ms exact, 67 ms jumping; docs/benchmarks.md)
+        small = w + h <= opts.exact_field or w + h < opts.exact_below
         self.method = "exact" if opts.method == "robust" and small else opts.method
         self.prog = program(ctx, PROGRAM, {
             f"METHOD_{self.method.upper()}": True,
