@@ -182,7 +182,10 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 #else
                 float r = texelFetch(u_safety, clamp(texel, ivec2(0), u_hf_size - 1), 0).r;
 #endif
-                if (r < 0.5 && u_zero_exact) {  // walk exactly to the next major centreline
+                // at a zero radius, and from the entry point (k == 0: the centreline behind
+                // it lies outside the box, or its texel's guarantee starts after the entry),
+                // walk exactly to the next major centreline
+                if (k == 0 || (r < 0.5 && u_zero_exact)) {
                     ci += dir;
                     walk_from = max(s, s0);
                     walk_to = min((ci + 0.5 - om) / dm, s1);
