@@ -142,9 +142,9 @@ uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (el
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
 // The radius jumps stop at a texel of radius 0; the exact walk then covers up to the next
-// major centreline and the jumps resume. A jump that ends below the surface is walked
-// exactly too (the paper bisects it; the cell walk finds the first crossing, also of a dip
-// the tolerance let the jumps pass, for fewer fetches). Rays shorter than u_exact_below
+// major centreline and the jumps resume. A jump that ends below the surface is bisected
+// (the paper) down to two texels, which the exact walk then tests cell by cell (an exact
+// hit instead of the linear root of the last bracket). Rays shorter than u_exact_below
 // texels (an option, 0 by default) and vertical ones are walked exactly from the start. The
 // exact walk has one call site, so the shader inlines it once: with the walk nested in the
 // jumps (inlined twice) robust ran 1.1-1.5x slower than the exact walk on llvmpipe.
@@ -205,6 +205,13 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
                 sa = s_new;
             }
             if (walk_from < 0.0) return false;
+        }
+        // a long jump that ends below: bisect it (the paper) down to two texels, then walk
+        // those exactly
+        for (int b = 0; bracketed && b < 32 && abs(dm) * (walk_to - walk_from) > 2.0; ++b) {
+            float sm = 0.5 * (walk_from + walk_to);
+            iters++;
+            if (hf_above(o + sm * d) < 0.0) walk_to = sm; else walk_from = sm;
         }
         if (walk_exact(o, d, walk_from, walk_to, s_hit, iters)) return true;
         if (bracketed) {  // below at the jump's end, above in every cell by rounding
