@@ -5,31 +5,40 @@ from __future__ import annotations
 from ..gl.context import bind_home_framebuffer, get_context
 from ..gl.targets import FRAME_ATTACHMENTS
 from ..gl.textures import render_target
-from ..gl.timing import gpu_time_ms
+from ..gl.timing import gpu_times_ms
 from ..render.registry import make_drawables, release_all
 from ..scene.light import DirectionalLight
 
 
 def time_render(obj, camera, *, repeats: int = 3, light=None, **options) -> dict:
     """Median wall and GPU milliseconds of drawing ``obj`` (clear + draw + finish)."""
+    return time_renders(obj, camera, [options], repeats=repeats, light=light)[0]
+
+
+def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
+                 light=None) -> list[dict]:
+    """`time_render` of ``obj`` with each option set of ``variants``, the draws interleaved
+    (`gl.timing.gpu_times_ms`): use it for figures reported as ratios of each other."""
     import moderngl
 
     ctx = get_context()
-    (drawable,) = make_drawables(ctx, [obj], options)
+    drawables = [make_drawables(ctx, [obj], options)[0] for options in variants]
     light = light or DirectionalLight()
     fbo = render_target(ctx, *camera.size, FRAME_ATTACHMENTS)
 
-    def draw():
-        fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        ctx.enable_only(moderngl.DEPTH_TEST)
-        drawable.draw(camera, light)
+    def drawing(drawable):
+        def draw():
+            fbo.use()
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            ctx.enable_only(moderngl.DEPTH_TEST)
+            drawable.draw(camera, light)
+        return draw
 
     try:
-        return gpu_time_ms(ctx, draw, repeats=repeats)
+        return gpu_times_ms(ctx, [drawing(d) for d in drawables], repeats=repeats)
     finally:
         bind_home_framebuffer(ctx)
         for attachment in (*fbo.color_attachments, fbo.depth_attachment):
             attachment.release()
         fbo.release()
-        release_all([drawable])
+        release_all(drawables)

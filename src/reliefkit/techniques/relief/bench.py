@@ -1,7 +1,8 @@
 """`reliefkit bench relief`: Table 1, Fig. 12 and the correctness study of Baboud & Décoret.
 
 Everything is measured side by side in one run on one machine: frame times are medians of
-repeated draws (wall clock after glFinish, plus GL timer queries), iteration counts come
+repeated draws (wall clock after glFinish, plus GL timer queries), the methods' draws
+interleaved round by round so that their ratios share the machine's drift; iteration counts come
 from the instrumented shader variant and do not depend on the machine.
 """
 
@@ -29,7 +30,7 @@ class BenchConfig:
     models: tuple = ("terrain", "blob", "vehicle")
     resolutions: tuple = (32, 64, 128, 256, 512, 1024)
     size: tuple = (800, 600)
-    repeats: int = 3
+    repeats: int = 5
     tolerances: tuple = (0.0, 0.002, 0.005, 0.01, 0.02, 0.05)
     tolerance_res: int = 256
     correctness_res: int = 256
@@ -64,7 +65,7 @@ def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
 
 def table1(cfg: BenchConfig, log) -> list[dict]:
     """Frame time per method and for the mesh, iterations per covered pixel (Table 1)."""
-    from ...bench.timing import time_render
+    from ...bench.timing import time_render, time_renders
     from ...io.rk import array_bytes
     from ...render import render
     from ...scene.assets import make_asset
@@ -98,12 +99,13 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
                    "mesh_bytes": sum(array_bytes(mesh).values())}
             # robust_jump: robust with every field jumping (exact_field=0), beside robust's
             # default, which draws small fields with the exact walk's program
-            for key, method, extra in [(m, m, {}) for m in METHODS] + [
-                    ("robust_jump", "robust", {"exact_field": 0})]:
-                row[f"{key}_ms"] = time_render(relief, camera, method=method,
-                                               repeats=cfg.repeats, **extra)["wall_ms"]
-                stats = render(relief, camera, method=method, count_iterations=True,
-                               **extra).stats
+            variants = {m: {"method": m} for m in METHODS}
+            variants["robust_jump"] = {"method": "robust", "exact_field": 0}
+            timings = time_renders(relief, camera, list(variants.values()),
+                                   repeats=cfg.repeats)
+            for (key, options), timing in zip(variants.items(), timings, strict=True):
+                row[f"{key}_ms"] = timing["wall_ms"]
+                stats = render(relief, camera, count_iterations=True, **options).stats
                 row[f"{key}_it_mean"] = stats["iterations_mean"]
                 row[f"{key}_it_max"] = stats["iterations_max"]
                 row["fragments"] = stats["fragments"]

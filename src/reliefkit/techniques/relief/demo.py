@@ -1,4 +1,5 @@
-"""Relief tiles of the demo sheet: heightfield terrain with shadows, box, frustum and cube."""
+"""Relief tiles of the demo sheet: heightfield terrain with shadows, box, frustum and a cube
+drawn with maximum mipmaps."""
 
 from __future__ import annotations
 
@@ -29,6 +30,9 @@ def demo_tiles() -> list[DemoTile]:
         DemoTile("vehicle: reverse-perspective relief", "vehicle-frustum",
                  _baked("vehicle", "relief-frustum", depth_res=128, color_res=256),
                  vehicle_view),
-        DemoTile("blob: six reverse frusta", "blob-cube",
-                 _baked("blob", "relief-cube", depth_res=128), blob_view),
+        # maxmip needs no precomputation (its max pyramid is built when drawn): the cube
+        # is baked without safety radii
+        DemoTile("blob: six reverse frusta, maxmip", "blob-cube",
+                 _baked("blob", "relief-cube", depth_res=128, safety=False), blob_view,
+                 {"method": "maxmip"}),
     ]

@@ -474,20 +474,50 @@ def _radius_from(dist, margin):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _to_original(ip, jp, wp, hp, transpose, flipx, flipy):
-    i2 = wp - 1 - ip if flipx else ip
+def _original_index(jp, ip, hp, wp, transpose, flipx, flipy):
+    """(row, col) in the original array of texel (jp, ip) of a frame."""
     j2 = hp - 1 - jp if flipy else jp
+    i2 = wp - 1 - ip if flipx else ip
     if transpose:
-        return i2, j2  # (row, col) in the original array
+        return i2, j2
     return j2, i2
 
 
-@njit(inline="always", **JIT_OPTIONS)
-def _current_bound(bufs, r, c):
-    best = bufs[0, r, c]
-    for b in range(1, bufs.shape[0]):
-        best = min(best, bufs[b, r, c])
-    return best
+@njit(**JIT_OPTIONS)
+def _seed_row(bounds, own, jp, transpose, flipx, flipy):
+    nthreads, hp, wp = own.shape
+    for ip in range(wp):
+        r, c = _original_index(jp, ip, hp, wp, transpose, flipx, flipy)
+        for t in range(nthreads):
+            own[t, jp, ip] = bounds[r, c]
+
+
+@njit(**JIT_OPTIONS)
+def _merge_row(bounds, own, jp, transpose, flipx, flipy):
+    nthreads, hp, wp = own.shape
+    for ip in range(wp):
+        r, c = _original_index(jp, ip, hp, wp, transpose, flipx, flipy)
+        v = bounds[r, c]
+        for t in range(nthreads):
+            v = min(v, own[t, jp, ip])
+        bounds[r, c] = v
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def _seed_bounds(bounds, own, transpose, flipx, flipy):
+    """Copy the shared bounds (original layout) into every thread's buffer in the frame's
+    layout, so that the walk along a line reads and writes its own buffer contiguously."""
+    nthreads, hp, wp = own.shape
+    for jp in prange(hp):
+        _seed_row(bounds, own, np.int64(jp), transpose, flipx, flipy)
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def _merge_bounds(bounds, own, transpose, flipx, flipy):
+    """The smallest bound of every thread's buffer, back into the shared bounds."""
+    nthreads, hp, wp = own.shape
+    for jp in prange(hp):
+        _merge_row(bounds, own, np.int64(jp), transpose, flipx, flipy)
 
 
 @njit(inline="always", **JIT_OPTIONS)
@@ -501,9 +531,9 @@ def _rows_of(y0, hp):
 
 
 @njit(**JIT_OPTIONS)
-def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose, flipx, flipy,
-                work, only_first):
-    """Scan every walk position of one sample line (only the first when ``only_first``)."""
+def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only_first):
+    """Scan every walk position of one sample line (only the first when ``only_first``),
+    lowering the bounds ``bound_of`` (frame layout) where a violation is found."""
     hp, wp = height.shape
     xlo, xhi = _line_range(hp, wp, m, yc)
     if not xhi > xlo:
@@ -523,13 +553,11 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
     for i in range(i_first, i_last + 1):
         xp = i + 0.5
         j, j2 = _rows_of(yc + m * xp, hp)
-        r, c = _to_original(i, j, wp, hp, transpose, flipx, flipy)
-        bound = _current_bound(bufs, r, c)
-        if j2 != j:
-            r2, c2 = _to_original(i, j2, wp, hp, transpose, flipx, flipy)
-            bound = max(bound, _current_bound(bufs, r2, c2))
+        bound = max(bound_of[j, i], bound_of[j2, i])
         if bound > 0:
-            xstop = max(xstop, min(xend, xp + 4 * bound + margin + 8.0))
+            # a line that only serves its first position need not settle later ones
+            reach = bound + margin + 1.0 if only_first else 4 * bound + margin + 8.0
+            xstop = max(xstop, min(xend, xp + reach))
     if not xstop > xlo:
         return
     npieces = _line_pieces(height, m, yc, xlo, xstop, work)
@@ -555,9 +583,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
         if k == 0 or work[0, k - 1] < xp - 1e-9:
             continue  # P is the end of the line: nothing after it
         j, j2 = _rows_of(yc + m * xp, hp)
-        r, c = _to_original(i, j, wp, hp, transpose, flipx, flipy)
-        r2, c2 = _to_original(i, j2, wp, hp, transpose, flipx, flipy)
-        bound = max(_current_bound(bufs, r, c), _current_bound(bufs, r2, c2))
+        bound = max(bound_of[j, i], bound_of[j2, i])
         if bound == 0:
             continue
         limit = min(xp + bound + margin, xstop)
@@ -569,33 +595,32 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose
         known = b if b != np.inf else xstop
         if b <= limit:
             n = max(_radius_from(b - xp, margin), 0)
-            if n < bufs[tid, r, c]:
-                bufs[tid, r, c] = n
-            if n < bufs[tid, r2, c2]:
-                bufs[tid, r2, c2] = n
+            bound_of[j, i] = min(bound_of[j, i], n)
+            bound_of[j2, i] = min(bound_of[j2, i], n)
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _sweep_direction(height, m, offsets, eps, floor, margin, bufs, transpose, flipx, flipy):
+def _sweep_direction(height, m, offsets, eps, floor, margin, own):
     """All sample lines of slope ``m`` in one octant frame, in parallel.
 
     The lines are ``y = k / offsets + m x`` for every integer ``k`` that reaches the
     rectangle, plus (``m > 0``) one line per column entering the box exactly at that
     column's walk position (``P`` on the box side, where nothing behind ``P`` blocks).
+    ``own[t]`` is thread ``t``'s copy of the bounds in the frame's layout.
     """
     hp, wp = height.shape
     k_lo = int(math.floor(-m * wp * offsets))
     k_hi = int(math.ceil(hp * offsets))
     nlines = k_hi - k_lo + 1
     nextra = wp if m > 0.0 else 0
-    nthreads = bufs.shape[0]
+    nthreads = own.shape[0]
     cap = hp + wp + 16
     works = np.empty((nthreads, 6, 3 * cap))
     for li in prange(nlines + nextra):
         tid = numba.get_thread_id()
         yc = (k_lo + li) / offsets if li < nlines else -m * (li - nlines + 0.5)
-        _sweep_line(height, m, yc, eps, floor, margin, offsets, bufs, tid, transpose, flipx, flipy,
-                    works[tid], li >= nlines)
+        _sweep_line(height, m, yc, eps, floor, margin, offsets, own[tid], works[tid],
+                    li >= nlines)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -714,7 +739,10 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     dtype = np.uint8 if int(max_radius) <= 255 else np.uint16
     nthreads = numba.get_num_threads()
     per_frame = len(_FRAMES) if octants else 1
-    bufs = np.full((per_frame, nthreads) + h.shape, int(max_radius), dtype=np.int32)
+    bounds = np.full((per_frame,) + h.shape, int(max_radius), dtype=np.int32)
+    # per thread, in the layout of the frames (transposed or not)
+    own = {t: np.empty((nthreads,) + (h.shape[::-1] if t else h.shape), np.int32)
+           for t in (False, True)}
     slopes = _slopes(int(directions))
     frames = [_frame(h, *f) for f in _FRAMES]
     eps = float(tolerance) * (1.0 - TOLERANCE_SLACK)
@@ -726,15 +754,17 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
             previous = numba.get_parallel_chunksize()
             numba.set_parallel_chunksize(1)
             try:
-                _sweep_direction(frame, float(slopes[si]), int(offsets), eps, NUMERIC_FLOOR,
-                                 float(margin), bufs[f if octants else 0], transpose, flipx,
-                                 flipy)
+                layer = bounds[f if octants else 0]
+                _seed_bounds(layer, own[transpose], transpose, flipx, flipy)
+                _sweep_direction(frame, float(slopes[si]), int(offsets), eps,
+                                 NUMERIC_FLOOR, float(margin), own[transpose])
+                _merge_bounds(layer, own[transpose], transpose, flipx, flipy)
             finally:
                 numba.set_parallel_chunksize(previous)
             done += 1
             if progress is not None:
                 progress(done, total)
-    radii = bufs.min(axis=1).astype(dtype)
+    radii = bounds.astype(dtype)
     return radii if octants else radii[0]
 
 
