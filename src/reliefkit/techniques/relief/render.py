@@ -108,8 +108,9 @@ class ReliefDrawable:
                     ctx, relief.safety.astype(np.float32), what="safety octants",
                     filter="nearest")
             elif self.method == "robust":
-                self.textures["u_safety"] = texture2d(ctx, relief.safety.astype(np.float32),
-                                                      what="safety", filter="nearest")
+                packed = np.stack([relief.height, relief.safety.astype(np.float32)], axis=-1)
+                self.textures["u_height_safety"] = texture2d(ctx, packed, what="height and safety",
+                                                             filter="nearest")
             if self.method == "cone":
                 self.textures["u_cone"] = texture2d(ctx, relaxed_cone_ratios(relief.height),
                                                     what="cone ratios", filter="nearest")

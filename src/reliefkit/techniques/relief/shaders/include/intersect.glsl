@@ -136,35 +136,59 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
 #if defined SAFETY_OCTANTS
 uniform highp sampler2DArray u_safety_octants;  // R32F radii per direction octant (safety.py)
 #else
-uniform sampler2D u_safety;   // R32F radii in texels (0: non-concave peak)
+uniform sampler2D u_height_safety;  // RG32F: height and safety radius (texels) per texel
 #endif
 uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (else clamp to 1)
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
+// Height and safety radius where the ray crosses the major centreline ci + 0.5 at minor
+// coordinate `minor`. On a centreline the bilinear height varies along the minor axis only:
+// two texels, and the radius's texel (the one holding the point) is one of them, so a jump
+// costs two fetches of the packed texture instead of four heights and a radius.
+vec2 centerline_height_radius(float ci, float minor, bool x_major, int octant) {
+    ivec2 size = x_major ? u_hf_size : u_hf_size.yx;  // (major, minor) extents
+    float q = clamp(minor, 0.5, float(size.y) - 0.5) - 0.5;
+    float j = floor(q), f = q - j;
+    int c = clamp(int(ci), 0, size.x - 1), j0 = int(j), j1 = min(j0 + 1, size.y - 1);
+    ivec2 t0 = x_major ? ivec2(c, j0) : ivec2(j0, c);
+    ivec2 t1 = x_major ? ivec2(c, j1) : ivec2(j1, c);
+#if defined SAFETY_OCTANTS
+    float h0 = texelFetch(u_height, t0, 0).r, h1 = texelFetch(u_height, t1, 0).r;
+    float r = texelFetch(u_safety_octants, ivec3(f < 0.5 ? t0 : t1, octant), 0).r;
+#else
+    vec2 a = texelFetch(u_height_safety, t0, 0).rg, b = texelFetch(u_height_safety, t1, 0).rg;
+    float h0 = a.x, h1 = b.x, r = f < 0.5 ? a.y : b.y;
+#endif
+    return vec2(mix(h0, h1, f), r);
+}
+
 // The radius jumps stop at a texel of radius 0; the exact walk then covers up to the next
-// major centreline and the jumps resume. A jump that ends below the surface is bisected
-// (the paper) down to two texels, which the exact walk then tests cell by cell (an exact
-// hit instead of the linear root of the last bracket). Rays shorter than u_exact_below
-// texels (an option, 0 by default) and vertical ones are walked exactly from the start. The
-// exact walk has one call site, so the shader inlines it once: with the walk nested in the
-// jumps (inlined twice) robust ran 1.1-1.5x slower than the exact walk on llvmpipe.
+// major centreline and the jumps resume. Every jump ends on a major centreline inside the box
+// (the last one before the exit at most: a shorter jump keeps the guarantee), so one sample
+// there gives the height to test and the next jump's radius. A jump that ends below the
+// surface is bisected (the paper) down to two texels, which the exact walk then tests cell
+// by cell (an exact hit instead of the linear root of the last bracket). Rays shorter than
+// u_exact_below texels (an option, 0 by default) and vertical ones are walked exactly from
+// the start. The exact walk has one call site, so the shader inlines it once: with the walk
+// nested in the jumps (inlined twice) robust ran 1.1-1.5x slower than the exact walk on
+// llvmpipe.
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
     bool x_major = abs(d.x) >= abs(d.y);
-    float om = x_major ? o.x : o.y;
-    float dm = x_major ? d.x : d.y;
+    float om = x_major ? o.x : o.y, dm = x_major ? d.x : d.y;
+    float on = x_major ? o.y : o.x, dn = x_major ? d.y : d.x;
     bool walk_all = dm == 0.0 || (abs(d.x) + abs(d.y)) * (s1 - s0) < u_exact_below;
-    // index of the last major centreline (x = ci + 0.5) at or before the entry point
-    float xm = om + s0 * dm;
+    // the major centrelines (x = c + 0.5): the last at or before the entry point, and the
+    // last strictly before the exit
+    float xm0 = om + s0 * dm, xm1 = om + s1 * dm;
     float dir = dm > 0.0 ? 1.0 : -1.0;
-    float ci = dm > 0.0 ? floor(xm - 0.5) : ceil(xm - 0.5);
+    float ci = dm > 0.0 ? floor(xm0 - 0.5) : ceil(xm0 - 0.5);
+    float ci_last = dm > 0.0 ? ceil(xm1 - 0.5) - 1.0 : floor(xm1 - 0.5) + 1.0;
     float sa = s0;  // last parameter known to be above the surface
-#if defined SAFETY_OCTANTS
     // the octant of this ray's direction (safety.octant): major axis, its sign, the minor's
-    float minor_d = x_major ? d.y : d.x;
-    int octant = (x_major ? 0 : 4) + (dm < 0.0 ? 2 : 0) + (minor_d < 0.0 ? 1 : 0);
-#endif
+    int octant = (x_major ? 0 : 4) + (dm < 0.0 ? 2 : 0) + (dn < 0.0 ? 1 : 0);
+    float r = -1.0;  // the radius at centreline ci; -1 until sampled
     int k = 0;
     bool bracketed = false;
     for (int round = 0; round < HARD_CAP && k < u_max_iterations; ++round) {
@@ -173,36 +197,33 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
             walk_from = -1.0;
             for (; k < HARD_CAP && k < u_max_iterations; ++k) {
                 float s = (ci + 0.5 - om) / dm;
-                float minor = x_major ? o.y + s * d.y : o.x + s * d.x;
-                ivec2 texel = x_major ? ivec2(int(ci), int(floor(minor)))
-                                      : ivec2(int(floor(minor)), int(ci));
-#if defined SAFETY_OCTANTS
-                float r = texelFetch(u_safety_octants,
-                                     ivec3(clamp(texel, ivec2(0), u_hf_size - 1), octant), 0).r;
-#else
-                float r = texelFetch(u_safety, clamp(texel, ivec2(0), u_hf_size - 1), 0).r;
-#endif
-                // at a zero radius, and from the entry point (k == 0: the centreline behind
-                // it lies outside the box, or its texel's guarantee starts after the entry),
-                // walk exactly to the next major centreline
-                if (k == 0 || (r < 0.5 && u_zero_exact)) {
+                float room = dir * (ci_last - ci);  // centrelines left before the exit
+                // from the entry point (k == 0: the centreline behind it lies outside the
+                // box, or its texel's guarantee starts after the entry), at a zero radius and
+                // after the last centreline, walk exactly to the next one (or the exit)
+                if (k == 0 || room < 0.5 || (r >= 0.0 && r < 0.5 && u_zero_exact)) {
                     ci += dir;
                     walk_from = max(s, s0);
                     walk_to = min((ci + 0.5 - om) / dm, s1);
+                    r = -1.0;
                     break;
                 }
-                ci += dir * max(r, 1.0);
-                float s_new = (ci + 0.5 - om) / dm;
-                float sb = min(s_new, s1);
-                iters++;
-                if (hf_above(o + sb * d) < 0.0) {  // the hit is in this jump: walk it exactly
-                    walk_from = max(sa, s0);
-                    walk_to = sb;
-                    bracketed = true;
-                    break;
+                // jump by the radius, or sample the radius here first
+                float target = r < 0.0 ? ci : ci + dir * min(max(r, 1.0), room);
+                float st = (target + 0.5 - om) / dm;
+                vec2 hr = centerline_height_radius(target, on + st * dn, x_major, octant);
+                if (r >= 0.0) {
+                    iters++;
+                    if (hr.x > 0.0 && o.z + st * d.z < hr.x) {  // the hit is in this jump
+                        walk_from = max(sa, s0);
+                        walk_to = st;
+                        bracketed = true;
+                        break;
+                    }
+                    sa = st;
+                    ci = target;
                 }
-                if (s_new >= s1) return false;
-                sa = s_new;
+                r = hr.y;
             }
             if (walk_from < 0.0) return false;
         }
