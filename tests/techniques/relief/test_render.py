@@ -90,13 +90,18 @@ def test_camera_inside_the_box(gl, method):
     assert np.linalg.norm(frame.position[inner] - hits[inner], axis=-1).max() < 1e-3
 
 
-def test_robust_needs_safety_radii(gl):
+def test_robust_needs_safety_radii_only_when_it_jumps(gl):
     from reliefkit.errors import UsageError
 
     relief = make_relief(flat(0.5))
     relief.safety = None
-    with pytest.raises(UsageError, match="no safety radii"):
-        render(relief, Camera.orbit((0, 0, 0), 0, 30, 3.0, size=(8, 8)), method="robust")
+    camera = Camera.orbit((0, 0, 0), 0, 30, 3.0, size=(8, 8))
+    with pytest.raises(UsageError, match="no safety radii.*maxmip"):
+        render(relief, camera, method="robust", exact_field=0)
+    # a field small enough to be drawn with the exact walk's program needs no radii
+    small = render(relief, camera, method="robust")
+    exact = render(relief, camera, method="exact")
+    assert small.mask.any() and np.array_equal(small.mask, exact.mask)
 
 
 def test_unknown_option_and_method_are_errors(gl):

@@ -15,7 +15,7 @@ AXES = ("x", "y", "z", "-x", "-y", "-z")
 # Safety radii cost about SAFETY_SECONDS_512 for a 512² field on a 2-core machine and grow
 # with the texel count (docs/benchmarks.md); above these sides a bake would run for many
 # minutes, so it is refused with a hint instead of leaving the user with a progress bar.
-SAFETY_SECONDS_512 = 55.0
+SAFETY_SECONDS_512 = 20.0  # 12 s measured on 2026-12-03, twice that on slower days
 SAFETY_MAX_TEXELS = 1024 * 1024
 
 
@@ -27,8 +27,8 @@ def check_safety_work(width: int, height: int, parts: int = 1) -> None:
     minutes = SAFETY_SECONDS_512 * texels / 512**2 / 60
     raise UsageError(f"safety radii for {parts} x {width}x{height} texels would take about "
                      f"{minutes:.0f} minutes here (the limit is {SAFETY_MAX_TEXELS} texels); "
-                     "bake with --no-safety and render with --method exact or binary, or use "
-                     "a smaller --depth-res")
+                     "bake with --no-safety and render with --method maxmip (exact, needs no "
+                     "radii), or use a smaller --depth-res")
 
 
 def _depth_res(default: int):

@@ -306,27 +306,35 @@ def plot(results: dict, path: Path) -> None:
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     rows = results["table1"]
-    for model in sorted({r["model"] for r in rows}):
+    markers = dict(zip(sorted({r["model"] for r in rows}), "osd^v", strict=False))
+    for model, marker in markers.items():  # colour: the method; marker: the model
         sub = [r for r in rows if r["model"] == model]
         res = [r["res"] for r in sub]
-        for method, style in zip(METHODS, ("-o", "-s", "-^", "-d", "-v", "-x"), strict=False):
+        for i, method in enumerate(METHODS):
             key = "robust_jump" if method == "robust" else method  # its own walk at every res
-            axes[0].plot(res, [r[f"{key}_it_mean"] for r in sub], style,
+            axes[0].plot(res, [r[f"{key}_it_mean"] for r in sub], f"-{marker}", color=f"C{i}",
                          label=f"{model} {method}", alpha=0.8)
     axes[0].set(xscale="log", yscale="log", xlabel="depth resolution",
                 ylabel="iterations per fragment (mean)", title="Table 1: iterations")
-    axes[0].legend(fontsize=6, ncol=2)
-    tol = [r for r in results["tolerance"] if r["zero_radius"] == "clamp"
-           and r.get("radii", "single") == "single"]
-    x = [max(r["tolerance"], 1e-4) for r in tol]
-    axes[1].plot(x, [r["mean_radius"] for r in tol], "-o", label="mean safety radius")
-    axes[1].plot(x, [r["iterations_mean"] for r in tol], "-s", label="robust iterations")
+    axes[0].legend(fontsize=6, ncol=3)
+    for radii, line in (("single", "-"), ("octants", "--")):
+        tol = [r for r in results["tolerance"] if r["zero_radius"] == "clamp"
+               and r.get("radii", "single") == radii]
+        if not tol:
+            continue
+        x = [max(r["tolerance"], 1e-4) for r in tol]
+        axes[1].plot(x, [r["mean_radius"] for r in tol], f"{line}o", color="C0",
+                     label=f"mean safety radius ({radii})")
+        axes[1].plot(x, [r["iterations_mean"] for r in tol], f"{line}s", color="C1",
+                     label=f"robust iterations ({radii})")
+        axes[2].plot(x, [100 * r["wrong_fraction"] for r in tol], f"{line}o", color="C3",
+                     label=f"{radii} radii")
     axes[1].set(xscale="log", xlabel="tolerance (height units; 0 shown at 1e-4)",
-                title="Fig. 12: tolerance vs radius and iterations")
+                title="Fig. 12: tolerance vs radius and iterations (zero radii clamped)")
     axes[1].legend(fontsize=8)
-    axes[2].plot(x, [100 * r["wrong_fraction"] for r in tol], "-o", color="C3")
     axes[2].set(xscale="log", xlabel="tolerance", ylabel="wrong pixels (%)",
                 title="Fig. 12: silhouette error")
+    axes[2].legend(fontsize=8)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")

@@ -77,9 +77,6 @@ class ReliefDrawable:
     def __init__(self, ctx, relief: ReliefTexture, options: ReliefRenderOptions | None = None,
                  instrument: bool = False):
         opts = options or ReliefRenderOptions()
-        if opts.method == "robust" and relief.safety is None:
-            raise UsageError("this relief texture has no safety radii: bake it with them or "
-                             "render with --method binary or exact")
         self.ctx, self.relief, self.options = ctx, relief, opts
         self.extra_attachments = 1 if instrument else 0
         w, h = relief.depth_resolution
@@ -90,6 +87,9 @@ class ReliefDrawable:
         # terrain at 64² takes 44 ms exact, 67 ms jumping; docs/benchmarks.md)
         small = w + h <= opts.exact_field or w + h < opts.exact_below
         self.method = "exact" if opts.method == "robust" and small else opts.method
+        if self.method == "robust" and relief.safety is None:
+            raise UsageError("this relief texture has no safety radii: bake it with them or "
+                             "render with --method maxmip (exact, needs no radii)")
         self.prog = program(ctx, PROGRAM, {
             f"METHOD_{self.method.upper()}": True,
             "SAFETY_OCTANTS": self.method == "robust" and relief.safety.ndim == 3,
