@@ -25,7 +25,8 @@ def test_every_method_is_measured(tiny):
         for method in METHODS:
             assert row[f"{method}_ms"] > 0 and row[f"{method}_it_mean"] > 0
         assert row["pyramid_s"] >= 0 and row["safety_s"] >= 0
-    assert {r["model"] for r in tiny["correctness"]} == {"terrain", "blob", "vehicle"}
+    assert {r["model"] for r in tiny["correctness"]} == {"terrain", "blob", "vehicle",
+                                                         "vehicle frustum", "blob cube"}
     for corr in tiny["correctness"]:
         assert corr["maxmip"] <= 0.001 and corr["exact"] <= 0.001
 

@@ -158,20 +158,26 @@ def correctness(cfg: BenchConfig, log) -> list[dict]:
     from ...scene.assets import make_asset
     from ...scene.views import orbit_bounds
     from .bake import bake_relief
+    from .frustum import bake_relief_cube, bake_relief_frustum
     from .reference import wrong_hits
 
     rows = []
-    for name in ("terrain", "blob", "vehicle"):
+    # the orthographic reliefs, then a reverse frustum and a cube of six (their projective
+    # h is where a tolerance in h units went wrong; relief.md)
+    bakers = (("terrain", "", bake_relief), ("blob", "", bake_relief),
+              ("vehicle", "", bake_relief), ("vehicle", " frustum", bake_relief_frustum),
+              ("blob", " cube", bake_relief_cube))
+    for name, kind, baker in bakers:
         mesh = make_asset(name)
-        relief = bake_relief(mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance)
+        relief = baker(mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance)
         for az, el in cfg.correctness_views:
             camera = orbit_bounds(relief.bounds, az, el, 2.2, cfg.correctness_size)
-            row = {"model": name, "azimuth": az, "elevation": el}
+            row = {"model": name + kind, "azimuth": az, "elevation": el}
             for method in METHODS:
                 frame = render(relief, camera, method=method)
                 row[method] = wrong_hits(frame, relief, camera)["wrong_fraction"]
             rows.append(row)
-            log(f"correctness: {name} el {el}: " + ", ".join(
+            log(f"correctness: {name}{kind} el {el}: " + ", ".join(
                 f"{m} {row[m]:.4%}" for m in METHODS))
     return rows
 

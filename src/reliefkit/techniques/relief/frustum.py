@@ -39,6 +39,24 @@ def frustum_matrix(apex, frame, tan_u: float, tan_v: float, near: float,
     return translation(apex) @ np.linalg.inv(UNIT_FROM_NDC @ proj @ view)
 
 
+def far_tolerance(box_to_world: np.ndarray, tolerance: float) -> float:
+    """The safety tolerance in h units that bounds, at a frustum's far end, the world depth
+    that ``tolerance`` bounds in an orthographic box as deep (its fraction of the depth).
+
+    A frustum's h is perspective depth, most compressed at the far end: there one unit of h
+    spans far / near times the box's mean depth per unit, so the tolerance shrinks by
+    near / far (1 for a box; 1/4 for a pyramid of the cube cut at a quarter of its height).
+    """
+    def world(h):
+        p = box_to_world @ np.array([0.5, 0.5, h, 1.0])
+        return p[:3] / p[3]
+
+    depth = np.linalg.norm(world(1.0) - world(0.0))
+    step = 1e-4
+    far_rate = np.linalg.norm(world(1.0) - world(1.0 - step)) / step
+    return float(tolerance) * min(1.0, float(depth / far_rate)) if far_rate > 0 else tolerance
+
+
 def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 30.0,
                         depth_res: int = 256) -> tuple[np.ndarray, tuple[int, int]]:
     """A reverse frustum around ``mesh`` seen from ``axis``, sides tilted by ``spread_deg``.
@@ -92,19 +110,43 @@ def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
     params = {"projection": "reverse-frustum", "axis": axis, "spread_deg": spread_deg,
               "depth_res": depth_res, "color_res": color_res or depth_res, "source": mesh.name}
     clip_bounds = np.stack([lo - pad, hi + pad]) if clip else None
-    return bake_through(mesh, frustum, size, color_size, safety=safety, tolerance=tolerance,
+    return bake_through(mesh, frustum, size, color_size, safety=safety,
+                        tolerance=far_tolerance(frustum, tolerance),
                         progress=progress, params=params, clip_bounds=clip_bounds, ctx=ctx,
                         octants=octants)
 
 
-def cube_frusta(mesh: RenderMesh, margin: float = 0.02,
-                near_fraction: float = 0.02) -> list[np.ndarray]:
-    """Six box_to_world matrices: pyramids from the bounding cube's centre to its faces."""
+def cube_frusta(mesh: RenderMesh, margin: float = 0.02, near_fraction: float = 0.02,
+                depth_res: int = 128, ctx=None) -> dict[str, np.ndarray]:
+    """Six box_to_world matrices: pyramids from the bounding cube's centre to its faces.
+
+    A pyramid's h is perspective depth: linear in 1 / distance from the centre, so with the
+    near plane close to the centre the outer half of the pyramid, where the surface is,
+    gets a sliver of h (2% near: the vehicle's heights all in [0.95, 1]). The safety radii's
+    tolerance is in h units, and there 0.01 spans a third of the object: robust missed up
+    to 24% of the vehicle's pixels. So each pyramid is first rasterized with the near plane
+    at ``near_fraction`` of the half cube, then cut at 90% of the distance of its innermost
+    covered texel, floored to 1/32 of the half cube (the outermost surface of every texel
+    lies beyond the cut: nothing is lost). `far_tolerance` then scales the tolerance.
+    """
+    from ...bake.project import project_mesh
+
     lo, hi = mesh.bounds
     centre = (lo + hi) / 2
     half = float((hi - lo).max()) / 2 * (1 + margin)
-    return {face: frustum_matrix(centre, frame, 1.0, 1.0, near_fraction * half, half)
-            for face, frame in cube_face_frames().items()}
+    frusta = {}
+    for face, frame in cube_face_frames().items():
+        near = near_fraction * half
+        probe = frustum_matrix(centre, frame, 1.0, 1.0, near, half)
+        height = project_mesh(mesh, probe, (depth_res, depth_res), ctx).height
+        covered = height > 0.0
+        if covered.any():
+            inner = probe @ np.array([0.5, 0.5, float(height[covered].min()), 1.0])
+            distance = float(np.dot(inner[:3] / inner[3] - centre, frame[2]))
+            # floored to 1/32 of the half cube: the same cut for the same mesh anywhere
+            near = max(near, np.floor(32 * 0.9 * distance / half) / 32 * half)
+        frusta[face] = frustum_matrix(centre, frame, 1.0, 1.0, near, half)
+    return frusta
 
 
 def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int | None = None,
@@ -114,13 +156,15 @@ def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int |
     size = (depth_res, depth_res)
     color_size = size if color_res is None else (color_res, color_res)
     parts = []
-    for k, (face, box_to_world) in enumerate(cube_frusta(mesh).items()):
+    for k, (face, box_to_world) in enumerate(cube_frusta(mesh, depth_res=depth_res,
+                                                             ctx=ctx).items()):
         params = {"projection": "cube-frustum", "face": face, "depth_res": depth_res,
                   "color_res": color_res or depth_res, "source": mesh.name}
         part_progress = None if progress is None else (
             lambda done, total, k=k: progress(k * total + done, 6 * total))
         parts.append(bake_through(mesh, box_to_world, size, color_size, safety=safety,
-                                  tolerance=tolerance, progress=part_progress, params=params,
+                                  tolerance=far_tolerance(box_to_world, tolerance),
+                                  progress=part_progress, params=params,
                                   zero_border=False, ctx=ctx, octants=octants))
     return ReliefObject(parts=parts, params={"projection": "cube", "source": mesh.name},
                         source_bounds=mesh.bounds)
