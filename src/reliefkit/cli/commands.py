@@ -299,10 +299,22 @@ def cmd_info(args) -> int:
         print(json.dumps(report, indent=2))
     else:
         for section in report.values():
-            for key, value in section.items():
-                shown = json.dumps(value) if isinstance(value, dict | list) else value
-                print(f"{key:>24}: {shown}")
+            _print_section(section)
     return 0
+
+
+def _print_section(section: dict) -> None:
+    """``key: value`` lines; an .rk's arrays one per line (dtype and shape; ``--json`` also
+    has their checksums), so a six-part cube reads as a list rather than a wall of JSON."""
+    for key, value in section.items():
+        if key == "arrays" and isinstance(value, dict):
+            print(f"{key:>24}: {len(value)}")
+            for name, record in value.items():
+                shape = "x".join(map(str, record.get("shape", []))) or "scalar"
+                print(f"{name:>26}  {record.get('dtype')} {shape}")
+            continue
+        shown = json.dumps(value) if isinstance(value, dict | list) else value
+        print(f"{key:>24}: {shown}")
 
 
 def _describe_file(spec: str) -> dict:
