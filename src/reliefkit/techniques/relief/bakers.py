@@ -51,7 +51,8 @@ def _octants():
 
 def _tolerance():
     return param(DEFAULT_TOLERANCE, "safety radii: ignored dip depth (height units, Fig. 12); "
-                 "larger radii and fewer iterations for a bounded silhouette error",
+                 "larger radii and fewer iterations for a bounded silhouette error (frusta and "
+                 "cubes scale it by near/far)",
                  lo=0.0, hi=1.0)
 
 
