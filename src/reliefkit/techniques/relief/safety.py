@@ -181,11 +181,29 @@ def _line_pieces(height, m, yc, xlo, xstop, work):
         j = int(math.floor(yc + m * xlo - 0.5)) + 1
         xj = (j + 0.5 - yc) / m
     else:
+        j = int(math.floor(yc + 0.5))  # the row band the line stays in
         xj = np.inf
     last = xlo
     while True:
         nxt = min(min(xi, xj), xstop)
         if nxt > last + 1e-12:
+            # the piece lies between centrelines i - 1/2 .. i + 1/2 and j - 1/2 .. j + 1/2:
+            # its bilinear cell has corners (i - 1, i) x (j - 1, j), clamped at the border
+            cx = min(max(i, 0), ww)
+            cy = min(max(j, 0), hh)
+            i0 = min(max(cx - 1, 0), ww - 1)
+            i1 = min(cx, ww - 1)
+            j0 = min(max(cy - 1, 0), hh - 1)
+            j1 = min(cy, hh - 1)
+            a00 = height[j0, i0]
+            e = height[j0, i1] - a00
+            f = height[j1, i0] - a00
+            g = height[j1, i1] - height[j0, i1] - height[j1, i0] + a00
+            px = last - (cx - 0.5)
+            py = yc + m * last - (cy - 0.5)
+            work[1, n] = a00 + e * px + f * py + g * px * py
+            work[2, n] = e + f * m + g * (px * m + py)
+            work[3, n] = g * m
             n += 1
             work[0, n] = nxt
             last = nxt
@@ -197,24 +215,6 @@ def _line_pieces(height, m, yc, xlo, xstop, work):
         if xj <= nxt:
             j += 1
             xj = (j + 0.5 - yc) / m
-    for k in range(n):
-        x0 = work[0, k]
-        xm = 0.5 * (x0 + work[0, k + 1])
-        cx = min(max(int(math.floor(xm + 0.5)), 0), ww)
-        cy = min(max(int(math.floor(yc + m * xm + 0.5)), 0), hh)
-        i0 = min(max(cx - 1, 0), ww - 1)
-        i1 = min(cx, ww - 1)
-        j0 = min(max(cy - 1, 0), hh - 1)
-        j1 = min(cy, hh - 1)
-        a00 = height[j0, i0]
-        e = height[j0, i1] - a00
-        f = height[j1, i0] - a00
-        g = height[j1, i1] - height[j0, i1] - height[j1, i0] + a00
-        px = x0 - (cx - 0.5)
-        py = yc + m * x0 - (cy - 0.5)
-        work[1, k] = a00 + e * px + f * py + g * px * py
-        work[2, k] = e + f * m + g * (px * m + py)
-        work[3, k] = g * m
     return n
 
 
