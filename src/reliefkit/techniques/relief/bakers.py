@@ -15,7 +15,7 @@ AXES = ("x", "y", "z", "-x", "-y", "-z")
 # Safety radii cost about SAFETY_SECONDS_512 for a 512² field on a 2-core machine and grow
 # with the texel count (docs/benchmarks.md); above these sides a bake would run for many
 # minutes, so it is refused with a hint instead of leaving the user with a progress bar.
-SAFETY_SECONDS_512 = 20.0  # 12 s measured on 2026-12-03, twice that on slower days
+SAFETY_SECONDS_512 = 20.0  # 11 s measured on 2026-12-03, twice that on slower days
 SAFETY_MAX_TEXELS = 1024 * 1024
 
 
