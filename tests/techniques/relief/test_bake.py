@@ -245,3 +245,18 @@ def test_robust_jumps_on_a_cube_meet_the_reference(gl, model):
         camera = orbit_bounds(rep.bounds, azimuth, elevation, 2.6, size=(128, 96))
         frame = render(rep, camera, method="robust", exact_field=0)
         assert wrong_hits(frame, rep, camera)["wrong_fraction"] <= 0.005, (azimuth, elevation)
+
+
+def test_far_tolerance_is_near_over_far_for_a_frustum_and_one_for_a_box():
+    """Perspective depth: dh/dr = near * far / ((far - near) r^2), so at the far end one unit of
+    h spans far / near times the mean depth per unit (an analytic check of the scaling)."""
+    from reliefkit.bake.project import axis_frame
+    from reliefkit.techniques.relief.bake import far_tolerance
+    from reliefkit.techniques.relief.frustum import frustum_matrix
+
+    for near, far in ((0.25, 1.0), (0.02, 1.0), (3.0, 4.5)):
+        m = frustum_matrix(np.array([0.3, -1.0, 2.0]), axis_frame("y"), 1.0, 0.7, near, far)
+        assert far_tolerance(m, 0.01) == pytest.approx(0.01 * near / far, rel=1e-3)
+    box = np.diag([2.0, 0.5, 3.0, 1.0])
+    box[:3, 3] = [1.0, 2.0, 3.0]
+    assert far_tolerance(box, 0.01) == 0.01

@@ -79,6 +79,25 @@ def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int,
     return tuple(max(2, int(round(s * scale))) for s in depth_size)
 
 
+def far_tolerance(box_to_world: np.ndarray, tolerance: float) -> float:
+    """The safety tolerance in h units that bounds, at a frustum's far end, the world depth
+    that ``tolerance`` bounds in an orthographic box as deep (its fraction of the depth).
+
+    A frustum's h is perspective depth, most compressed at the far end: there one unit of h
+    spans far / near times the box's mean depth per unit, so the tolerance shrinks by
+    near / far (1 for a box; 1/4 for a pyramid of the cube cut at a quarter of its height).
+    """
+    if not np.any(box_to_world[3, :3]):  # affine: h is uniform, the tolerance as given
+        return float(tolerance)
+
+    m = np.asarray(box_to_world, dtype=np.float64)
+    p0, p1 = m @ [0.5, 0.5, 0.0, 1.0], m @ [0.5, 0.5, 1.0, 1.0]  # the box's centre line
+    depth = np.linalg.norm(p1[:3] / p1[3] - p0[:3] / p0[3])
+    dp = m[:, 2]  # d p / d h; the world point is p[:3] / p[3], differentiated exactly at h = 1
+    far_rate = np.linalg.norm((dp[:3] * p1[3] - p1[:3] * dp[3]) / p1[3] ** 2)
+    return float(tolerance) * min(1.0, float(depth / far_rate))
+
+
 def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
                  safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
                  params: dict | None = None, zero_border: bool = True,
@@ -104,6 +123,7 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
     if safety:
         from .safety import safety_radii
 
+        tolerance = far_tolerance(box_to_world, tolerance)  # a frustum's h is not uniform
         relief.safety = safety_radii(height, tolerance=tolerance, progress=progress,
                                      octants=octants)
         relief.params["safety_tolerance"] = float(tolerance)

@@ -39,24 +39,6 @@ def frustum_matrix(apex, frame, tan_u: float, tan_v: float, near: float,
     return translation(apex) @ np.linalg.inv(UNIT_FROM_NDC @ proj @ view)
 
 
-def far_tolerance(box_to_world: np.ndarray, tolerance: float) -> float:
-    """The safety tolerance in h units that bounds, at a frustum's far end, the world depth
-    that ``tolerance`` bounds in an orthographic box as deep (its fraction of the depth).
-
-    A frustum's h is perspective depth, most compressed at the far end: there one unit of h
-    spans far / near times the box's mean depth per unit, so the tolerance shrinks by
-    near / far (1 for a box; 1/4 for a pyramid of the cube cut at a quarter of its height).
-    """
-    def world(h):
-        p = box_to_world @ np.array([0.5, 0.5, h, 1.0])
-        return p[:3] / p[3]
-
-    depth = np.linalg.norm(world(1.0) - world(0.0))
-    step = 1e-4
-    far_rate = np.linalg.norm(world(1.0) - world(1.0 - step)) / step
-    return float(tolerance) * min(1.0, float(depth / far_rate)) if far_rate > 0 else tolerance
-
-
 def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 30.0,
                         depth_res: int = 256) -> tuple[np.ndarray, tuple[int, int]]:
     """A reverse frustum around ``mesh`` seen from ``axis``, sides tilted by ``spread_deg``.
@@ -110,8 +92,7 @@ def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
     params = {"projection": "reverse-frustum", "axis": axis, "spread_deg": spread_deg,
               "depth_res": depth_res, "color_res": color_res or depth_res, "source": mesh.name}
     clip_bounds = np.stack([lo - pad, hi + pad]) if clip else None
-    return bake_through(mesh, frustum, size, color_size, safety=safety,
-                        tolerance=far_tolerance(frustum, tolerance),
+    return bake_through(mesh, frustum, size, color_size, safety=safety, tolerance=tolerance,
                         progress=progress, params=params, clip_bounds=clip_bounds, ctx=ctx,
                         octants=octants)
 
@@ -127,7 +108,7 @@ def cube_frusta(mesh: RenderMesh, margin: float = 0.02, near_fraction: float = 0
     to 24% of the vehicle's pixels. So each pyramid is first rasterized with the near plane
     at ``near_fraction`` of the half cube, then cut at 90% of the distance of its innermost
     covered texel, floored to 1/32 of the half cube (the outermost surface of every texel
-    lies beyond the cut: nothing is lost). `far_tolerance` then scales the tolerance.
+    lies beyond the cut: nothing is lost). `bake.far_tolerance` then scales the tolerance.
     """
     from ...bake.project import project_mesh
 
@@ -163,8 +144,7 @@ def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int |
         part_progress = None if progress is None else (
             lambda done, total, k=k: progress(k * total + done, 6 * total))
         parts.append(bake_through(mesh, box_to_world, size, color_size, safety=safety,
-                                  tolerance=far_tolerance(box_to_world, tolerance),
-                                  progress=part_progress, params=params,
+                                  tolerance=tolerance, progress=part_progress, params=params,
                                   zero_border=False, ctx=ctx, octants=octants))
     return ReliefObject(parts=parts, params={"projection": "cube", "source": mesh.name},
                         source_bounds=mesh.bounds)
