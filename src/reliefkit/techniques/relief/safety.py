@@ -195,10 +195,12 @@ def _line_pieces(height, m, yc, xlo, xstop, work):
             i1 = min(cx, ww - 1)
             j0 = min(max(cy - 1, 0), hh - 1)
             j1 = min(cy, hh - 1)
-            a00 = height[j0, i0]
-            e = height[j0, i1] - a00
-            f = height[j1, i0] - a00
-            g = height[j1, i1] - height[j0, i1] - height[j1, i0] + a00
+            a00 = np.float64(height[j0, i0])
+            a10 = np.float64(height[j0, i1])
+            a01 = np.float64(height[j1, i0])
+            e = a10 - a00
+            f = a01 - a00
+            g = np.float64(height[j1, i1]) - a10 - a01 + a00
             px = last - (cx - 0.5)
             py = yc + m * last - (cy - 0.5)
             work[1, n] = a00 + e * px + f * py + g * px * py
@@ -744,7 +746,10 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     own = {t: np.empty((nthreads,) + (h.shape[::-1] if t else h.shape), np.int32)
            for t in (False, True)}
     slopes = _slopes(int(directions))
-    frames = [_frame(h, *f) for f in _FRAMES]
+    # float32 when that holds the heights exactly: the same radii for half the memory traffic
+    h32 = h.astype(np.float32)
+    hf = h32 if np.array_equal(h32, h) else h
+    frames = [_frame(hf, *f) for f in _FRAMES]
     eps = float(tolerance) * (1.0 - TOLERANCE_SLACK)
     total = len(_FRAMES) * len(slopes)
     done = 0
