@@ -174,6 +174,21 @@ def test_dtype_cap_and_progress():
     assert big.dtype == np.uint16 and np.all(big == 300)
 
 
+@pytest.mark.parametrize("directions, offsets", [(4, 1), (8, 4)])
+def test_work_counts_one_visit_per_sample(directions, offsets):
+    # a flat field needs every walk position of every line: the visits per texel are the
+    # direction-frames times the offsets, plus one per column and sloped direction-frame
+    # for the lines that enter the box at a walk position (1/H per texel)
+    h = np.full((32, 32), 0.3)
+    work = {}
+    s = safety_radii(h, directions=directions, offsets=offsets, work=work)
+    frames = 8 * (directions // 2 + 1)
+    assert frames * offsets <= work["visits"] <= frames * (offsets + 1 / 32) + 1
+    assert work["scans"] <= work["visits"] <= work["pieces"]
+    assert work["scanned_pieces"] >= work["scans"]
+    assert np.array_equal(s, safety_radii(h, directions=directions, offsets=offsets))
+
+
 def test_zero_radius_fraction():
     assert zero_radius_fraction(np.array([[0, 1], [2, 0]], np.uint8)) == 0.5
     with pytest.raises(UsageError):

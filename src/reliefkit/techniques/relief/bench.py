@@ -83,8 +83,9 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
         mesh_ms = time_render(mesh, camera, repeats=cfg.repeats)["wall_ms"]
         for res in cfg.resolutions:
             relief = bake_relief(mesh, depth_res=res, safety=False)
+            work = {}
             start = time.perf_counter()
-            relief.safety = safety_radii(relief.height, tolerance=cfg.tolerance)
+            relief.safety = safety_radii(relief.height, tolerance=cfg.tolerance, work=work)
             safety_s = time.perf_counter() - start
             start = time.perf_counter()
             max_pyramid(relief.height)
@@ -94,6 +95,7 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
             row = {"model": name, "res": res, "mesh_ms": mesh_ms,
                    "triangles": mesh.triangle_count, "safety_s": safety_s,
                    "pyramid_s": pyramid_s, "cone_s": time.perf_counter() - start,
+                   **{f"safety_{k}": v for k, v in work.items()},
                    "mean_radius": float(relief.safety.mean()),
                    "bytes": sum(array_bytes(relief).values()),
                    "mesh_bytes": sum(array_bytes(mesh).values())}
@@ -250,6 +252,8 @@ def check_targets(results: dict) -> list[dict]:
 
 
 def markdown(results: dict) -> str:
+    from .safety import WORK_COUNTERS
+
     m = results["machine"]
     lines = [f"Machine: {m['renderer']}, {m['gl']}, CPU {m['cpu']}, Python {m['python']}; "
              f"images {results['config']['size'][0]}x{results['config']['size'][1]}, "
@@ -286,12 +290,16 @@ def markdown(results: dict) -> str:
                      + " | ".join(f"{r[m]:.3%}" for m in METHODS) + " |")
     lines += ["", f"#### Precomputation: safety radii (tolerance "
               f"{results['config']['tolerance']}) and the max pyramid", "",
-              "| model | resolution | safety radii s | mean radius | max pyramid s | "
-              "cone map s |", "|---" * 6 + "|"]
+              "The safety sweep's work per texel: walk positions visited, profile pieces "
+              "built, forward scans and the pieces they visited.", "",
+              "| model | resolution | safety radii s | mean radius | visits | pieces | scans | "
+              "scanned pieces | max pyramid s | cone map s |", "|---" * 10 + "|"]
+    nan = float("nan")
     for r in results["table1"]:
+        work = " | ".join(f"{r.get(f'safety_{k}', nan):.0f}" for k in WORK_COUNTERS)
         lines.append(f"| {r['model']} | {r['res']}² | {r['safety_s']:.2f} | "
-                     f"{r['mean_radius']:.2f} | {r.get('pyramid_s', float('nan')):.3f} | "
-                     f"{r.get('cone_s', float('nan')):.2f} |")
+                     f"{r['mean_radius']:.2f} | {work} | {r.get('pyramid_s', nan):.3f} | "
+                     f"{r.get('cone_s', nan):.2f} |")
     lines += ["", "#### Memory (arrays as stored, uncompressed)", "",
               "| model | resolution | relief texture | its mesh |", "|---" * 4 + "|"]
     for r in results["table1"]:

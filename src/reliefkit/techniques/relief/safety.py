@@ -82,6 +82,7 @@ from ...reference.heightfield import JIT_OPTIONS, as_height
 __all__ = [
     "NUMERIC_FLOOR",
     "TOLERANCE_SLACK",
+    "WORK_COUNTERS",
     "safety_radii",
     "zero_radius_fraction",
 ]
@@ -94,6 +95,10 @@ TOLERANCE_SLACK = 0.01
 tolerance between two sampled directions or walk positions are still counted."""
 
 _NEG_INF = -np.inf
+
+# work counters of the sweep (device-independent cost, reported by `safety_radii`'s ``work``)
+_VISITS, _PIECES, _SCANS, _SCANNED = range(4)
+WORK_COUNTERS = ("visits", "pieces", "scans", "scanned_pieces")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -339,12 +344,12 @@ def _next_switch(u, length, t, came_from, x0, c0, c1, c2, work, nh, eps):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _scan(work, npieces, kp, xlimit, nh, eps, floor):
+def _scan(work, npieces, kp, xlimit, nh, eps, floor, counts):
     """First violation ``b*`` (absolute x) after the walk position at piece ``kp``.
 
     Returns ``inf`` when there is none before ``xlimit``. ``K`` is the running maximum of
-    the slope ``k(a)`` of the steepest ray through ``(a, f(a) - eps)`` that clears the hull.
-    Two states alternate:
+    the slope ``k(a)`` of the steepest ray through ``(a, f(a) - eps)`` that clears the hull
+    (``counts[_SCANNED]`` counts the pieces it visits). Two states alternate:
 
     * tracking (``k(a)`` is the running maximum and increasing): no violation is possible;
       on a convex or straight piece where ``k`` rises at the start it rises to the end (each
@@ -367,6 +372,7 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor):
         x0 = work[0, kk]
         if x0 >= xlimit:
             break
+        counts[_SCANNED] += 1
         length = min(work[0, kk + 1], xlimit) - x0
         c0 = work[1, kk]
         c1 = work[2, kk]
@@ -533,9 +539,11 @@ def _rows_of(y0, hp):
 
 
 @njit(**JIT_OPTIONS)
-def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only_first):
+def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only_first,
+                counts):
     """Scan every walk position of one sample line (only the first when ``only_first``),
-    lowering the bounds ``bound_of`` (frame layout) where a violation is found."""
+    lowering the bounds ``bound_of`` (frame layout) where a violation is found; adds its
+    work to ``counts`` (indexed by `_VISITS`, `_PIECES`, `_SCANS`, `_SCANNED`)."""
     hp, wp = height.shape
     xlo, xhi = _line_range(hp, wp, m, yc)
     if not xhi > xlo:
@@ -563,6 +571,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
     if not xstop > xlo:
         return
     npieces = _line_pieces(height, m, yc, xlo, xstop, work)
+    counts[_PIECES] += npieces
     nh = 0
     k = 0
     # Along one line the first violation b*(P) never moves backwards as P advances (a later P
@@ -584,6 +593,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
             k += 1
         if k == 0 or work[0, k - 1] < xp - 1e-9:
             continue  # P is the end of the line: nothing after it
+        counts[_VISITS] += 1
         j, j2 = _rows_of(yc + m * xp, hp)
         bound = max(bound_of[j, i], bound_of[j2, i])
         if bound == 0:
@@ -593,7 +603,8 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
             continue
         # scan on to the first violation (or xstop), not just to ``limit``: the result settles
         # the following walk positions too
-        b = _scan(work, npieces, k - 1, xstop, nh, eps, floor)
+        counts[_SCANS] += 1
+        b = _scan(work, npieces, k - 1, xstop, nh, eps, floor, counts)
         known = b if b != np.inf else xstop
         if b <= limit:
             n = max(_radius_from(b - xp, margin), 0)
@@ -602,13 +613,14 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _sweep_direction(height, m, offsets, eps, floor, margin, own):
+def _sweep_direction(height, m, offsets, eps, floor, margin, own, counts):
     """All sample lines of slope ``m`` in one octant frame, in parallel.
 
     The lines are ``y = k / offsets + m x`` for every integer ``k`` that reaches the
     rectangle, plus (``m > 0``) one line per column entering the box exactly at that
     column's walk position (``P`` on the box side, where nothing behind ``P`` blocks).
-    ``own[t]`` is thread ``t``'s copy of the bounds in the frame's layout.
+    ``own[t]`` is thread ``t``'s copy of the bounds in the frame's layout and ``counts[t]``
+    its work counters.
     """
     hp, wp = height.shape
     k_lo = int(math.floor(-m * wp * offsets))
@@ -622,7 +634,7 @@ def _sweep_direction(height, m, offsets, eps, floor, margin, own):
         tid = numba.get_thread_id()
         yc = (k_lo + li) / offsets if li < nlines else -m * (li - nlines + 0.5)
         _sweep_line(height, m, yc, eps, floor, margin, offsets, own[tid], works[tid],
-                    li >= nlines)
+                    li >= nlines, counts[tid])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -685,7 +697,8 @@ def octant(x_major: bool, major_sign: float, minor_sign: float) -> int:
 def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
                  directions: int = 64, offsets: int = 4, margin: float = 0.25,
                  octants: bool = False,
-                 progress: Callable[[int, int], None] | None = None) -> np.ndarray:
+                 progress: Callable[[int, int], None] | None = None,
+                 work: dict | None = None) -> np.ndarray:
     """Conservative safety radius of every texel (see the module docstring for the definition).
 
     Parameters
@@ -713,6 +726,11 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     progress : callable, optional
         ``progress(done, total)`` called after each batch of work (one direction in one of
         the eight octant frames: ``total = 8 * (directions // 2 + 1)``), for a progress bar.
+    work : dict, optional
+        Filled with the sweep's work per texel, a device-independent cost for benchmarks:
+        ``visits`` (walk positions looked at: directions x offsets, all but those past a
+        line's last needed position), ``pieces`` (profile pieces built), ``scans``
+        (forward scans run) and ``scanned_pieces`` (pieces those scans visited).
 
     Returns
     -------
@@ -751,6 +769,7 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     hf = h32 if np.array_equal(h32, h) else h
     frames = [_frame(hf, *f) for f in _FRAMES]
     eps = float(tolerance) * (1.0 - TOLERANCE_SLACK)
+    counts = np.zeros((nthreads, len(WORK_COUNTERS)), np.int64)
     total = len(_FRAMES) * len(slopes)
     done = 0
     for si in _coarse_to_fine(len(slopes)):
@@ -762,13 +781,15 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
                 layer = bounds[f if octants else 0]
                 _seed_bounds(layer, own[transpose], transpose, flipx, flipy)
                 _sweep_direction(frame, float(slopes[si]), int(offsets), eps,
-                                 NUMERIC_FLOOR, float(margin), own[transpose])
+                                 NUMERIC_FLOOR, float(margin), own[transpose], counts)
                 _merge_bounds(layer, own[transpose], transpose, flipx, flipy)
             finally:
                 numba.set_parallel_chunksize(previous)
             done += 1
             if progress is not None:
                 progress(done, total)
+    if work is not None:
+        work.update(zip(WORK_COUNTERS, (counts.sum(axis=0) / h.size).tolist(), strict=True))
     radii = bounds.astype(dtype)
     return radii if octants else radii[0]
 
