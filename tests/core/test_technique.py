@@ -114,8 +114,8 @@ def test_params_check_every_kind():
     assert params.make(P, {"n": "4", "x": "2", "size": "1,2,3.5"}, "t") == \
         P(n=4, x=2.0, size=(1.0, 2.0, 3.5))
     assert params.make(P, {"maybe": None}, "t").maybe is None
-    for values, message in (({"n": 9}, "within"), ({"n": 2.5}, "must be a int"),
-                            ({"x": "nan"}, "must be a float"), ({"flag": "yes"}, "bool"),
+    for values, message in (({"n": 9}, "within"), ({"n": 2.5}, "must be an integer"),
+                            ({"x": "nan"}, "must be a number"), ({"flag": "yes"}, "true or false"),
                             ({"name": "c"}, "one of a, b"), ({"size": "1,2"}, "3 comma"),
                             ({"size": "1,-2,3"}, "within"), ({"q": 1}, "unknown option")):
         with pytest.raises(UsageError, match=message):

@@ -73,7 +73,7 @@ class Option:
             value = _convert(self.kind, value, self.count)
         except (TypeError, ValueError):
             shape = f"{self.count} comma-separated numbers" if self.kind == "floats" else \
-                f"a {self.kind}"
+                _KIND_NAMES.get(self.kind, f"a {self.kind}")
             raise UsageError(f"{where} must be {shape}, got {value!r}") from None
         if self.choices and value not in self.choices:
             raise UsageError(f"{where} must be one of {', '.join(map(str, self.choices))}, "
@@ -88,6 +88,10 @@ class Option:
 
 def _num(x, unbounded: str) -> str:
     return unbounded if x is None else f"{x:g}"
+
+
+_KIND_NAMES = {"int": "an integer", "float": "a number", "bool": "true or false",
+               "str": "a string"}
 
 
 def _convert(kind: str, value, count: int | None):

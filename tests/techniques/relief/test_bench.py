@@ -35,4 +35,18 @@ def test_targets_name_each_method_and_render(tiny):
     names = " ".join(t["target"] for t in tiny["targets"])
     assert "maxmip" in names and "robust never slower than exact" in names
     text = bench.markdown(tiny)
-    assert "maxmip ms" in text and "max pyramid s" in text
+    assert "maxmip ms" in text and "max pyramid s" in text and "scanned pieces" in text
+    # a quick run times single draws: its frame-time ratios are shown, not judged
+    timed = [t for t in tiny["targets"] if "slower than exact" in t["target"]]
+    assert timed and all(t["met"] is None for t in timed)
+    assert "not judged" in text
+    judged = bench.check_targets({**tiny, "config": {**tiny["config"], "repeats": 5}})
+    assert all(isinstance(t["met"], bool) for t in judged)
+
+
+def test_safety_work_is_reported_per_texel(tiny):
+    for row in tiny["table1"]:
+        # at most one visit per direction-frame (264) and line through the texel (4 offsets
+        # and the line entering at its column)
+        assert 0 < row["safety_scans"] <= row["safety_visits"] <= 264 * 5
+        assert row["safety_scanned_pieces"] >= row["safety_scans"]

@@ -17,7 +17,7 @@ from reliefkit.scene.camera import Camera
 from reliefkit.techniques.relief.reference import wrong_hits
 from reliefkit.techniques.relief.safety import safety_radii
 
-VIEWS = [(30, 45), (120, 20), (250, 8)]
+VIEWS = [(30, 45), (120, 20), (250, 8), (60, -30), (200, -10)]  # the last two from below
 
 
 def smooth_field(n, sigma, seed=0, lo=0.1, hi=0.9):

@@ -90,6 +90,23 @@ def test_camera_inside_the_box(gl, method):
     assert np.linalg.norm(frame.position[inner] - hits[inner], axis=-1).max() < 1e-3
 
 
+@pytest.mark.parametrize("method", METHODS)
+def test_a_box_reaching_past_both_clip_planes_keeps_the_surface_between_them(gl, method):
+    # the box reaches in front of the near plane (so its back faces are drawn) and behind
+    # the far plane, as a reverse frustum baked without clipping does: the surface between
+    # the planes must be drawn whole, not cut where the back faces lie beyond far
+    relief = make_relief(flat(0.125))  # surface at y = 0.125 over x, z in [-1, 1]
+    camera = Camera(eye=(0.0, 1.5, 3.0), target=(0.0, 0.0, 0.0), size=(64, 64), fov_deg=50,
+                    near=2.2, far=3.6)
+    frame = render(relief, camera, method=method, **OPTIONS.get(method, {}))
+    hits, t = plane_hits(camera, 0.125)
+    depth = -(hits @ np.asarray(camera.view)[2, :3] + camera.view[2, 3])
+    inner = ((np.abs(hits[..., 0]) < 0.9) & (np.abs(hits[..., 2]) < 0.9) & (t > 0)
+             & (depth > camera.near * 1.01) & (depth < camera.far * 0.99))
+    assert inner.mean() > 0.1 and frame.mask[inner].all()
+    assert np.linalg.norm(frame.position[inner] - hits[inner], axis=-1).max() < 1e-2
+
+
 def test_robust_needs_safety_radii_only_when_it_jumps(gl):
     from reliefkit.errors import UsageError
 

@@ -139,7 +139,7 @@ def _load(path: Path, label: str) -> RenderMesh:
     del scene  # trimesh's other arrays and caches (and the file's bytes, which its load
     gc.collect()  # record keeps) go before the mesh is merged; they sit in reference cycles
     if not parts:
-        raise BadFile("contains no triangles (only points, lines or nothing); nothing to render")
+        raise BadFile("contains no triangles (only points, lines or nothing): no surface to use")
     check_visible(parts)
     mesh = render_mesh(parts, label, path)
     if notes:  # before the ones merging found (textures, see .materials)

@@ -59,7 +59,7 @@ from ...gl.context import check_gl_error
 from ...gl.shaders import program
 from ...gl.textures import check_3d_size, texture2d, texture3d
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
-from ...render.proxy import box_planes, convex_proxy, cull_face
+from ...render.proxy import box_planes, convex_proxy, cull_face, proxy_raster_state
 from ...scene.camera import Camera
 from .boxes import BillboardBox, BillboardBoxes
 from .lod import flatten_factor
@@ -269,12 +269,10 @@ class BillboardBoxesDrawable:
         return values
 
     def _draw_boxes(self, camera, light, flatten: float, handoff: float = 0.0) -> None:
-        import moderngl
 
         set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms()
                      | self._handoff_uniforms(camera, handoff))
-        self.ctx.enable(moderngl.CULL_FACE)
-        try:
+        with proxy_raster_state(self.ctx):
             for part in self.parts:
                 set_uniforms(self.prog, part.uniforms | part.box_uniforms(camera, flatten)
                              | model_offset(camera, part.proxy.origin))
@@ -283,8 +281,6 @@ class BillboardBoxesDrawable:
                     set_uniforms(self.prog, {name: unit})
                 self.ctx.cull_face = cull_face(part.proxy, camera)
                 part.vao.render()
-        finally:
-            self.ctx.disable(moderngl.CULL_FACE)
 
     def finish(self, frame) -> None:
         frame.stats["boxes"] = len(self.parts)

@@ -34,7 +34,7 @@ class BenchConfig:
     tolerances: tuple = (0.0, 0.002, 0.005, 0.01, 0.02, 0.05)
     tolerance_res: int = 256
     correctness_res: int = 256
-    correctness_views: tuple = ((30, 45), (120, 20), (200, 10), (300, 5))
+    correctness_views: tuple = ((30, 45), (120, 20), (200, 10), (300, 5), (60, -30))
     correctness_size: tuple = (400, 300)
     tolerance: float = DEFAULT_TOLERANCE
 
@@ -200,9 +200,20 @@ def run(cfg: BenchConfig, log=print) -> dict:
     return results
 
 
+#: Frame-time targets are judged only on medians of at least this many draws (not --quick).
+JUDGED_REPEATS = 3
+
+
 def check_targets(results: dict) -> list[dict]:
-    """The issue's targets, met or not, with the figures."""
+    """The issue's targets, met or not, with the figures. Frame-time ratios of a run with
+    fewer than `JUDGED_REPEATS` draws per median (``--quick``) are reported with ``met``
+    None: a single draw on a busy machine says nothing about them."""
     out = []
+    judged = results["config"]["repeats"] >= JUDGED_REPEATS
+
+    def timed(met: bool):
+        return met if judged else None
+
     corr = results["correctness"]
     worst = {m: max(r[m] for r in corr) for m in METHODS}
     out.append({"target": "exact <= 0.1% wrong pixels at every view",
@@ -230,18 +241,18 @@ def check_targets(results: dict) -> list[dict]:
         if 256 in by_res:
             ratio = by_res[256]["robust_ms"] / by_res[256]["binary_ms"]
             out.append({"target": f"{model}: robust within 1.3x of binary's frame time at 256^2",
-                        "value": ratio, "met": ratio <= 1.3})
+                        "value": ratio, "met": timed(ratio <= 1.3)})
             ratio = by_res[256]["maxmip_ms"] / by_res[256]["binary_ms"]
             out.append({"target": f"{model}: maxmip within 1.3x of binary's frame time at 256^2",
-                        "value": ratio, "met": ratio <= 1.3})
+                        "value": ratio, "met": timed(ratio <= 1.3)})
         slower = max(r["robust_ms"] / r["exact_ms"] for r in by_res.values())
         out.append({"target": f"{model}: robust never slower than exact (worst time ratio; "
                               f"{TIMING_NOISE:.0%} is this machine's timing noise)",
-                    "value": slower, "met": slower <= 1.0 + TIMING_NOISE})
+                    "value": slower, "met": timed(slower <= 1.0 + TIMING_NOISE)})
         slower = max(r["robust_jump_ms"] / r["exact_ms"] for r in by_res.values())
         out.append({"target": f"{model}: robust with every field jumping (exact_field=0) "
                               "never slower than exact (worst time ratio)",
-                    "value": slower, "met": slower <= 1.0 + TIMING_NOISE})
+                    "value": slower, "met": timed(slower <= 1.0 + TIMING_NOISE)})
     for row in rows:
         if row["res"] == 1024 and row["model"] == "terrain":
             out.append({"target": "safety radii for 1024^2 in <= 10 s",
@@ -307,7 +318,8 @@ def markdown(results: dict) -> str:
                      f"{format_bytes(r['mesh_bytes'])} |")
     lines += ["", "#### Targets", "", "| target | value | met |", "|---|---|---|"]
     for t in results["targets"]:
-        lines.append(f"| {t['target']} | {t['value']:.4g} | {'yes' if t['met'] else 'no'} |")
+        met = {True: "yes", False: "no", None: "not judged (single draws)"}[t["met"]]
+        lines.append(f"| {t['target']} | {t['value']:.4g} | {met} |")
     return "\n".join(lines) + "\n"
 
 

@@ -17,6 +17,7 @@ from ...scene.camera import pixel_segments
 from .representation import ReliefObject, ReliefTexture
 
 FLOOR_EPS = 1e-7
+FLOOR_STEP = 1e-6  # how far along its box segment a ray rising through the floor is resumed
 
 
 def _clip(fa: np.ndarray, fb: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> None:
@@ -56,6 +57,33 @@ def box_segments(relief: ReliefTexture, near: np.ndarray, far: np.ndarray):
     return p0, p1 - p0, valid, np.stack([lo, hi], axis=1)
 
 
+def _first_hits(height, origin, direction, rows):
+    """(rows that hit, box hit points) of the segments ``origin + t direction``, t in [0, 1].
+
+    A contact with the floor of an empty texel is no hit: a segment going down leaves the
+    box there, one coming up through the floor (its entry) goes on, as in the shader.
+    """
+    hh, ww = height.shape
+
+    def hits(start, rows):
+        # the rest of each segment, from its parameter ``start`` on, as a segment of its own
+        rest = direction[rows] * (1.0 - start)
+        t = intersect_rays(height, origin[rows] + start * direction[rows], rest)
+        hit = t <= 1.0 + 1e-9
+        rows = rows[hit]
+        box = origin[rows] + start * direction[rows] + np.minimum(t[hit], 1.0)[:, None] * rest[hit]
+        on_floor = (box[:, 2] < FLOOR_EPS) & (
+            surface_height(height, box[:, 0] * ww, box[:, 1] * hh) <= FLOOR_EPS)
+        return rows, box, on_floor
+
+    rows, box, on_floor = hits(0.0, rows)
+    rising = on_floor & (direction[rows, 2] > 0.0)
+    again, again_box, again_floor = hits(FLOOR_STEP, rows[rising])
+    keep = ~on_floor
+    return (np.concatenate([rows[keep], again[~again_floor]]),
+            np.concatenate([box[keep], again_box[~again_floor]]))
+
+
 def reference_hits(relief, camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(mask (H, W), world positions (H, W, 3) NaN where no hit, part index (H, W), -1 where
     none) of the exact first hits.
@@ -73,15 +101,7 @@ def reference_hits(relief, camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     best_part = np.full(w * h, -1)
     for index, part in enumerate(parts):
         origin, direction, valid, span = box_segments(part, near, far)
-        rows = np.flatnonzero(valid)
-        t = intersect_rays(part.height, origin[rows], direction[rows])
-        hit = t <= 1.0 + 1e-9
-        rows, t = rows[hit], np.minimum(t[hit], 1.0)
-        box = origin[rows] + t[:, None] * direction[rows]
-        hh, ww = part.height.shape
-        on_floor = (box[:, 2] < FLOOR_EPS) & (
-            surface_height(part.height, box[:, 0] * ww, box[:, 1] * hh) <= FLOOR_EPS)
-        rows, box = rows[~on_floor], box[~on_floor]
+        rows, box = _first_hits(part.height, origin, direction, np.flatnonzero(valid))
         world = part.to_world(box)
         # the hit's parameter along the world segment near -> far
         seg = far[rows] - near[rows]

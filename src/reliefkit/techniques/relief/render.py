@@ -13,7 +13,13 @@ from ...gl.shaders import program
 from ...gl.textures import texture2d, texture_array, texture_levels
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
-from ...render.proxy import aabb_planes, box_planes, convex_proxy, cull_face
+from ...render.proxy import (
+    aabb_planes,
+    box_planes,
+    convex_proxy,
+    cull_face,
+    proxy_raster_state,
+)
 from .cone import relaxed_cone_ratios
 from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
@@ -140,18 +146,15 @@ class ReliefDrawable:
         check_gl_error(ctx, "uploading a relief texture")
 
     def draw(self, camera, light) -> None:
-        import moderngl
-
         set_uniforms(self.prog, self.uniforms | box_uniforms(camera, self.relief.box_to_world)
                      | camera_uniforms(camera) | model_offset(camera, self.proxy.origin)
                      | light.uniforms())
         for unit, (name, tex) in enumerate(self.textures.items()):
             tex.use(unit)
             set_uniforms(self.prog, {name: unit})
-        self.ctx.enable(moderngl.CULL_FACE)
-        self.ctx.cull_face = cull_face(self.proxy, camera)
-        self.vao.render()
-        self.ctx.disable(moderngl.CULL_FACE)
+        with proxy_raster_state(self.ctx):
+            self.ctx.cull_face = cull_face(self.proxy, camera)
+            self.vao.render()
 
     def finish(self, frame) -> None:
         """Depth AOV from the hit positions (in conservative mode the Z-buffer holds the box)."""

@@ -234,13 +234,12 @@ class DepthObjectDrawable(GLObjects):
 
         opts = self.options
         if opts.slicing == "raycast":
-            from ...render.proxy import cull_face
+            from ...render.proxy import cull_face, proxy_raster_state
 
             self._bind(camera, light, {"u_visible_depth": self._visible_depth(None)})
-            self.ctx.enable(moderngl.CULL_FACE)
-            self.ctx.cull_face = cull_face(self.proxy, camera)
-            self.vaos["main"].render()
-            self.ctx.disable(moderngl.CULL_FACE)
+            with proxy_raster_state(self.ctx):
+                self.ctx.cull_face = cull_face(self.proxy, camera)
+                self.vaos["main"].render()
             self.stats = {"slicing": "raycast", "slices": 0, "passes": "single",
                           "texturing": opts.texturing}
             return
