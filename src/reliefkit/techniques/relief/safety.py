@@ -99,6 +99,7 @@ _NEG_INF = -np.inf
 # work counters of the sweep (device-independent cost, reported by `safety_radii`'s ``work``)
 _VISITS, _PIECES, _SCANS, _SCANNED = range(4)
 WORK_COUNTERS = ("visits", "pieces", "scans", "scanned_pieces")
+_COUNTS_STRIDE = 16  # int64s per thread: 128 bytes, so threads never share a cache line
 
 
 # ---------------------------------------------------------------------------------------------
@@ -344,12 +345,13 @@ def _next_switch(u, length, t, came_from, x0, c0, c1, c2, work, nh, eps):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _scan(work, npieces, kp, xlimit, nh, eps, floor, counts):
-    """First violation ``b*`` (absolute x) after the walk position at piece ``kp``.
+def _scan(work, npieces, kp, xlimit, nh, eps, floor):
+    """First violation ``b*`` (absolute x) after the walk position at piece ``kp``, and the
+    number of pieces visited.
 
-    Returns ``inf`` when there is none before ``xlimit``. ``K`` is the running maximum of
-    the slope ``k(a)`` of the steepest ray through ``(a, f(a) - eps)`` that clears the hull
-    (``counts[_SCANNED]`` counts the pieces it visits). Two states alternate:
+    ``b*`` is ``inf`` when there is none before ``xlimit``. ``K`` is the running maximum of
+    the slope ``k(a)`` of the steepest ray through ``(a, f(a) - eps)`` that clears the hull.
+    Two states alternate:
 
     * tracking (``k(a)`` is the running maximum and increasing): no violation is possible;
       on a convex or straight piece where ``k`` rises at the start it rises to the end (each
@@ -368,11 +370,12 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor, counts):
     k = _NEG_INF
     tk = t
     came_from = -1
+    visited = 0
     for kk in range(kp, npieces):
         x0 = work[0, kk]
         if x0 >= xlimit:
             break
-        counts[_SCANNED] += 1
+        visited += 1
         length = min(work[0, kk + 1], xlimit) - x0
         c0 = work[1, kk]
         c1 = work[2, kk]
@@ -450,7 +453,7 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor, counts):
                                  length)
                 uv = _first_positive(da, db, dc - floor, u, min(ur, length))
                 if uv != np.inf:
-                    return x0 + uv
+                    return x0 + uv, visited
                 if ur <= length:
                     tracking = True
                     t = tk
@@ -461,8 +464,9 @@ def _scan(work, npieces, kp, xlimit, nh, eps, floor, counts):
                 done = True
                 break
         if not done:
-            return x0 + u  # no progress (degenerate ties): report a violation, conservatively
-    return np.inf
+            # no progress (degenerate ties): report a violation, conservatively
+            return x0 + u, visited
+    return np.inf, visited
 
 
 # ---------------------------------------------------------------------------------------------
@@ -571,7 +575,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
     if not xstop > xlo:
         return
     npieces = _line_pieces(height, m, yc, xlo, xstop, work)
-    counts[_PIECES] += npieces
+    visits = scans = scanned = 0
     nh = 0
     k = 0
     # Along one line the first violation b*(P) never moves backwards as P advances (a later P
@@ -593,7 +597,7 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
             k += 1
         if k == 0 or work[0, k - 1] < xp - 1e-9:
             continue  # P is the end of the line: nothing after it
-        counts[_VISITS] += 1
+        visits += 1
         j, j2 = _rows_of(yc + m * xp, hp)
         bound = max(bound_of[j, i], bound_of[j2, i])
         if bound == 0:
@@ -603,13 +607,18 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
             continue
         # scan on to the first violation (or xstop), not just to ``limit``: the result settles
         # the following walk positions too
-        counts[_SCANS] += 1
-        b = _scan(work, npieces, k - 1, xstop, nh, eps, floor, counts)
+        b, visited = _scan(work, npieces, k - 1, xstop, nh, eps, floor)
+        scans += 1
+        scanned += visited
         known = b if b != np.inf else xstop
         if b <= limit:
             n = max(_radius_from(b - xp, margin), 0)
             bound_of[j, i] = min(bound_of[j, i], n)
             bound_of[j2, i] = min(bound_of[j2, i], n)
+    counts[_VISITS] += visits
+    counts[_PIECES] += npieces
+    counts[_SCANS] += scans
+    counts[_SCANNED] += scanned
 
 
 @njit(parallel=True, **JIT_OPTIONS)
@@ -769,7 +778,7 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     hf = h32 if np.array_equal(h32, h) else h
     frames = [_frame(hf, *f) for f in _FRAMES]
     eps = float(tolerance) * (1.0 - TOLERANCE_SLACK)
-    counts = np.zeros((nthreads, len(WORK_COUNTERS)), np.int64)
+    counts = np.zeros((nthreads, _COUNTS_STRIDE), np.int64)
     total = len(_FRAMES) * len(slopes)
     done = 0
     for si in _coarse_to_fine(len(slopes)):
@@ -789,7 +798,8 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
             if progress is not None:
                 progress(done, total)
     if work is not None:
-        work.update(zip(WORK_COUNTERS, (counts.sum(axis=0) / h.size).tolist(), strict=True))
+        per_texel = counts[:, :len(WORK_COUNTERS)].sum(axis=0) / h.size
+        work.update(zip(WORK_COUNTERS, per_texel.tolist(), strict=True))
     radii = bounds.astype(dtype)
     return radii if octants else radii[0]
 
