@@ -269,7 +269,6 @@ class BillboardBoxesDrawable:
         return values
 
     def _draw_boxes(self, camera, light, flatten: float, handoff: float = 0.0) -> None:
-
         set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms()
                      | self._handoff_uniforms(camera, handoff))
         with proxy_raster_state(self.ctx):

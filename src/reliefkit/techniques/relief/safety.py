@@ -773,7 +773,7 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
     own = {t: np.empty((nthreads,) + (h.shape[::-1] if t else h.shape), np.int32)
            for t in (False, True)}
     slopes = _slopes(int(directions))
-    # float32 when that holds the heights exactly: the same radii for half the memory traffic
+    # float32 when that holds the heights exactly: the same radii for half the frames' memory
     h32 = h.astype(np.float32)
     hf = h32 if np.array_equal(h32, h) else h
     frames = [_frame(hf, *f) for f in _FRAMES]
