@@ -121,6 +121,55 @@ def test_robust_needs_safety_radii_only_when_it_jumps(gl):
     assert small.mask.any() and np.array_equal(small.mask, exact.mask)
 
 
+@pytest.mark.parametrize("octants", [False, True], ids=["single", "octants"])
+@pytest.mark.parametrize("axis", ["+x", "-x", "+y", "-y"])
+def test_robust_jumps_by_the_radius_of_the_texel_holding_the_walk_position(gl, axis, octants):
+    """The radius a jump takes is that of the texel holding the walk position (safety.py's
+    contract), read at the end of an exact walk and of a jump alike. Walls in columns 40 and
+    52; odd rows have radius 0 (walked exactly: they meet the first wall); even rows have
+    radius 2 in column 39 (a jump over the first wall) and 0 after it (they meet the second
+    wall). Odd rows' radius 30 in column 41 would carry an even row over the second wall
+    too. The radii are deliberately unsafe: a radius read from any neighbouring texel
+    changes which wall a ray meets."""
+    n = 64
+    height = flat(0.1, n)
+    height[:, 40] = height[:, 52] = 0.9
+    odd = (np.arange(n) % 2 == 1)[:, None]
+    safety = np.zeros((n, n), np.uint8)
+    safety[:, 39] = np.where(odd[:, 0], 0, 2)
+    safety[:, 41] = np.where(odd[:, 0], 30, 0)
+    no_first_wall = height.copy()
+    no_first_wall[:, 40] = 0.1
+    # the rays travel along +u, -u, +v or -v: flip and transpose the field to match
+    fields = [height, no_first_wall, safety]
+    if axis[0] == "-":
+        fields = [np.flip(f, axis=1) for f in fields]
+    if axis[1] == "y":
+        fields = [f.T for f in fields]
+    height, no_first_wall, safety = (np.ascontiguousarray(f) for f in fields)
+    relief = make_relief(height, safety=np.stack([safety] * 8) if octants else safety)
+    # orthographic along the axis: each ray stays on one row (column) of the field
+    azimuth = {"+x": -90, "-x": 90, "+y": 0, "-y": 180}[axis]
+    camera = Camera.orbit((0, 0.4, 0), azimuth, 15, 3.0, size=(256, 48), ortho_height=1.2)
+    robust = render(relief, camera, method="robust", exact_field=0)
+    exact = render(relief, camera, method="exact")
+    second = render(make_relief(no_first_wall), camera, method="exact")
+    origins, _ = camera.pixel_rays()
+    u, v = (origins[..., 0] + 1) / 2 * n, (1 - origins[..., 2]) / 2 * n  # texel coordinates
+    minor = v if axis[1] == "x" else u
+    clear = np.abs(minor - np.round(minor)) > 0.02  # off the row boundaries
+    row_odd = np.floor(minor) % 2 == 1
+    # rays that meet the first wall high up (so the second one is in their way too)
+    hit = np.nan_to_num(exact.position)
+    major = (hit[..., 0] + 1) / 2 * n if axis[1] == "x" else (1 - hit[..., 2]) / 2 * n
+    wall = 40.5 if axis[0] == "+" else n - 40.5
+    first = exact.mask & clear & (np.abs(major - wall) < 1.0) & (hit[..., 1] > 0.3)
+    assert (first & row_odd).sum() > 60 and (first & ~row_odd).sum() > 60
+    for rows, expected in ((first & row_odd, exact), (first & ~row_odd, second)):
+        assert robust.mask[rows].all() and expected.mask[rows].all()
+        np.testing.assert_allclose(robust.position[rows], expected.position[rows], atol=1e-4)
+
+
 def test_unknown_option_and_method_are_errors(gl):
     from reliefkit.errors import UsageError
 

@@ -52,31 +52,56 @@ float next_centerline(float x, float ox, float dx) {
     return (c - ox) / dx;
 }
 
+// Parameters of the next vertical and horizontal centrelines strictly after o + s d, and
+// the parameter steps between consecutive ones.
+vec2 next_crossings(vec3 o, vec3 d, float s) {
+    vec3 p = o + s * d;
+    return vec2(next_centerline(p.x, o.x, d.x), next_centerline(p.y, o.y, d.y));
+}
+
+vec2 crossing_steps(vec3 d) {
+    return vec2(d.x != 0.0 ? 1.0 / abs(d.x) : 3.0e38, d.y != 0.0 ? 1.0 / abs(d.y) : 3.0e38);
+}
+
 uniform bool u_quadratic_cells;  // test the exact quadratic inside each cell (see below)
 
-// F(s) = z(s) - height(s) on the bilinear cell that holds the ray between two consecutive
-// centreline crossings sa < sb: F = c.x + c.y t + c.z t^2 with t = s - sa, exactly (the
-// four corners fetched once; in the border strips the clamped coordinate is constant). A cell
-// whose corners are all 0 is empty space (hf_above): it is never hit.
-vec3 cell_poly(vec3 o, vec3 d, float sa, float sb) {
+// The bilinear cell that holds the ray between two consecutive centreline crossings
+// sa < sb: its corner texels lo and hi, the ray's cell coordinates a at sa and their rate dd
+// (in the border strips the clamped coordinate is constant and the strip has one column or
+// row: lo = hi there).
+void ray_cell(vec3 o, vec3 d, float sa, float sb, out ivec2 lo, out ivec2 hi, out vec2 a,
+              out vec2 dd) {
     vec2 last = vec2(u_hf_size) - 1.0;
     vec2 qm = o.xy + 0.5 * (sa + sb) * d.xy - 0.5;          // the segment's middle
     vec2 c = floor(clamp(qm, vec2(0.0), last));
     bvec2 strip = bvec2(qm.x <= 0.0 || qm.x >= last.x, qm.y <= 0.0 || qm.y >= last.y);
-    vec2 a = o.xy + sa * d.xy - 0.5 - c;                     // cell coordinates at sa
-    vec2 dd = d.xy;
+    a = o.xy + sa * d.xy - 0.5 - c;
+    dd = d.xy;
     if (strip.x) { a.x = 0.0; dd.x = 0.0; }
     if (strip.y) { a.y = 0.0; dd.y = 0.0; }
-    int i = int(c.x), j = int(c.y);
-    int i1 = strip.x ? i : i + 1, j1 = strip.y ? j : j + 1;  // a strip has one column (row)
-    float h00 = hf_texel(i, j), h10 = hf_texel(i1, j);
-    float h01 = hf_texel(i, j1), h11 = hf_texel(i1, j1);
-    if (max(max(h00, h10), max(h01, h11)) <= 0.0) return vec3(1.0, 0.0, 0.0);  // empty
-    float ex = h10 - h00, ey = h01 - h00, g = h11 - h10 - h01 + h00;
-    float za = o.z + sa * d.z;
-    return vec3(za - (h00 + ex * a.x + ey * a.y + g * a.x * a.y),
-                d.z - (ex * dd.x + ey * dd.y + g * (a.x * dd.y + a.y * dd.x)),
+    lo = ivec2(c);
+    hi = ivec2(strip.x ? lo.x : lo.x + 1, strip.y ? lo.y : lo.y + 1);
+}
+
+// F(s) = z(s) - height(s) in a cell with corner heights h = (h00, h10, h01, h11), the ray at
+// height za and cell coordinates a at t = 0: F = c.x + c.y t + c.z t^2, exactly. A cell whose
+// corners are all 0 is empty space (hf_above): it is never hit.
+vec3 cell_quadratic(vec4 h, vec2 a, vec2 dd, float za, float dz) {
+    if (max(max(h.x, h.y), max(h.z, h.w)) <= 0.0) return vec3(1.0, 0.0, 0.0);  // empty
+    float ex = h.y - h.x, ey = h.z - h.x, g = h.w - h.y - h.z + h.x;
+    return vec3(za - (h.x + ex * a.x + ey * a.y + g * a.x * a.y),
+                dz - (ex * dd.x + ey * dd.y + g * (a.x * dd.y + a.y * dd.x)),
                 -g * dd.x * dd.y);
+}
+
+// F on the cell between crossings sa < sb (its four corners fetched once).
+vec3 cell_poly(vec3 o, vec3 d, float sa, float sb) {
+    ivec2 lo, hi;
+    vec2 a, dd;
+    ray_cell(o, d, sa, sb, lo, hi, a, dd);
+    vec4 h = vec4(hf_texel(lo.x, lo.y), hf_texel(hi.x, lo.y), hf_texel(lo.x, hi.y),
+                  hf_texel(hi.x, hi.y));
+    return cell_quadratic(h, a, dd, o.z + sa * d.z, d.z);
 }
 
 // First t in [0, len] where the quadratic c goes below zero, or -1. With `ends_only` the
@@ -104,9 +129,7 @@ float cell_hit(vec3 c, float len, bool ends_only) {
 // Walk centreline crossings from sa (above) to s_end, one bilinear cell per iteration; true
 // with s_hit on the first hit.
 bool walk_exact(vec3 o, vec3 d, float sa, float s_end, out float s_hit, inout int iters) {
-    vec3 p = o + sa * d;
-    vec2 t = vec2(next_centerline(p.x, o.x, d.x), next_centerline(p.y, o.y, d.y));
-    vec2 dt = vec2(d.x != 0.0 ? 1.0 / abs(d.x) : 3.0e38, d.y != 0.0 ? 1.0 / abs(d.y) : 3.0e38);
+    vec2 t = next_crossings(o, d, sa), dt = crossing_steps(d);
     for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
         float sb = min(min(t.x, t.y), s_end);
         iters++;
@@ -141,43 +164,59 @@ uniform sampler2D u_height_safety;  // RG32F: height and safety radius (texels) 
 uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (else clamp to 1)
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
-// Height and safety radius where the ray crosses the major centreline ci + 0.5 at minor
-// coordinate `minor`. On a centreline the bilinear height varies along the minor axis only:
-// two texels, and the radius's texel (the one holding the point) is one of them, so a jump
-// costs two fetches of the packed texture instead of four heights and a radius.
-vec2 centerline_height_radius(float ci, float minor, bool x_major, int octant) {
-    ivec2 size = x_major ? u_hf_size : u_hf_size.yx;  // (major, minor) extents
-    float q = clamp(minor, 0.5, float(size.y) - 0.5) - 0.5;
-    float j = floor(q), f = q - j;
-    int c = clamp(int(ci), 0, size.x - 1), j0 = int(j), j1 = min(j0 + 1, size.y - 1);
-    ivec2 t0 = x_major ? ivec2(c, j0) : ivec2(j0, c);
-    ivec2 t1 = x_major ? ivec2(c, j1) : ivec2(j1, c);
-#if defined SAFETY_OCTANTS
-    float h0 = texelFetch(u_height, t0, 0).r, h1 = texelFetch(u_height, t1, 0).r;
-    float r = texelFetch(u_safety_octants, ivec3(f < 0.5 ? t0 : t1, octant), 0).r;
-#else
-    vec2 a = texelFetch(u_height_safety, t0, 0).rg, b = texelFetch(u_height_safety, t1, 0).rg;
-    float h0 = a.x, h1 = b.x, r = f < 0.5 ? a.y : b.y;
-#endif
-    return vec2(mix(h0, h1, f), r);
+// The texels around point p (texel coordinates) that its bilinear height mixes, clamped at
+// the border, and its fractions between them (as hf_height).
+void point_cell(vec2 p, out ivec2 lo, out ivec2 hi, out vec2 f) {
+    vec2 q = clamp(p, vec2(0.5), vec2(u_hf_size) - 0.5) - 0.5;
+    vec2 c = floor(q);
+    f = q - c;
+    lo = ivec2(c);
+    hi = min(lo + 1, u_hf_size - 1);
 }
 
-// The radius jumps stop at a texel of radius 0; the exact walk then covers up to the next
-// major centreline and the jumps resume. Every jump ends on a major centreline inside the box
-// (the last one before the exit at most: a shorter jump keeps the guarantee), so one sample
-// there gives the height to test and the next jump's radius. A jump that ends below the
-// surface is bisected (the paper) down to two texels, which the exact walk then tests cell
-// by cell (an exact hit instead of the linear root of the last bracket). Rays shorter than
-// u_exact_below texels (an option, 0 by default) and vertical ones are walked exactly from
-// the start. The exact walk has one call site, so the shader inlines it once: with the walk
-// nested in the jumps (inlined twice) robust ran 1.1-1.5x slower than the exact walk on
-// llvmpipe.
+// The corner heights (h00, h10, h01, h11) of texels lo..hi and, for corner 0-3 (-1: none),
+// that texel's safety radius: with the packed texture one fetch gives both.
+vec4 robust_corners(ivec2 lo, ivec2 hi, int corner, int octant, out float radius) {
+#if defined SAFETY_OCTANTS
+    radius = 0.0;
+    if (corner >= 0) {
+        ivec2 texel = ivec2((corner & 1) != 0 ? hi.x : lo.x, (corner & 2) != 0 ? hi.y : lo.y);
+        radius = texelFetch(u_safety_octants, ivec3(texel, octant), 0).r;
+    }
+    return vec4(texelFetch(u_height, lo, 0).r, texelFetch(u_height, ivec2(hi.x, lo.y), 0).r,
+                texelFetch(u_height, ivec2(lo.x, hi.y), 0).r, texelFetch(u_height, hi, 0).r);
+#else
+    vec2 c00 = texelFetch(u_height_safety, lo, 0).rg;
+    vec2 c10 = texelFetch(u_height_safety, ivec2(hi.x, lo.y), 0).rg;
+    vec2 c01 = texelFetch(u_height_safety, ivec2(lo.x, hi.y), 0).rg;
+    vec2 c11 = texelFetch(u_height_safety, hi, 0).rg;
+    radius = corner == 0 ? c00.y : (corner == 1 ? c10.y : (corner == 2 ? c01.y : c11.y));
+    return vec4(c00.x, c10.x, c01.x, c11.x);
+#endif
+}
+
+#define ROBUST_WALK 0    // the exact walk, one cell per iteration, up to s_to
+#define ROBUST_JUMP 1    // jump by the radius r of centreline ci
+#define ROBUST_BISECT 2  // halve the bracket [sa, s_to] of a jump that ended below
+
+// The paper's walk (section 3.4) as one loop whose every iteration fetches the four texels
+// around one point or cell, whatever it does: a jump, a bisection step, or one cell of the
+// exact walk. Jumps and walks end on a major centreline, and the texel that holds the end
+// point (whose radius the next jump takes) is one of the four: with the packed texture the
+// radius comes with the heights. The entry point's texel, texels of radius 0 (u_zero_exact)
+// and the last centreline before the exit are walked exactly to the next major centreline;
+// a jump that ends below the surface is bisected down to two texels, which are walked
+// exactly (an exact hit); a shorter last jump keeps the guarantee. Rays shorter than
+// u_exact_below texels and vertical ones are walked exactly. With the jumps, bisections and
+// walks in nested loops (and a fetch of its own for the radius after each walk) a SIMD group
+// waited in each loop for its slowest ray: on llvmpipe that took 1.1-1.3x this loop's time
+// for the same hits and iterations (docs/benchmarks.md).
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
     bool x_major = abs(d.x) >= abs(d.y);
     float om = x_major ? o.x : o.y, dm = x_major ? d.x : d.y;
-    float on = x_major ? o.y : o.x, dn = x_major ? d.y : d.x;
+    float dn = x_major ? d.y : d.x;
     bool walk_all = dm == 0.0 || (abs(d.x) + abs(d.y)) * (s1 - s0) < u_exact_below;
     // the major centrelines (x = c + 0.5): the last at or before the entry point, and the
     // last strictly before the exit
@@ -185,63 +224,105 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
     float dir = dm > 0.0 ? 1.0 : -1.0;
     float ci = dm > 0.0 ? floor(xm0 - 0.5) : ceil(xm0 - 0.5);
     float ci_last = dm > 0.0 ? ceil(xm1 - 0.5) - 1.0 : floor(xm1 - 0.5) + 1.0;
-    float sa = s0;  // last parameter known to be above the surface
     // the octant of this ray's direction (safety.octant): major axis, its sign, the minor's
     int octant = (x_major ? 0 : 4) + (dm < 0.0 ? 2 : 0) + (dn < 0.0 ? 1 : 0);
-    float r = -1.0;  // the radius at centreline ci; -1 until sampled
-    int k = 0;
+    // first the walk from the entry to the next major centreline (the one behind the entry
+    // lies outside the box, or its texel's guarantee starts after the entry)
+    int mode = ROBUST_WALK;
+    float sa = s0;    // the ray is above the surface up to sa
+    float s_to = s1;  // the end of the walk, or of the bracket
+    if (!walk_all) {
+        ci += dir;
+        s_to = min((ci + 0.5 - om) / dm, s1);
+    }
+    vec2 t = next_crossings(o, d, sa), dt = crossing_steps(d);
+    float r = 0.0;    // the radius at centreline ci
     bool bracketed = false;
-    for (int round = 0; round < HARD_CAP && k < u_max_iterations; ++round) {
-        float walk_from = s0, walk_to = s1;
-        if (!walk_all) {
-            walk_from = -1.0;
-            for (; k < HARD_CAP && k < u_max_iterations; ++k) {
-                float s = (ci + 0.5 - om) / dm;
-                float room = dir * (ci_last - ci);  // centrelines left before the exit
-                // from the entry point (k == 0: the centreline behind it lies outside the
-                // box, or its texel's guarantee starts after the entry), at a zero radius and
-                // after the last centreline, walk exactly to the next one (or the exit)
-                if (k == 0 || room < 0.5 || (r >= 0.0 && r < 0.5 && u_zero_exact)) {
-                    ci += dir;
-                    walk_from = max(s, s0);
-                    walk_to = min((ci + 0.5 - om) / dm, s1);
-                    r = -1.0;
-                    break;
-                }
-                // jump by the radius, or sample the radius here first
-                float target = r < 0.0 ? ci : ci + dir * min(max(r, 1.0), room);
-                float st = (target + 0.5 - om) / dm;
-                vec2 hr = centerline_height_radius(target, on + st * dn, x_major, octant);
-                if (r >= 0.0) {
-                    iters++;
-                    if (hr.x > 0.0 && o.z + st * d.z < hr.x) {  // the hit is in this jump
-                        walk_from = max(sa, s0);
-                        walk_to = st;
-                        bracketed = true;
-                        break;
-                    }
-                    sa = st;
-                    ci = target;
-                }
-                r = hr.y;
+    int bisections = 0;
+    for (int k = 0; k < HARD_CAP && k < u_max_iterations; ++k) {
+        // where to look: the walk's next cell, the bracket's middle or the jump's end
+        float s = 0.0, target = ci;
+        ivec2 lo, hi;
+        vec2 a = vec2(0.0), dd = vec2(0.0), f = vec2(0.0);
+        int corner = -1;  // which of the four holds the end point (-1: no radius needed)
+        if (mode == ROBUST_WALK) {
+            s = min(min(t.x, t.y), s_to);
+            ray_cell(o, d, sa, s, lo, hi, a, dd);
+            if (s >= s_to && !walk_all && s_to < s1) {  // the walk's last cell: centreline ci
+                ivec2 end = ivec2(int(ci), int(floor((x_major ? o.y : o.x) + s_to * dn)));
+                if (!x_major) end = end.yx;
+                end = clamp(end, ivec2(0), u_hf_size - 1);
+                corner = (end.x == lo.x ? 0 : 1) + (end.y == lo.y ? 0 : 2);
             }
-            if (walk_from < 0.0) return false;
+        } else {
+            if (mode == ROBUST_BISECT) {
+                s = 0.5 * (sa + s_to);
+            } else {
+                target = ci + dir * min(max(r, 1.0), dir * (ci_last - ci));
+                s = (target + 0.5 - om) / dm;
+            }
+            vec2 p = o.xy + s * d.xy;
+            if (mode == ROBUST_JUMP) {  // exactly on the centreline
+                if (x_major) p.x = target + 0.5; else p.y = target + 0.5;
+            }
+            point_cell(p, lo, hi, f);
+            if (mode == ROBUST_JUMP) corner = (f.x >= 0.5 ? 1 : 0) + (f.y >= 0.5 ? 2 : 0);
         }
-        // a long jump that ends below: bisect it (the paper) down to two texels, then walk
-        // those exactly
-        for (int b = 0; bracketed && b < 32 && abs(dm) * (walk_to - walk_from) > 2.0; ++b) {
-            float sm = 0.5 * (walk_from + walk_to);
+        float radius;
+        vec4 h = robust_corners(lo, hi, corner, octant, radius);
+        if (mode == ROBUST_WALK) {
             iters++;
-            if (hf_above(o + sm * d) < 0.0) walk_to = sm; else walk_from = sm;
+            vec3 c = cell_quadratic(h, a, dd, o.z + sa * d.z, d.z);
+            float th = cell_hit(c, s - sa, !u_quadratic_cells);
+            if (th >= 0.0) {
+                s_hit = sa + th;
+                return true;
+            }
+            if (s < s_to) {
+                if (t.x <= t.y) t.x += dt.x; else t.y += dt.y;
+                sa = s;
+                continue;
+            }
+            if (bracketed) {  // below at the jump's end, above in every cell by rounding
+                s_hit = s_to;
+                return true;
+            }
+            if (walk_all || s_to >= s1) return false;
+            sa = s_to;  // on centreline ci
+            r = radius;
+        } else {
+            float height = mix(mix(h.x, h.y, f.x), mix(h.z, h.w, f.x), f.y);
+            bool below = height > 0.0 && o.z + s * d.z < height;
+            iters++;
+            if (mode == ROBUST_BISECT) {
+                if (below) s_to = s; else sa = s;
+                ++bisections;
+            } else if (below) {  // the hit is in this jump
+                s_to = s;
+                bracketed = true;
+                mode = ROBUST_BISECT;
+            }
+            if (mode == ROBUST_BISECT) {
+                if (bisections >= 32 || abs(dm) * (s_to - sa) <= 2.0) {
+                    mode = ROBUST_WALK;
+                    t = next_crossings(o, d, sa);
+                }
+                continue;
+            }
+            sa = s;  // jumped: the ray is above up to the jump's end
+            ci = target;
+            r = radius;
         }
-        if (walk_exact(o, d, walk_from, walk_to, s_hit, iters)) return true;
-        if (bracketed) {  // below at the jump's end, above in every cell by rounding
-            s_hit = walk_to;
-            return true;
+        // on centreline ci with radius r: jump next, or walk exactly to the next centreline
+        // at a zero radius and after the last centreline
+        if (dir * (ci_last - ci) < 0.5 || (r < 0.5 && u_zero_exact)) {
+            ci += dir;
+            s_to = min((ci + 0.5 - om) / dm, s1);
+            mode = ROBUST_WALK;
+            t = next_crossings(o, d, sa);
+        } else {
+            mode = ROBUST_JUMP;
         }
-        if (walk_all || walk_to >= s1) return false;
-        sa = walk_to;
-        ++k;
     }
     return false;
 }
