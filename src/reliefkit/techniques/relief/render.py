@@ -71,6 +71,17 @@ def relief_proxy(relief: ReliefTexture):
     return convex_proxy(planes, near=relief.center)
 
 
+def drawn_method(relief: ReliefTexture, options: ReliefRenderOptions) -> str:
+    """The method whose program draws ``relief``: robust walks every ray shorter than
+    ``exact_below`` texels exactly, so when no ray of the field can be longer (W + H bounds
+    |dx| + |dy|) the exact walk's own program draws the same hits without the robust code
+    around it; so does a field so small (``exact_field``) that the exact walk is the cheaper
+    one (up to 128² on llvmpipe; docs/benchmarks.md)."""
+    w, h = relief.depth_resolution
+    small = w + h <= options.exact_field or w + h < options.exact_below
+    return "exact" if options.method == "robust" and small else options.method
+
+
 class ReliefDrawable:
     """GPU textures and proxy of one ReliefTexture, drawn with one intersection method.
 
@@ -86,13 +97,7 @@ class ReliefDrawable:
         self.ctx, self.relief, self.options = ctx, relief, opts
         self.extra_attachments = 1 if instrument else 0
         w, h = relief.depth_resolution
-        # robust walks every ray shorter than exact_below texels exactly: when no ray of this
-        # field can be longer (W + H bounds |dx| + |dy|), the exact walk's own program draws
-        # the same hits without the robust code around it; so does a field so small
-        # (exact_field) that the exact walk is the cheaper one (up to 128² on llvmpipe: the
-        # terrain at 64² takes 44 ms exact, 67 ms jumping; docs/benchmarks.md)
-        small = w + h <= opts.exact_field or w + h < opts.exact_below
-        self.method = "exact" if opts.method == "robust" and small else opts.method
+        self.method = drawn_method(relief, opts)
         if self.method == "robust" and relief.safety is None:
             raise UsageError("this relief texture has no safety radii: bake it with them or "
                              "render with --method maxmip (exact, needs no radii)")
