@@ -61,12 +61,27 @@ def texture2d(ctx, array: np.ndarray, *, what: str = "texture", filter: str = "l
     return tex
 
 
-def texture_levels(ctx, levels: list, *, what: str = "texture"):
-    """Upload a full mip chain of float32 (H, W) arrays, each half the size of the one
-    before down to 1 x 1 (a max pyramid, say), into one R32F texture sampled with
-    ``texelFetch(tex, p, level)``; sizes are checked before anything is allocated."""
+def mip_chain(ctx, width: int, height: int, *, what: str = "texture"):
+    """An R32F texture with its full mip chain allocated (contents undefined), sampled with
+    ``texelFetch(tex, p, level)``; the size is checked before anything is allocated."""
     import moderngl
 
+    _check_2d(ctx, width, height, what)
+    tex = ctx.texture((width, height), 1, dtype="f4")
+    try:
+        tex.build_mipmaps()  # allocates the levels
+        tex.filter = (moderngl.NEAREST_MIPMAP_NEAREST, moderngl.NEAREST)
+        tex.repeat_x = tex.repeat_y = False
+        check_gl_error(ctx, f"creating {what} ({width}x{height} with its mip levels)")
+    except BaseException:
+        tex.release()
+        raise
+    return tex
+
+
+def texture_levels(ctx, levels: list, *, what: str = "texture"):
+    """Upload a full mip chain of float32 (H, W) arrays, each half the size of the one
+    before down to 1 x 1 (a max pyramid, say), into one R32F texture (`mip_chain`)."""
     arrays = [np.ascontiguousarray(a, dtype=np.float32) for a in levels]
     if not arrays or any(a.ndim != 2 for a in arrays):
         raise GPUError(f"{what}: expected a list of (H, W) levels")
@@ -77,15 +92,11 @@ def texture_levels(ctx, levels: list, *, what: str = "texture"):
             raise GPUError(f"{what}: level {k} must be {expected}, got {a.shape}")
     if arrays[-1].shape != (1, 1):
         raise GPUError(f"{what}: the chain must end at 1 x 1, got {arrays[-1].shape}")
-    _check_2d(ctx, width, height, what)
-    tex = ctx.texture((width, height), 1, arrays[0].tobytes(), dtype="f4")
+    tex = mip_chain(ctx, width, height, what=what)
     try:
-        tex.build_mipmaps(0, len(arrays) - 1)  # allocates the levels; overwritten below
-        for k, a in enumerate(arrays[1:], start=1):
+        for k, a in enumerate(arrays):
             tex.write(a.tobytes(), level=k)
-        tex.filter = (moderngl.NEAREST_MIPMAP_NEAREST, moderngl.NEAREST)
-        tex.repeat_x = tex.repeat_y = False
-        check_gl_error(ctx, f"creating {what} ({width}x{height}, {len(arrays)} levels)")
+        check_gl_error(ctx, f"uploading {what} ({width}x{height}, {len(arrays)} levels)")
     except BaseException:
         tex.release()
         raise

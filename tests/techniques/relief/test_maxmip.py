@@ -42,3 +42,26 @@ def test_levels_upload_as_one_mipmapped_texture(gl):
 
     with pytest.raises(GPUError, match="level 1"):
         texture_levels(gl, [levels[0], levels[0]], what="bad")
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 5), (7, 3), (16, 16), (33, 20), (20, 64)])
+def test_the_gpu_build_equals_the_cpu_pyramid(gl, shape):
+    """The compute passes build the same pyramid, bit for bit (maxima are exact), from the
+    height texture: border clamping, the zero padding and every level."""
+    from reliefkit.gl.textures import texture2d
+    from reliefkit.techniques.relief.maxmip import max_pyramid_texture
+
+    rng = np.random.default_rng(sum(shape))
+    h = rng.random(shape).astype(np.float32)
+    h[rng.random(shape) < 0.3] = 0.0  # empty texels
+    levels = max_pyramid(h)
+    height = texture2d(gl, h, what="height", filter="nearest")
+    tex, top = max_pyramid_texture(gl, h, height)
+    try:
+        assert top == len(levels) - 1
+        for k, lv in enumerate(levels):
+            got = np.frombuffer(tex.read(level=k), np.float32).reshape(lv.shape)
+            assert np.array_equal(got, lv), f"level {k}"
+    finally:
+        tex.release()
+        height.release()

@@ -10,7 +10,7 @@ from ...core.params import param
 from ...errors import UsageError
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
-from ...gl.textures import texture2d, texture_array, texture_levels
+from ...gl.textures import texture2d, texture_array
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
 from ...render.frame import window_depth
 from ...render.proxy import (
@@ -21,7 +21,7 @@ from ...render.proxy import (
     proxy_raster_state,
 )
 from .cone import relaxed_cone_ratios
-from .maxmip import max_pyramid
+from .maxmip import max_pyramid_texture
 from .representation import ReliefObject, ReliefTexture
 
 METHODS = ("binary", "exact", "robust", "maxmip", "cone")
@@ -126,9 +126,8 @@ class ReliefDrawable:
                 self.textures["u_cone"] = texture2d(ctx, relaxed_cone_ratios(relief.height),
                                                     what="cone ratios", filter="nearest")
             if self.method == "maxmip":
-                levels = max_pyramid(relief.height)
-                self.textures["u_maxmip"] = texture_levels(ctx, levels, what="max pyramid")
-                self.top_level = len(levels) - 1
+                self.textures["u_maxmip"], self.top_level = max_pyramid_texture(
+                    ctx, relief.height, self.textures["u_height"])
             self.proxy = relief_proxy(relief)
             self.vbo = ctx.buffer(self.proxy.positions.tobytes())
             self.ibo = ctx.buffer(self.proxy.triangles.tobytes())
