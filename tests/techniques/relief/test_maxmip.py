@@ -65,3 +65,27 @@ def test_the_gpu_build_equals_the_cpu_pyramid(gl, shape):
     finally:
         tex.release()
         height.release()
+
+
+def test_below_gl_4_3_the_cpu_builds_the_same_pyramid(gl):
+    from reliefkit.gl.textures import texture2d
+    from reliefkit.techniques.relief.maxmip import max_pyramid_texture
+
+    class GL41:  # no compute shaders: the CPU pyramid is uploaded instead
+        version_code = 410
+
+        def __getattr__(self, name):
+            return getattr(gl, name)
+
+    h = np.random.default_rng(5).random((9, 14)).astype(np.float32)
+    height = texture2d(gl, h, what="height", filter="nearest")
+    tex, top = max_pyramid_texture(GL41(), h, height)
+    try:
+        levels = max_pyramid(h)
+        assert top == len(levels) - 1
+        for k, lv in enumerate(levels):
+            got = np.frombuffer(tex.read(level=k), np.float32).reshape(lv.shape)
+            assert np.array_equal(got, lv)
+    finally:
+        tex.release()
+        height.release()
