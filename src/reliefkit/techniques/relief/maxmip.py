@@ -58,13 +58,13 @@ def max_pyramid_texture(ctx, height: np.ndarray, height_texture):
     tex = mip_chain(ctx, side, side, what="max pyramid")
     try:
         base = program(ctx, BUILD_PROGRAM, {"FROM_HEIGHT": True})
-        reduce = program(ctx, BUILD_PROGRAM)
+        halve = program(ctx, BUILD_PROGRAM)
         height_texture.use(0)
         base["u_height"] = 0
         base["u_hf_size"] = (ww, hh)
         for level in range(top + 1):
             n = side >> level
-            prog = base if level == 0 else reduce
+            prog = base if level == 0 else halve
             prog["u_dst_size"] = (n, n)
             if level > 0:
                 tex.bind_to_image(0, read=True, write=False, level=level - 1)
