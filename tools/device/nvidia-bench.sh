@@ -24,6 +24,10 @@ if ! "$PY" -c "import moderngl, glcontext, trimesh" 2>/dev/null; then
     export PYTHONPATH="/tmp/site${PYTHONPATH:+:$PYTHONPATH}"
 fi
 export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
+# the image's own numpy, scipy and numba are used: say so if they do not go together
+"$PY" -c "import numpy, scipy, numba; print('numpy', numpy.__version__, 'numba', numba.__version__)" \
+    || { echo "error: the image's numba/numpy do not import together: add numba and llvmlite" \
+              "wheels to .whl/" >&2; exit 2; }
 command -v nvidia-smi >/dev/null && nvidia-smi -L
 "$PY" -c "from reliefkit.gl.context import get_context, gl_info; print(gl_info(get_context()))" \
     || exit 3
