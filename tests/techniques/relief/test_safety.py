@@ -87,6 +87,20 @@ def test_checker_finds_no_violation_on_random_fields(field, tol):
     _assert_checked(field, s, tol)
 
 
+def test_rays_rising_through_the_open_floor_are_unblocked(gl):
+    """Where the height is 0 the box's bottom is open (the renderer and the reference let
+    rays from below through), so a walk position past an empty stretch is reached by rays
+    rising steeply from the floor, not only by the near-horizontal ones that enter through a
+    side. Baked as if every ray entered through a side, the demo blob's radii at 96² let 3
+    of these rays dip through the surface beside its ring."""
+    from reliefkit.scene.assets import make_asset
+    from reliefkit.techniques.relief.bake import bake_relief
+
+    h = bake_relief(make_asset("blob"), depth_res=96, safety=False, ctx=gl).height
+    assert (h == 0).mean() > 0.2  # much open floor
+    _assert_checked(h, safety_radii(h, tolerance=0.01), 0.01, rays=300_000, seed=3)
+
+
 def test_single_narrow_peak():
     h = spike(21)
     s = safety_radii(h)

@@ -14,7 +14,10 @@ swapped.
 ``safety[j, i]`` is the largest ``n <= max_radius`` such that, for every ray (every
 projected direction, every vertical slope up or down, every crossing point ``P`` of that
 texel's centerline segment, any height above the surface at ``P``) that is *unblocked*,
-i.e. strictly above the surface at every point from its entry into the box up to ``P``,
+i.e. strictly above the surface at every point from its entry into the box up to ``P``
+(through a side, or through the bottom where the floor is open: where the height is 0 the
+box's bottom face is no surface, and rays from below enter there, as the renderer and the
+reference let them),
 the ray has no *violating pair of crossings* strictly between ``P`` and the jump target
 (the segment being cut where the ray leaves the box). A violating pair is a crossing down
 below the surface followed by a crossing back above it, such that the largest depth
@@ -49,7 +52,10 @@ scan of an earlier one.
   peaks where ``f'(a) = K``; both are roots of quadratics); the first point where ``L_K``
   rises above the profile;
 * conservative: ``A`` is the hull of profile samples (piece ends and the maxima of concave
-  pieces), which lies below the true hull, so more rays count as unblocked;
+  pieces), which lies below the true hull, so more rays count as unblocked; it restarts at
+  every sample where the profile is 0 (open floor: a ray entering the box there is not
+  blocked by anything behind it; the profile is 0 only at piece ends, since a bilinear cell
+  with corners >= 0 is 0 inside only when all its corners are);
 * sampled: the projected directions (``directions`` per half-plane and major axis, uniform
   in angle, both axes and both diagonals included) and the walk positions within a texel
   (``offsets`` parallel lines per texel and direction, evenly spaced, the phase varying from
@@ -593,6 +599,8 @@ def _sweep_line(height, m, yc, eps, floor, margin, offsets, bound_of, work, only
                 if 0.0 < uc < work[0, k] - work[0, k - 1]:
                     nh = hull_push(work, nh, work[0, k - 1] + uc,
                                     _qv(work[3, k - 1], work[2, k - 1], work[1, k - 1], uc))
+            if work[1, k] <= 0.0:
+                nh = 0  # open floor: a ray may enter the box here, nothing behind blocks it
             nh = hull_push(work, nh, work[0, k], work[1, k])
             k += 1
         if k == 0 or work[0, k - 1] < xp - 1e-9:
