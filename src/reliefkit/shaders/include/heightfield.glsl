@@ -7,15 +7,33 @@ float hf_texel(int i, int j) {
     return texelFetch(u_height, clamp(ivec2(i, j), ivec2(0), u_hf_size - 1), 0).r;
 }
 
-// Bilinear height at texel coordinates p (x = u * W, y = v * H).
-float hf_height(vec2 p) {
+// The heights (h00, h10, h01, h11) of the texels lo..hi (corners of one bilinear cell).
+vec4 hf_corners(ivec2 lo, ivec2 hi) {
+    return vec4(hf_texel(lo.x, lo.y), hf_texel(hi.x, lo.y), hf_texel(lo.x, hi.y),
+                hf_texel(hi.x, hi.y));
+}
+
+// The texels lo..hi whose bilinear mix is the height at texel coordinates p (clamped at the
+// border) and the fractions f between them.
+void hf_point_cell(vec2 p, out ivec2 lo, out ivec2 hi, out vec2 f) {
     vec2 q = clamp(p, vec2(0.5), vec2(u_hf_size) - 0.5) - 0.5;
     vec2 c = floor(q);
-    vec2 f = q - c;
-    int i = int(c.x), j = int(c.y);
-    float h00 = hf_texel(i, j), h10 = hf_texel(i + 1, j);
-    float h01 = hf_texel(i, j + 1), h11 = hf_texel(i + 1, j + 1);
-    return mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
+    f = q - c;
+    lo = ivec2(c);
+    hi = min(lo + 1, u_hf_size - 1);
+}
+
+// The bilinear mix of corner heights h (hf_corners) at fractions f.
+float hf_mix(vec4 h, vec2 f) {
+    return mix(mix(h.x, h.y, f.x), mix(h.z, h.w, f.x), f.y);
+}
+
+// Bilinear height at texel coordinates p (x = u * W, y = v * H).
+float hf_height(vec2 p) {
+    ivec2 lo, hi;
+    vec2 f;
+    hf_point_cell(p, lo, hi, f);
+    return hf_mix(hf_corners(lo, hi), f);
 }
 
 // Signed height of a ray point above the surface; negative means inside the solid.

@@ -99,9 +99,7 @@ vec3 cell_poly(vec3 o, vec3 d, float sa, float sb) {
     ivec2 lo, hi;
     vec2 a, dd;
     ray_cell(o, d, sa, sb, lo, hi, a, dd);
-    vec4 h = vec4(hf_texel(lo.x, lo.y), hf_texel(hi.x, lo.y), hf_texel(lo.x, hi.y),
-                  hf_texel(hi.x, hi.y));
-    return cell_quadratic(h, a, dd, o.z + sa * d.z, d.z);
+    return cell_quadratic(hf_corners(lo, hi), a, dd, o.z + sa * d.z, d.z);
 }
 
 // First t in [0, len] where the quadratic c goes below zero, or -1. With `ends_only` the
@@ -164,16 +162,6 @@ uniform sampler2D u_height_safety;  // RG32F: height and safety radius (texels) 
 uniform bool u_zero_exact;    // radius 0: exact walk to the next centreline (else clamp to 1)
 uniform float u_exact_below;  // rays crossing fewer texels than this are walked exactly
 
-// The texels around point p (texel coordinates) that its bilinear height mixes, clamped at
-// the border, and its fractions between them (as hf_height).
-void point_cell(vec2 p, out ivec2 lo, out ivec2 hi, out vec2 f) {
-    vec2 q = clamp(p, vec2(0.5), vec2(u_hf_size) - 0.5) - 0.5;
-    vec2 c = floor(q);
-    f = q - c;
-    lo = ivec2(c);
-    hi = min(lo + 1, u_hf_size - 1);
-}
-
 // The corner heights (h00, h10, h01, h11) of texels lo..hi and, for corner 0-3 (-1: none),
 // that texel's safety radius: with the packed texture one fetch gives both.
 vec4 robust_corners(ivec2 lo, ivec2 hi, int corner, int octant, out float radius) {
@@ -183,8 +171,7 @@ vec4 robust_corners(ivec2 lo, ivec2 hi, int corner, int octant, out float radius
         ivec2 texel = ivec2((corner & 1) != 0 ? hi.x : lo.x, (corner & 2) != 0 ? hi.y : lo.y);
         radius = texelFetch(u_safety_octants, ivec3(texel, octant), 0).r;
     }
-    return vec4(texelFetch(u_height, lo, 0).r, texelFetch(u_height, ivec2(hi.x, lo.y), 0).r,
-                texelFetch(u_height, ivec2(lo.x, hi.y), 0).r, texelFetch(u_height, hi, 0).r);
+    return hf_corners(lo, hi);
 #else
     vec2 c00 = texelFetch(u_height_safety, lo, 0).rg;
     vec2 c10 = texelFetch(u_height_safety, ivec2(hi.x, lo.y), 0).rg;
@@ -265,7 +252,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
             if (mode == ROBUST_JUMP) {  // exactly on the centreline
                 if (x_major) p.x = target + 0.5; else p.y = target + 0.5;
             }
-            point_cell(p, lo, hi, f);
+            hf_point_cell(p, lo, hi, f);
             if (mode == ROBUST_JUMP) corner = (f.x >= 0.5 ? 1 : 0) + (f.y >= 0.5 ? 2 : 0);
         }
         float radius;
@@ -291,7 +278,7 @@ bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout
             sa = s_to;  // on centreline ci
             r = radius;
         } else {
-            float height = mix(mix(h.x, h.y, f.x), mix(h.z, h.w, f.x), f.y);
+            float height = hf_mix(h, f);
             bool below = height > 0.0 && o.z + s * d.z < height;
             iters++;
             if (mode == ROBUST_BISECT) {
