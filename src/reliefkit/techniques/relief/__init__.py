@@ -48,6 +48,12 @@ def _bench(quick, out, log):
     return run_suite(quick, out, log)
 
 
+def _bench_sampling(quick, out, log):
+    from .bench_sampling import run_suite
+
+    return run_suite(quick, out, log)
+
+
 def _demo_tiles():
     from .demo import demo_tiles
 
@@ -99,7 +105,9 @@ TECHNIQUE = Technique(
     compare_metrics=(CompareMetric("wrong hits", _wrong_hits,
                                    ("wrong_hit_fraction", "wrong_pixels")),),
     bench_suites=(BenchSuite("relief", "Table 1, Fig. 12 and correctness of relief textures",
-                             _bench),),
+                             _bench),
+                  BenchSuite("relief-sampling", "safety radii: sampling vs time vs the "
+                             "checker's violating rays", _bench_sampling)),
     demo_tiles=_demo_tiles,
     programs=_programs(),
     samples=_samples,
@@ -113,7 +121,8 @@ TECHNIQUE = Technique(
                  "reliefkit bake height.png --as relief --box 2,0.4,2 -o terrain.rk"],
         "compare": ["reliefkit compare demo:vehicle --as relief-frustum --out cmp",
                     "reliefkit compare car.glb --as relief-frustum --view 60,15,2 --out cmp"],
-        "bench": ["reliefkit bench relief --quick", "reliefkit bench relief --out docs/bench"],
+        "bench": ["reliefkit bench relief --quick", "reliefkit bench relief --out docs/bench",
+                  "reliefkit bench relief-sampling --out docs/bench"],
     },
 )
 
