@@ -1,4 +1,5 @@
-"""What every bench report shares: the machine it ran on, and writing its json and markdown."""
+"""What every bench report shares: the machine it ran on, and writing its json, markdown and
+plots."""
 
 from __future__ import annotations
 
@@ -41,3 +42,15 @@ def write_report(out, stem: str, data: dict, markdown: Callable[[dict], str]) ->
     with atomic_path(paths[1]) as tmp:
         tmp.write_text(markdown(data))
     return paths
+
+
+def save_figure(fig, path) -> None:
+    """A matplotlib figure as a PNG at ``path``, atomically (no torn file), then closed."""
+    import matplotlib.pyplot as plt
+
+    from ..io.atomic import atomic_path
+
+    fig.tight_layout()
+    with atomic_path(Path(path)) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)

@@ -68,3 +68,11 @@ def test_safety_work_is_reported_per_texel(tiny):
         # and the line entering at its column)
         assert 0 < row["safety_scans"] <= row["safety_visits"] <= 264 * 5
         assert row["safety_scanned_pieces"] >= row["safety_scans"]
+
+
+def test_report_files(tiny, tmp_path):
+    paths = bench.write(tiny, tmp_path)
+    assert [p.name for p in paths] == ["relief-bench.json", "relief-bench.md",
+                                       "relief-bench.png"]
+    assert all(p.stat().st_size > 0 for p in paths)
+    assert paths[1].read_text().startswith("Machine: ")

@@ -22,7 +22,6 @@ glFinish); on a software rasterizer read the ratios.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import platform
@@ -32,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...io.atomic import atomic_path
+from ...bench.report import save_figure, write_report
 from ...units import format_bytes
 from .boxes import VARIANTS
 
@@ -602,20 +601,12 @@ def plot(results: dict, path: Path) -> bool:
         ax.set_xticks([1.5, 3, 6, 12, 25, 50], ["1.5", "3", "6", "12", "25", "50"])
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
+    save_figure(fig, path)
     return True
 
 
 def write(results: dict, out: Path) -> list[Path]:
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "billboard-bench.json", out / "billboard-bench.md"]
-    with atomic_path(paths[0]) as tmp:
-        tmp.write_text(json.dumps(results, indent=2))
-    with atomic_path(paths[1]) as tmp:
-        tmp.write_text(markdown(results))
+    paths = write_report(out, "billboard-bench", results, markdown)
     if plot(results, out / "billboard-bench.png"):
         paths.append(out / "billboard-bench.png")
     return paths

@@ -8,15 +8,13 @@ from the instrumented shader variant and do not depend on the machine.
 
 from __future__ import annotations
 
-import json
-import platform
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ...io.atomic import atomic_path
+from ...bench.report import machine, machine_line, save_figure, write_report
 from ...units import format_bytes
 from .bake import DEFAULT_TOLERANCE
 from .render import METHODS, ReliefRenderOptions, drawn_method
@@ -213,12 +211,7 @@ def correctness(cfg: BenchConfig, log) -> list[dict]:
 
 
 def run(cfg: BenchConfig, log=print) -> dict:
-    from ...gl.context import gl_info
-
-    info = gl_info()
-    results = {"machine": {"renderer": info["renderer"], "gl": info["version"],
-                           "cpu": platform.processor() or platform.machine(),
-                           "python": platform.python_version()},
+    results = {"machine": machine(),
                "config": {"size": cfg.size, "repeats": cfg.repeats,
                           "tolerance": cfg.tolerance}}
     results["table1"] = table1(cfg, log)
@@ -301,9 +294,8 @@ def check_targets(results: dict) -> list[dict]:
 def markdown(results: dict) -> str:
     from .safety import WORK_COUNTERS
 
-    m = results["machine"]
-    lines = [f"Machine: {m['renderer']}, {m['gl']}, CPU {m['cpu']}, Python {m['python']}; "
-             f"images {results['config']['size'][0]}x{results['config']['size'][1]}, "
+    lines = [machine_line(results["machine"]) + " Images "
+             f"{results['config']['size'][0]}x{results['config']['size'][1]}, "
              f"median of {results['config']['repeats']} draws.", "",
              f"Relief textures baked with safety tolerance {results['config']['tolerance']} "
              "(robust method, zero radii walked exactly). The robust column is robust's "
@@ -398,20 +390,13 @@ def plot(results: dict, path: Path) -> None:
     axes[2].set(xscale="log", xlabel="tolerance", ylabel="wrong pixels (%)",
                 title="Fig. 12: silhouette error")
     axes[2].legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def write(results: dict, out: Path) -> list[Path]:
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "relief-bench.json", out / "relief-bench.md", out / "relief-bench.png"]
-    plot(results, paths[2])
-    with atomic_path(paths[0]) as tmp:
-        tmp.write_text(json.dumps(results, indent=2))
-    with atomic_path(paths[1]) as tmp:
-        tmp.write_text(markdown(results))
+    paths = write_report(out, "relief-bench", results, markdown)
+    paths.append(Path(out) / "relief-bench.png")
+    plot(results, paths[-1])
     return paths
 
 

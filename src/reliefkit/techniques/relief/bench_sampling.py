@@ -11,15 +11,13 @@ cheaper sampling would give up.
 
 from __future__ import annotations
 
-import json
-import platform
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ...io.atomic import atomic_path
+from ...bench.report import machine, machine_line, save_figure, write_report
 from .bake import DEFAULT_TOLERANCE
 
 #: (directions, offsets, margin); the first is `safety_radii`'s default.
@@ -78,8 +76,7 @@ def run(cfg: SamplingConfig, log=print) -> dict:
     from .safety import safety_radii
 
     safety_radii(np.zeros((8, 8), np.float32))  # compile before measuring
-    results = {"machine": {"cpu": platform.processor() or platform.machine(),
-                           "python": platform.python_version()},
+    results = {"machine": machine(),
                "config": {"rays": cfg.rays, "seed": cfg.seed, "tolerance": cfg.tolerance},
                "rows": []}
     for model, res, samplings in cfg.fields:
@@ -112,8 +109,8 @@ def verdicts(rows: list[dict]) -> list[dict]:
 
 def markdown(results: dict) -> str:
     c = results["config"]
-    lines = [f"CPU {results['machine']['cpu']}, Python {results['machine']['python']}; "
-             f"tolerance {c['tolerance']}, {c['rays']} checker rays per bake (seed {c['seed']}, "
+    lines = [machine_line(results["machine"]),
+             f"Tolerance {c['tolerance']}, {c['rays']} checker rays per bake (seed {c['seed']}, "
              "the same rays for every sampling of a field).", "",
              "| model | resolution | directions | offsets | margin | visits per texel | "
              "seconds | time / default | mean radius | violating rays | per million | "
@@ -156,21 +153,13 @@ def plot(results: dict, path: Path) -> None:
            title="Safety radii: sampling (directions x offsets / margin) vs guarantee")
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def write(results: dict, out: Path) -> list[Path]:
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "relief-sampling.json", out / "relief-sampling.md",
-             out / "relief-sampling.png"]
-    plot(results, paths[2])
-    with atomic_path(paths[0]) as tmp:
-        tmp.write_text(json.dumps(results, indent=2))
-    with atomic_path(paths[1]) as tmp:
-        tmp.write_text(markdown(results))
+    paths = write_report(out, "relief-sampling", results, markdown)
+    paths.append(Path(out) / "relief-sampling.png")
+    plot(results, paths[-1])
     return paths
 
 
