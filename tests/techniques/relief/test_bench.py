@@ -62,6 +62,17 @@ def test_robust_is_judged_against_exact_only_where_it_jumps(tiny):
     assert target["value"] == pytest.approx(1.2) and target["met"] is False
 
 
+def test_table1_shows_each_methods_time_as_a_ratio_to_binary(tiny):
+    """The issue asks for frame times as ratios to binary taken in the same run."""
+    row = dict(tiny["table1"][0], binary_ms=40.0, exact_ms=50.0, robust_ms=30.0,
+               maxmip_ms=20.0, cone_ms=100.0, robust_jump_ms=44.0)
+    text = bench.markdown({**tiny, "table1": [row]})
+    line = next(x for x in text.splitlines() if x.startswith(f"| {row['model']} | "))
+    cells = [c.strip() for c in line.split("|")[4:10]]
+    assert cells == ["40.0", "50.0 (1.25x)", "30.0 (0.75x)", "20.0 (0.50x)",
+                     "100.0 (2.50x)", "44.0 (1.10x)"]
+
+
 def test_safety_work_is_reported_per_texel(tiny):
     for row in tiny["table1"]:
         # at most one visit per direction-frame (264) and line through the texel (4 offsets
