@@ -200,3 +200,62 @@ def test_shadows_darken_the_lee_of_a_wall(gl):
     ratio = shaded.color[..., 1][lee].mean() / lit.color[..., 1][lee].mean()
     assert ratio < 0.5
     np.testing.assert_allclose(shaded.color[open_side], lit.color[open_side], atol=1e-5)
+
+
+def _checker_relief(height, square=4):
+    relief = make_relief(height)
+    n = height.shape[0]
+    rows, cols = np.mgrid[0:n, 0:n]
+    red = ((rows // square + cols // square) % 2).astype(bool)
+    relief.color[..., 0] = np.where(red, 255, 0)
+    relief.color[..., 1] = np.where(red, 0, 255)
+    relief.color[..., 2] = 0
+    return relief
+
+
+@pytest.mark.parametrize("method", ["exact", "maxmip", "robust"])
+def test_colour_along_depth_edges_is_the_hit_texels_not_a_blurred_mip(gl, method):
+    """A magnified red/green checker on two terraces and a ridge: every pixel whose hit lies
+    a texel inside a square is pure red or green (a coarser mip would blend them). Hardware
+    derivatives, taken across the quad's other surfaces or discarded fragments, picked
+    blended mips along the edges."""
+    from reliefkit.scene.light import DirectionalLight
+
+    n, square = 32, 4
+    h = flat(0.3, n)
+    h[1:-1, n // 2:-1] = 0.7
+    h[12:20, 4:8] = 0.95
+    relief = _checker_relief(h, square)
+    light = DirectionalLight(specular=0.0)
+    for az, el in [(75, 25), (200, 40), (300, 35)]:  # magnified: the finest level
+        camera = Camera.orbit((0, 0.5, 0), az, el, 3.0, size=(128, 128))
+        frame = render(relief, camera, method=method, light=light, **OPTIONS.get(method, {}))
+        p = frame.position
+        texel = np.stack([(p[..., 0] + 1) / 2 * n, (1 - p[..., 2]) / 2 * n], axis=-1)
+        inside = ((texel % square > 1) & (texel % square < square - 1)).all(-1)
+        inside &= frame.mask & (texel > 1).all(-1) & (texel < n - 1).all(-1)
+        r, g = frame.color[..., 0][inside], frame.color[..., 1][inside]
+        mixed = np.minimum(r, g) > 0.05 * np.maximum(r, g)
+        assert inside.sum() > 1500
+        assert mixed.sum() == 0, f"view {az},{el}: {mixed.sum()} pixels of blended colour"
+
+
+def test_methods_that_find_the_same_hits_give_the_same_colours(gl):
+    from scipy.ndimage import gaussian_filter
+
+    from reliefkit.techniques.relief.safety import safety_radii
+
+    rng = np.random.default_rng(0)
+    h = gaussian_filter(rng.random((64, 64)), 2)
+    h = ((h - h.min()) / np.ptp(h) * 0.8 + 0.1).astype(np.float32)
+    relief = _checker_relief(h, 2)
+    relief.safety = safety_radii(h)
+    for az, el in [(30, 7), (200, 20)]:
+        camera = Camera.orbit((0, 0.5, 0), az, el, 3.0, size=(128, 128))
+        frames = {m: render(relief, camera, method=m) for m in ["exact", "maxmip", "robust"]}
+        for m in ["maxmip", "robust"]:
+            same = frames["exact"].mask & frames[m].mask & (np.linalg.norm(
+                frames["exact"].position - frames[m].position, axis=-1) < 1e-5)
+            assert same.sum() > 5000
+            diff = np.abs(frames["exact"].color - frames[m].color)[same].max()
+            assert diff < 1e-3, f"{m} at {az},{el}"

@@ -36,6 +36,19 @@ float hf_height(vec2 p) {
     return hf_mix(hf_corners(lo, hi), f);
 }
 
+// The bilinear surface's slope (dh/dx, dh/dy) per texel at texel coordinates p; flat where
+// the border clamps it.
+vec2 hf_slope(vec2 p) {
+    ivec2 lo, hi;
+    vec2 f;
+    hf_point_cell(p, lo, hi, f);
+    vec4 h = hf_corners(lo, hi);
+    vec2 slope = vec2(mix(h.y - h.x, h.w - h.z, f.y), mix(h.z - h.x, h.w - h.y, f.x));
+    bvec2 inside = bvec2(p.x > 0.5 && p.x < float(u_hf_size.x) - 0.5,
+                         p.y > 0.5 && p.y < float(u_hf_size.y) - 0.5);
+    return mix(vec2(0.0), slope, inside);
+}
+
 // Signed height of a ray point above the surface; negative means inside the solid.
 // Height 0 is empty space: the box's bottom face is no surface (represent/relief.py).
 float hf_above(vec3 p) {

@@ -34,14 +34,45 @@ vec3 to_world(vec3 box) {
     return w.xyz / w.w;
 }
 
+// The axis (0, 1, 2) of the box face nearest to box point p.
+int box_face_axis(vec3 p) {
+    vec3 dist = min(p, 1.0 - p);
+    return dist.x < dist.y ? (dist.x < dist.z ? 0 : 2) : (dist.y < dist.z ? 1 : 2);
+}
+
 // World normal of the box face that box point p lies on (the side walls of the solid).
 vec3 box_face_normal(vec3 p) {
-    vec3 dist = min(p, 1.0 - p);
-    int k = dist.x < dist.y ? (dist.x < dist.z ? 0 : 2) : (dist.y < dist.z ? 1 : 2);
+    int k = box_face_axis(p);
     vec4 w = vec4(u_world_to_box[0][3], u_world_to_box[1][3], u_world_to_box[2][3], 0.0);
     vec4 row = vec4(u_world_to_box[0][k], u_world_to_box[1][k], u_world_to_box[2][k], 0.0);
     vec3 grad = (row - p[k] * w).xyz;   // gradient of box coordinate k in world space
     return normalize(p[k] < 0.5 ? -grad : grad);
+}
+
+// The colour's texture gradients at box point `hit`: where the rays of the next pixels right
+// and up meet the surface's tangent plane there (ray differentials), in box (u, v). The plane
+// is the box face the ray entered by (`on_face`) or the bilinear surface's own, not the
+// shading normal's, which is smoothed across edges. Hardware derivatives would be taken from
+// the 2x2 quad's other fragments, whose rays end on other surfaces or were discarded after
+// their own march: blurred colours along every depth edge, and different colours from two
+// methods that find the same hits.
+void hit_gradients(vec2 ndc, vec3 hit, bool on_face, out vec2 dx, out vec2 dy) {
+    vec3 nb = vec3(0.0);
+    if (on_face) nb[box_face_axis(hit)] = 1.0;
+    else nb = vec3(-hf_slope(hit.xy * vec2(u_hf_size)) * vec2(u_hf_size), 1.0);
+    // the plane in world space: box_h = W x_h, so (nb, -nb.hit) . box_h = (W^T plane) . x_h
+    vec4 plane = transpose(u_world_to_box) * vec4(nb, -dot(nb, hit));
+    vec2 pixel = 2.0 / u_viewport;
+    vec2 uv[2];
+    for (int i = 0; i < 2; ++i) {
+        vec2 next = ndc + (i == 0 ? vec2(pixel.x, 0.0) : vec2(0.0, pixel.y));
+        vec3 o = unproject(next, -1.0), e = unproject(next, 1.0);
+        float fo = dot(plane, vec4(o, 1.0)), fe = dot(plane, vec4(e, 1.0));
+        float t = fo != fe ? clamp(fo / (fo - fe), -1e6, 1e6) : 1e6;  // parallel: far away
+        uv[i] = clamp(to_box(mix(o, e, t)).xy - hit.xy, -1.0, 1.0);
+    }
+    dx = uv[0];
+    dy = uv[1];
 }
 
 void main() {
@@ -69,9 +100,11 @@ void main() {
     }
     vec3 hit_box = clamp(a + s_hit * d, 0.0, 1.0);
     vec3 hit = to_world(hit_box);
-    vec4 base = texture(u_color, hit_box.xy);
-    vec3 n = normalize(texture(u_normal, hit_box.xy).xyz);
+    vec3 n = normalize(textureLod(u_normal, hit_box.xy, 0.0).xyz);  // not mipmapped
     if (s_hit <= s0 && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
+    vec2 uv_dx, uv_dy;
+    hit_gradients(ndc, hit_box, s_hit <= s0 && (entered_side || a.z <= 0.0), uv_dx, uv_dy);
+    vec4 base = textureGrad(u_color, hit_box.xy, uv_dx, uv_dy);
     vec3 to_eye = towards_eye(hit);
     if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
 
