@@ -204,6 +204,22 @@ def test_bakes_that_would_run_for_many_minutes_are_refused_up_front(kind, res):
         bake(np.zeros((2048, 2048)), "relief")
 
 
+@pytest.mark.parametrize("kind", ["relief", "relief-frustum", "relief-cube"])
+@pytest.mark.parametrize("options, named", [(["--safety-octants"], "--safety-octants"),
+                                            (["--safety-tolerance", "0.05"],
+                                             "--safety-tolerance")])
+def test_safety_options_with_no_safety_are_refused_in_one_line(tmp_path, capsys, kind,
+                                                                 options, named):
+    from reliefkit import cli
+
+    out = tmp_path / "b.rk"
+    code = cli.main(["bake", "demo:blob", "--as", kind, "--depth-res", "16", "--no-safety",
+                     *options, "-o", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code != 0 and not out.exists()
+    assert len(err.splitlines()) == 1 and named in err and "--no-safety" in err
+
+
 def test_a_frustum_takes_octant_radii_and_robust_keeps_the_reference_hits(gl):
     """Rays are straight in a frustum's texel space, so the radii per direction octant hold
     there as in an orthographic box: robust with every ray jumping meets the exact reference."""

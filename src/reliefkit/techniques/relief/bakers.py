@@ -31,6 +31,18 @@ def check_safety_work(width: int, height: int, parts: int = 1) -> None:
                      "radii), or use a smaller --depth-res")
 
 
+def check_safety_options(p) -> None:
+    """Refuse safety-radii options given with ``--no-safety``: they would be silently ignored."""
+    if p.safety:
+        return
+    given = [flag for flag, on in (("--safety-octants", p.safety_octants),
+                                   ("--safety-tolerance", p.safety_tolerance != DEFAULT_TOLERANCE))
+             if on]
+    if given:
+        raise UsageError(f"{' and '.join(given)} shape safety radii, which --no-safety leaves "
+                         "out: drop one or the other")
+
+
 def _depth_res(default: int):
     return param(default, "heightfield resolution (longest side, texels)", lo=8, hi=8192)
 
@@ -94,6 +106,7 @@ class ReliefCubeParams:
 
 
 def bake_orthographic(source, p: ReliefParams, progress=None):
+    check_safety_options(p)
     if p.safety:
         side = max(source.shape) if isinstance(source, np.ndarray) else p.depth_res
         check_safety_work(side, side)
@@ -107,6 +120,7 @@ def bake_orthographic(source, p: ReliefParams, progress=None):
 
 
 def bake_frustum(source, p: ReliefFrustumParams, progress=None):
+    check_safety_options(p)
     if p.safety:
         check_safety_work(p.depth_res, p.depth_res)
     return bake_relief_frustum(source, depth_res=p.depth_res, color_res=p.color_res,
@@ -116,6 +130,7 @@ def bake_frustum(source, p: ReliefFrustumParams, progress=None):
 
 
 def bake_cube(source, p: ReliefCubeParams, progress=None):
+    check_safety_options(p)
     if p.safety:
         check_safety_work(p.depth_res, p.depth_res, parts=6)
     return bake_relief_cube(source, depth_res=p.depth_res, color_res=p.color_res,
