@@ -511,7 +511,7 @@ def _open_rk(path):
     path = Path(path)
     if not path.is_file():
         why = "is not a file" if path.exists() else "no such file"
-        raise FormatError(f"{path}: {why}; check the path")
+        raise FormatError(f"{path}: {why}")  # as the mesh and heightmap loaders say it
     try:
         fh = open(path, "rb")  # noqa: SIM115 - closed below, after the yield
     except OSError as exc:

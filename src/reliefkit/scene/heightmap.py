@@ -22,7 +22,7 @@ def load_heightmap(path) -> np.ndarray:
     far edge (-z) seen from above (`relief_from_heights`)."""
     path = Path(path)
     if not path.is_file():
-        raise FormatError(f"{path}: no such file")
+        raise FormatError(f"{path}: {'is not a file' if path.exists() else 'no such file'}")
     heights = _load_npy(path) if path.suffix.lower() == ".npy" else _load_png(path)
     if heights.ndim != 2 or min(heights.shape) < 4 or max(heights.shape) > MAX_SIDE:
         raise FormatError(f"{path}: a heightmap must be 2D, between 4 and {MAX_SIDE} texels "
