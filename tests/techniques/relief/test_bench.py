@@ -36,6 +36,7 @@ def test_targets_name_each_method_and_render(tiny):
     assert "maxmip" in names and "robust with every field jumping" in names
     text = bench.markdown(tiny)
     assert "maxmip ms" in text and "max pyramid GPU ms" in text and "scanned pieces" in text
+    assert "Fig. 12" in text and "terrain 16², view elevation 20°" in text  # its resolution
     # a quick run times single draws: its frame-time ratios are shown, not judged
     timed = [t for t in tiny["targets"] if "slower than exact" in t["target"]]
     assert timed and all(t["met"] is None for t in timed)
