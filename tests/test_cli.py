@@ -104,6 +104,8 @@ def test_bake_render_info_relief(gl, tmp_path):
 
 @pytest.mark.parametrize("args, words", [
     (["render", "missing.obj", "-o", "x.png"], ["missing.obj", "no such file"]),
+    (["render", "missing.rk", "-o", "x.png"], ["missing.rk: no such file"]),
+    (["bake", "missing.png", "--as", "relief", "-o", "x.rk"], ["missing.png: no such file"]),
     (["render", "demo:nope", "-o", "x.png"], ["nope"]),
     (["render", "demo:tree", "--view", "1,2,3,4", "-o", "x.png"], ["--view"]),
     (["render", "demo:tree", "--size", "0x5", "-o", "x.png"], ["--size"]),

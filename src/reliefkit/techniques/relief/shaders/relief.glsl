@@ -101,9 +101,10 @@ void main() {
     vec3 hit_box = clamp(a + s_hit * d, 0.0, 1.0);
     vec3 hit = to_world(hit_box);
     vec3 n = normalize(textureLod(u_normal, hit_box.xy, 0.0).xyz);  // not mipmapped
-    if (s_hit <= s0 && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
+    bool at_entry = s_hit <= s0;  // on the face the ray entered by
+    if (at_entry && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
     vec2 uv_dx, uv_dy;
-    hit_gradients(ndc, hit_box, s_hit <= s0 && (entered_side || a.z <= 0.0), uv_dx, uv_dy);
+    hit_gradients(ndc, hit_box, at_entry && (entered_side || a.z <= 0.0), uv_dx, uv_dy);
     vec4 base = textureGrad(u_color, hit_box.xy, uv_dx, uv_dy);
     vec3 to_eye = towards_eye(hit);
     if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
