@@ -129,23 +129,38 @@ def test_describe_counts_materials_and_says_textured_only_with_an_image(tmp_path
     assert summary["textured"] is True and summary["materials"] == 2
 
 
-def spec_transform(offset, rotation, scale) -> np.ndarray:
-    """KHR_texture_transform's matrix, transcribed from the GLSL of its specification
-    (column-major mat3 constructors), acting on glTF UVs (v down)."""
+def gltf_uv_transform(offset=(0.0, 0.0), rotation=0.0, scale=(1.0, 1.0)) -> np.ndarray:
+    """KHR_texture_transform as three.js, Babylon.js and Blender apply it to glTF UVs (v down):
+    translation * rotation * scale with rotation [[cos, sin], [-sin, cos]], the sign under
+    which Khronos' TextureTransformTest arrows point at their "Correct" markers (the GLSL
+    listing of the specification has the other sign, KhronosGroup/glTF#1563)."""
     c, s = np.cos(rotation), np.sin(rotation)
-    translation = np.array([1, 0, 0, 0, 1, 0, offset[0], offset[1], 1.0]).reshape(3, 3).T
-    rotate = np.array([c, s, 0, -s, c, 0, 0, 0, 1.0]).reshape(3, 3).T
-    scaling = np.array([scale[0], 0, 0, 0, scale[1], 0, 0, 0, 1.0]).reshape(3, 3).T
-    return translation @ rotate @ scaling
+    translate = np.array([[1, 0, offset[0]], [0, 1, offset[1]], [0, 0, 1.0]])
+    rotate = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1.0]])
+    return translate @ rotate @ np.diag([scale[0], scale[1], 1.0])
 
 
-def test_gltf_texture_transform_is_kept_per_material(tmp_path):
+# the transforms of Khronos' TextureTransformTest sample, by material, and one with an
+# unequal scale (where the order of rotation and scale shows)
+SAMPLE_TRANSFORMS = {
+    "offset_u": {"offset": [0.5, 0.0]},
+    "offset_v": {"offset": [0.0, 0.5]},
+    "offset_uv": {"offset": [0.5, 0.5]},
+    "rotation": {"rotation": 0.39269908169872414},
+    "scale": {"scale": [1.5, 1.5]},
+    "all": {"offset": [-0.2, -0.1], "rotation": 0.3, "scale": [1.5, 1.5]},
+    "unequal_scale": {"offset": [0.25, 0.5], "rotation": 0.4, "scale": [0.5, 2.0]},
+}
+
+
+@pytest.mark.parametrize("case", SAMPLE_TRANSFORMS)
+def test_gltf_texture_transform_is_kept_per_material(tmp_path, case):
     path = tmp_path / "transformed.gltf"
     quads = [textured_quad(IMAGES["bricks"], 0.0, "plain"),
              textured_quad(IMAGES["sky"], 2.0, "atlas")]
     trimesh.Scene(quads).export(str(path))
     tree = json.loads(path.read_text())
-    params = {"offset": [0.25, 0.5], "rotation": 0.4, "scale": [0.5, 2.0]}
+    params = SAMPLE_TRANSFORMS[case]
     (atlas,) = [m for m in tree["materials"] if m["name"] == "atlas"]
     atlas["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
         "KHR_texture_transform": params}
@@ -157,7 +172,7 @@ def test_gltf_texture_transform_is_kept_per_material(tmp_path):
     ours = material_of_quad(mesh_out, 2.0).uv_transform.astype(np.float64)
     uv = np.random.default_rng(0).random((10, 2))
     gltf_uv = np.column_stack([uv[:, 0], 1 - uv[:, 1], np.ones(10)])  # glTF's v runs down
-    moved = gltf_uv @ spec_transform(**params).T
+    moved = gltf_uv @ gltf_uv_transform(**params).T
     expected = np.column_stack([moved[:, 0], 1 - moved[:, 1]])
     got = (np.column_stack([uv, np.ones(10)]) @ ours.T)[:, :2]
     np.testing.assert_allclose(got, expected, atol=1e-6)
