@@ -130,10 +130,10 @@ def test_describe_counts_materials_and_says_textured_only_with_an_image(tmp_path
 
 
 def gltf_uv_transform(offset=(0.0, 0.0), rotation=0.0, scale=(1.0, 1.0)) -> np.ndarray:
-    """KHR_texture_transform as three.js, Babylon.js and Blender apply it to glTF UVs (v down):
-    translation * rotation * scale with rotation [[cos, sin], [-sin, cos]], the sign under
-    which Khronos' TextureTransformTest arrows point at their "Correct" markers (the GLSL
-    listing of the specification has the other sign, KhronosGroup/glTF#1563)."""
+    """KHR_texture_transform on glTF UVs (v down): the specification's translation * rotation
+    * scale, with the rotation [[cos, sin], [-sin, cos]] that three.js, Babylon.js and Blender
+    use and under which Khronos' TextureTransformTest arrows point at their "Correct" markers
+    (the GLSL listing of the specification has the other sign, KhronosGroup/glTF#1563)."""
     c, s = np.cos(rotation), np.sin(rotation)
     translate = np.array([[1, 0, offset[0]], [0, 1, offset[1]], [0, 0, 1.0]])
     rotate = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1.0]])
