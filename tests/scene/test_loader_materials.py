@@ -176,3 +176,39 @@ def test_gltf_texture_transform_is_kept_per_material(tmp_path, case):
     expected = np.column_stack([moved[:, 0], 1 - moved[:, 1]])
     got = (np.column_stack([uv, np.ones(10)]) @ ours.T)[:, :2]
     np.testing.assert_allclose(got, expected, atol=1e-6)
+
+
+def test_gltf_texture_rotation_draws_the_texels_the_viewers_draw(gl, tmp_path):
+    """A quarter turn (KHR_texture_transform rotation pi/2) on a 4x4 image of 16 colours,
+    rendered from the front: at every pixel over a texel's centre, the colour of the texel
+    the reference transform picks (the old sign picked the mirror-image texel)."""
+    from reliefkit.render import render
+    from reliefkit.scene.camera import Camera
+    from reliefkit.scene.light import DirectionalLight
+
+    image = np.zeros((4, 4, 4), np.uint8)  # PIL rows: row 0 at glTF's v = 0
+    image[..., 0] = np.arange(16).reshape(4, 4) * 16
+    image[..., 1] = 255 - np.arange(16).reshape(4, 4) * 16
+    image[..., 2], image[..., 3] = 128, 255
+    quad = textured_quad(image, -1.0, "turned")
+    quad.vertices = quad.vertices * [2, 2, 1] - [-1, 1, 0]  # x, y in [-1, 1]
+    path = tmp_path / "turned.gltf"
+    quad.export(str(path))
+    tree = json.loads(path.read_text())
+    tree["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+        "KHR_texture_transform": {"rotation": np.pi / 2}}
+    tree["extensionsUsed"] = [*tree.get("extensionsUsed", []), "KHR_texture_transform"]
+    path.write_text(json.dumps(tree))
+
+    frame = render(load_mesh(path), Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(20, 20),
+                                           ortho_height=1.0),
+                   light=DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0))
+    centres = np.arange(2, 20, 5)  # 5 pixels per texel: these pixels sit on texel centres
+    rows, cols = np.meshgrid(centres, centres, indexing="ij")
+    u, v_up = (cols + 0.5) / 20, 1 - (rows + 0.5) / 20  # the quad's UVs (v up) there
+    gltf = np.stack([u.ravel(), 1 - v_up.ravel(), np.ones(u.size)])  # glTF's v runs down
+    moved = (gltf_uv_transform(rotation=np.pi / 2) @ gltf)[:2] % 1.0  # the sampler repeats
+    texel = image[(moved[1] * 4).astype(int), (moved[0] * 4).astype(int), :3] / 255.0
+    expected = np.where(texel <= 0.04045, texel / 12.92, ((texel + 0.055) / 1.055) ** 2.4)
+    np.testing.assert_allclose(frame.color[rows.ravel(), cols.ravel(), :3], expected,
+                               atol=2e-3)
