@@ -8,11 +8,11 @@
 from . import metrics
 from .bake import bake
 from .errors import FormatError, GPUError, MeshError, ReliefkitError, UsageError
+from .io.inputs import load_mesh
 from .io.rk import load, save
 from .render import Frame, render
 from .scene.camera import Camera
 from .scene.light import DirectionalLight
-from .scene.loader import load_mesh
 from .scene.mesh import RenderMesh
 from .techniques.billboard import (
     BillboardBoxes,

@@ -566,10 +566,26 @@ def test_obj_missing_mtl_loads_with_the_default_material_and_one_warning(tmp_pat
     assert "material.mtl" in mesh.extra["warnings"][0]
 
 
-def test_obj_missing_texture(tmp_path):
+def assert_drawn_without_texture(mesh_out, name: str, why: str, color) -> None:
+    """The mesh kept its triangles and UVs, no texture, the material's colour, and one
+    one-line warning that names the texture and why it was not read."""
+    assert mesh_out.triangle_count == 2 and mesh_out.uvs is not None
+    assert not mesh_out.textured and mesh_out.texture is None
+    np.testing.assert_allclose(mesh_out.materials[0].color, color, atol=1e-6)
+    (line,) = mesh_out.extra["warnings"]
+    assert "\n" not in line and f"texture '{name}'" in line and why in line, line
+    assert "drawn with the material colour" in line, line
+
+
+def test_obj_missing_texture_draws_the_material_colour_with_one_warning(tmp_path):
     path = write_export(textured_quad(), tmp_path / "q.obj")
     (tmp_path / "material_0.png").unlink()
-    expect_error(path, "references missing file", "material_0.png")
+    kd = [float(x) for x in next(line.split()[1:] for line in
+                                 (tmp_path / "material.mtl").read_text().splitlines()
+                                 if line.startswith("Kd"))]
+    linear = [srgb_byte_to_linear(round(255 * x)) for x in kd]
+    assert_drawn_without_texture(load_mesh(path), "material_0.png", "not found",
+                                 [*linear, 1.0])
 
 
 def test_gltf_missing_buffer(tmp_path):
@@ -578,21 +594,38 @@ def test_gltf_missing_buffer(tmp_path):
     expect_error(path, "references missing file", "gltf_buffer_0.bin")
 
 
-def test_gltf_missing_image(tmp_path):
+def test_gltf_missing_image_draws_the_factor_with_one_warning(tmp_path):
     path = write_export(textured_quad(), tmp_path / "q.gltf")
     tree = json.loads(path.read_text())
     tree["images"] = [{"uri": "texture.png"}]
+    tree["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = [0.2, 0.4, 1.0, 1.0]
     path.write_text(json.dumps(tree))
-    expect_error(path, "references missing file", "texture.png")
+    assert_drawn_without_texture(load_mesh(path), "texture.png", "not found",
+                                 [0.2, 0.4, 1.0, 1.0])
 
 
-def test_reference_outside_the_folder(tmp_path):
+def test_gltf_image_outside_the_folder_is_not_read(tmp_path):
+    folder = tmp_path / "model"
+    folder.mkdir()
+    path = write_export(textured_quad(), folder / "q.gltf")
+    Image.fromarray(TEXTURE_TOP_DOWN, "RGBA").save(tmp_path / "texture.png")
+    tree = json.loads(path.read_text())
+    tree["images"] = [{"uri": "../texture.png"}]
+    path.write_text(json.dumps(tree))
+    assert_drawn_without_texture(load_mesh(path), "../texture.png", "outside the mesh's folder",
+                                 [1.0, 1.0, 1.0, 1.0])
+
+
+def test_mtl_outside_the_folder_is_not_read(tmp_path):
     folder = tmp_path / "model"
     folder.mkdir()
     (tmp_path / "m.mtl").write_text("newmtl paint\nKd 1 0 0\n")
     path = folder / "m.obj"
     path.write_text("mtllib ../m.mtl\nusemtl paint\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
-    expect_error(path, "outside its folder")
+    mesh_out = load_mesh(path)
+    assert mesh_out.materials == (type(mesh_out.materials[0])(),)  # the default, not its red
+    (line,) = mesh_out.extra["warnings"]
+    assert "'../m.mtl'" in line and "outside the mesh's folder" in line, line
 
 
 @pytest.mark.parametrize("suffix", SUPPORTED_EXTENSIONS)

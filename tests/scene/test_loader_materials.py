@@ -129,23 +129,38 @@ def test_describe_counts_materials_and_says_textured_only_with_an_image(tmp_path
     assert summary["textured"] is True and summary["materials"] == 2
 
 
-def spec_transform(offset, rotation, scale) -> np.ndarray:
-    """KHR_texture_transform's matrix, transcribed from the GLSL of its specification
-    (column-major mat3 constructors), acting on glTF UVs (v down)."""
+def gltf_uv_transform(offset=(0.0, 0.0), rotation=0.0, scale=(1.0, 1.0)) -> np.ndarray:
+    """KHR_texture_transform on glTF UVs (v down): the specification's translation * rotation
+    * scale, with the rotation [[cos, sin], [-sin, cos]] that three.js, Babylon.js and Blender
+    use and under which Khronos' TextureTransformTest arrows point at their "Correct" markers
+    (the GLSL listing of the specification has the other sign, KhronosGroup/glTF#1563)."""
     c, s = np.cos(rotation), np.sin(rotation)
-    translation = np.array([1, 0, 0, 0, 1, 0, offset[0], offset[1], 1.0]).reshape(3, 3).T
-    rotate = np.array([c, s, 0, -s, c, 0, 0, 0, 1.0]).reshape(3, 3).T
-    scaling = np.array([scale[0], 0, 0, 0, scale[1], 0, 0, 0, 1.0]).reshape(3, 3).T
-    return translation @ rotate @ scaling
+    translate = np.array([[1, 0, offset[0]], [0, 1, offset[1]], [0, 0, 1.0]])
+    rotate = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1.0]])
+    return translate @ rotate @ np.diag([scale[0], scale[1], 1.0])
 
 
-def test_gltf_texture_transform_is_kept_per_material(tmp_path):
+# the transforms of Khronos' TextureTransformTest sample, by material, and one with an
+# unequal scale (where the order of rotation and scale shows)
+SAMPLE_TRANSFORMS = {
+    "offset_u": {"offset": [0.5, 0.0]},
+    "offset_v": {"offset": [0.0, 0.5]},
+    "offset_uv": {"offset": [0.5, 0.5]},
+    "rotation": {"rotation": 0.39269908169872414},
+    "scale": {"scale": [1.5, 1.5]},
+    "all": {"offset": [-0.2, -0.1], "rotation": 0.3, "scale": [1.5, 1.5]},
+    "unequal_scale": {"offset": [0.25, 0.5], "rotation": 0.4, "scale": [0.5, 2.0]},
+}
+
+
+@pytest.mark.parametrize("case", SAMPLE_TRANSFORMS)
+def test_gltf_texture_transform_is_kept_per_material(tmp_path, case):
     path = tmp_path / "transformed.gltf"
     quads = [textured_quad(IMAGES["bricks"], 0.0, "plain"),
              textured_quad(IMAGES["sky"], 2.0, "atlas")]
     trimesh.Scene(quads).export(str(path))
     tree = json.loads(path.read_text())
-    params = {"offset": [0.25, 0.5], "rotation": 0.4, "scale": [0.5, 2.0]}
+    params = SAMPLE_TRANSFORMS[case]
     (atlas,) = [m for m in tree["materials"] if m["name"] == "atlas"]
     atlas["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
         "KHR_texture_transform": params}
@@ -157,7 +172,43 @@ def test_gltf_texture_transform_is_kept_per_material(tmp_path):
     ours = material_of_quad(mesh_out, 2.0).uv_transform.astype(np.float64)
     uv = np.random.default_rng(0).random((10, 2))
     gltf_uv = np.column_stack([uv[:, 0], 1 - uv[:, 1], np.ones(10)])  # glTF's v runs down
-    moved = gltf_uv @ spec_transform(**params).T
+    moved = gltf_uv @ gltf_uv_transform(**params).T
     expected = np.column_stack([moved[:, 0], 1 - moved[:, 1]])
     got = (np.column_stack([uv, np.ones(10)]) @ ours.T)[:, :2]
     np.testing.assert_allclose(got, expected, atol=1e-6)
+
+
+def test_gltf_texture_rotation_draws_the_texels_the_viewers_draw(gl, tmp_path):
+    """A quarter turn (KHR_texture_transform rotation pi/2) on a 4x4 image of 16 colours,
+    rendered from the front: at every pixel over a texel's centre, the colour of the texel
+    the reference transform picks (the old sign picked the mirror-image texel)."""
+    from reliefkit.render import render
+    from reliefkit.scene.camera import Camera
+    from reliefkit.scene.light import DirectionalLight
+
+    image = np.zeros((4, 4, 4), np.uint8)  # PIL rows: row 0 at glTF's v = 0
+    image[..., 0] = np.arange(16).reshape(4, 4) * 16
+    image[..., 1] = 255 - np.arange(16).reshape(4, 4) * 16
+    image[..., 2], image[..., 3] = 128, 255
+    quad = textured_quad(image, -1.0, "turned")
+    quad.vertices = quad.vertices * [2, 2, 1] - [-1, 1, 0]  # x, y in [-1, 1]
+    path = tmp_path / "turned.gltf"
+    quad.export(str(path))
+    tree = json.loads(path.read_text())
+    tree["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+        "KHR_texture_transform": {"rotation": np.pi / 2}}
+    tree["extensionsUsed"] = [*tree.get("extensionsUsed", []), "KHR_texture_transform"]
+    path.write_text(json.dumps(tree))
+
+    frame = render(load_mesh(path), Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(20, 20),
+                                           ortho_height=1.0),
+                   light=DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0))
+    centres = np.arange(2, 20, 5)  # 5 pixels per texel: these pixels sit on texel centres
+    rows, cols = np.meshgrid(centres, centres, indexing="ij")
+    u, v_up = (cols + 0.5) / 20, 1 - (rows + 0.5) / 20  # the quad's UVs (v up) there
+    gltf = np.stack([u.ravel(), 1 - v_up.ravel(), np.ones(u.size)])  # glTF's v runs down
+    moved = (gltf_uv_transform(rotation=np.pi / 2) @ gltf)[:2] % 1.0  # the sampler repeats
+    texel = image[(moved[1] * 4).astype(int), (moved[0] * 4).astype(int), :3] / 255.0
+    expected = np.where(texel <= 0.04045, texel / 12.92, ((texel + 0.055) / 1.055) ** 2.4)
+    np.testing.assert_allclose(frame.color[rows.ravel(), cols.ravel(), :3], expected,
+                               atol=2e-3)

@@ -6,15 +6,12 @@ the face lists, the image the .mtl names).
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pytest
 import trimesh
 from helpers import inside_polygon, shoelace, triangles_covering
 from PIL import Image
 
-from reliefkit.errors import MeshError
 from reliefkit.scene.loader import load_mesh
 
 # ------------------------------------------------------------------------- texture paths
@@ -60,19 +57,22 @@ def test_mtllib_with_another_case_resolves(tmp_path):
     assert mesh_out.textured
 
 
-def test_a_path_that_leaves_the_folder_is_still_refused(tmp_path):
+def test_a_path_that_leaves_the_folder_is_not_read(tmp_path):
     folder = tmp_path / "model"
     folder.mkdir()
     Image.new("RGBA", (4, 4), RED).save(tmp_path / "wall.png")
-    path = textured_obj(folder, "..\\wall.png", "unused.png")
-    with pytest.raises(MeshError, match="outside its folder"):
-        load_mesh(path)
+    mesh_out = load_mesh(textured_obj(folder, "..\\wall.png", "unused.png"))
+    assert not mesh_out.textured  # the red image beside the folder is not read
+    np.testing.assert_allclose(mesh_out.materials[0].color, [1, 1, 1, 1])  # Kd 1 1 1
+    (line,) = mesh_out.extra["warnings"]
+    assert line.startswith("texture '..\\wall.png' is outside the mesh's folder"), line
 
 
 def test_a_missing_texture_is_named_as_written(tmp_path):
-    path = textured_obj(tmp_path, "textures\\gone.png", "textures/other.png")
-    with pytest.raises(MeshError, match=re.escape("references missing file 'textures\\gone.png'")):
-        load_mesh(path)
+    mesh_out = load_mesh(textured_obj(tmp_path, "textures\\gone.png", "textures/other.png"))
+    assert not mesh_out.textured
+    (line,) = mesh_out.extra["warnings"]
+    assert line.startswith("texture 'textures\\gone.png' not found"), line
 
 
 # --------------------------------------------------------------------- concave polygons

@@ -1,7 +1,13 @@
-"""Open whatever the user names: a mesh file, a .rk representation, or a demo asset."""
+"""Open whatever the user names: a mesh file, a .rk representation, or a demo asset.
+
+The one place that reads ``demo:NAME``: the CLI's inputs (`load_input`) and the public
+``reliefkit.load_mesh`` (`load_mesh`) both go through it.
+"""
 
 from __future__ import annotations
 
+import hashlib
+import os
 from pathlib import Path
 
 DEMO_PREFIX = "demo:"
@@ -9,17 +15,39 @@ DEMO_PREFIX = "demo:"
 
 def load_input(spec: str):
     """``demo:NAME`` -> a procedural RenderMesh, ``*.rk`` -> its representation, else a mesh."""
-    if spec.startswith(DEMO_PREFIX):
-        from ..scene.assets import make_asset
-
-        return make_asset(spec[len(DEMO_PREFIX):])
-    if Path(spec).suffix.lower() == ".rk":
+    if not _is_demo(spec) and Path(spec).suffix.lower() == ".rk":
         from .rk import load
 
         return load(spec)
-    from ..scene.loader import load_mesh
-
     return load_mesh(spec)
+
+
+def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
+    """A mesh file (see `reliefkit.scene.loader.load_mesh`), or ``demo:NAME``: the procedural
+    asset or surface the CLI calls so (`reliefkit.scene.assets.make_asset`).
+
+    `name` labels the mesh in pictures and messages (default: the file name without its
+    extension, or the asset's own name). Raises `MeshError` for a file that cannot be
+    loaded, `UsageError` for an unknown demo name.
+    """
+    if not _is_demo(spec):
+        from ..scene.loader import load_mesh as load_mesh_file
+
+        return load_mesh_file(spec, name=name)
+    from ..scene.assets import make_asset
+    from ..scene.mesh import RenderMesh
+
+    mesh = make_asset(spec[len(DEMO_PREFIX):])
+    if name is None:
+        return mesh
+    return RenderMesh(mesh.positions, mesh.indices, mesh.normals, mesh.colors, mesh.uvs,
+                      name=name, extra=mesh.extra, materials=mesh.materials,
+                      material=mesh.material, origin=mesh.origin)
+
+
+def _is_demo(spec) -> bool:
+    """Only a string names a demo asset (a path object is always a file)."""
+    return isinstance(spec, str) and spec.startswith(DEMO_PREFIX)
 
 
 def describe(obj) -> dict:
@@ -31,6 +59,14 @@ def describe(obj) -> dict:
         return {"kind": "mesh", "name": obj.name, "vertices": len(obj.positions),
                 "triangles": obj.triangle_count, "bounds_min": lo.tolist(),
                 "bounds_max": hi.tolist(), "materials": len(obj.materials),
-                "textured": obj.textured}
+                "textures": _texture_count(obj), "textured": obj.textured,
+                "uvs": obj.uvs is not None}
     summary = getattr(obj, "summary", None)
     return summary() if callable(summary) else {"kind": type(obj).__name__}
+
+
+def _texture_count(mesh) -> int:
+    """How many distinct images the materials use (materials that share one, or carry equal
+    copies of one file, count it once)."""
+    return len({(m.texture.shape, hashlib.blake2b(m.texture.data, digest_size=16).digest())
+                for m in mesh.materials if m.texture is not None})

@@ -81,7 +81,7 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
         scene-graph matrices beyond `MAX_COORDINATE` or not finite, out-of-range face
         indices, no triangle with a visible area (every face of zero area: collinear or
         coincident corners, a node scaled to 0, slivers far thinner than float32 can
-        resolve), or references a missing file other than an OBJ's .mtl. The message is one
+        resolve), or a glTF buffer that is missing or cannot be read. The message is one
         line that starts with the path; nothing the parsing libraries log or warn reaches
         stderr. Any other failure while parsing bad input (running out of memory, a parser's
         internal error) is turned into a `MeshError` naming the file as well.
@@ -90,8 +90,9 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
     -----
     A mesh with some visible triangles keeps its zero-area ones (they draw nothing). Problems
     that do not stop the mesh from rendering are listed, one line each, in
-    ``extra["warnings"]`` (present only when there are some): an OBJ whose ``mtllib`` file is
-    missing is drawn with the default material.
+    ``extra["warnings"]`` (present only when there are some): a ``.mtl`` or a texture that is
+    missing, outside the mesh's folder (never read) or not a regular file is one warning, and
+    the mesh is drawn with the default material or with the material's colour instead.
     """
     path = Path(os.fsdecode(path))  # bytes names too (undecodable bytes as surrogates)
     try:
@@ -133,7 +134,7 @@ def _silenced():
 
 def _load(path: Path, label: str) -> RenderMesh:
     file_type = _file_type(path)
-    notes: list[str] = []  # the load's warnings (a missing .mtl, dropped references)
+    notes: list[str] = []  # the load's warnings (a .mtl or texture not read, dropped references)
     scene, transforms = _parsed(path, file_type, notes)
     parts = scene_parts(scene, srgb=file_type not in _GLTF_FORMATS, uv_transforms=transforms)
     del scene  # trimesh's other arrays and caches (and the file's bytes, which its load

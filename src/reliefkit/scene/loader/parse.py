@@ -24,12 +24,13 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
     """Find referenced files next to the mesh and remember the ones that are missing.
 
     trimesh skips a missing .mtl, texture or image silently, so `parse_file` asks this resolver
-    afterwards. Names are looked up as other importers do: also URL-decoded (glTF URIs escape
-    spaces as %20), with `\\` as a separator (files written on Windows), and at last with
-    any case, in the named subfolder or the mesh's own folder. Names that lead out of the
-    folder are refused. .mtl files are handed over as UTF-8 like the OBJ itself. Only regular
-    files within the size cap are read (`read_regular`): a FIFO, a device or a socket is
-    refused and remembered, never opened for blocking reads.
+    afterwards (a missing buffer makes trimesh fail, and the resolver names it). Names are
+    looked up as other importers do: also URL-decoded (glTF URIs escape spaces as %20), with
+    `\\` as a separator (files written on Windows), and at last with any case, in the named
+    subfolder or the mesh's own folder. Names that lead out of the folder are refused. .mtl
+    files are handed over as UTF-8 like the OBJ itself. Only regular files within the size
+    cap are read (`read_regular`): a FIFO, a device or a socket is refused and remembered,
+    never opened for blocking reads.
     """
 
     def __init__(self, source: Path):
@@ -88,7 +89,8 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         return as_utf8(data, "MTL") if name.lower().endswith(".mtl") else data
 
     def problem(self) -> str | None:
-        """A message for the first unusable reference, or None (a missing .mtl is a warning)."""
+        """Why a parse that failed failed: the first unusable reference other than a missing
+        .mtl, or None (a parse that succeeded did without them: see `warnings`)."""
         if self.refused:
             name, reason = self.refused[0]
             return f"references '{name}', which {reason.removeprefix('is ')}"
@@ -103,9 +105,20 @@ class _RecordingResolver(trimesh.resolvers.FilePathResolver):
         return None
 
     def warnings(self) -> list[str]:
-        """One line per missing .mtl file (the mesh renders with the default material)."""
-        return [f"material library '{m}' not found (looked in {self.parent}); using the "
-                "default material" for m in dict.fromkeys(self.missing) if _is_mtl(m)]
+        """One line per reference a parse that succeeded did without: a .mtl (the mesh renders
+        with the default material) or a texture (drawn with its material's colour)."""
+        why = {name: f"not found (looked in {self.parent})" for name in self.missing}
+        why.update((name, "is outside the mesh's folder and is not read (copy it next to the "
+                    "mesh)") for name in self.outside)
+        why.update((name, reason) for name, reason in self.refused)
+        return [f"material library '{name}' {reason}; using the default material"
+                if _is_mtl(name) else
+                f"texture '{name}' {reason}; drawn with the material colour instead"
+                for name, reason in why.items()]
+
+    def unread(self) -> set[str]:
+        """The names of the references that were not read."""
+        return {*self.missing, *self.outside, *(name for name, _ in self.refused)}
 
 
 def _is_mtl(name: str) -> bool:
@@ -146,7 +159,8 @@ def parse_file(data: bytes | PlainObj | BinaryStl, file_type: str, path: Path,
 
     `data` is the file's bytes, or the arrays of a plain OBJ (:mod:`.plain_obj`) or a binary
     STL (:mod:`.stl`), which trimesh turns into its scene as it would the file's. Problems
-    that still leave a usable mesh (a missing .mtl) are appended to `warnings_out`.
+    that still leave a usable mesh (a .mtl or a texture that is missing, outside the mesh's
+    folder or not a regular file) are appended to `warnings_out`, one line per file.
     """
     resolver = _RecordingResolver(path)
     begin_warnings()  # a new load: notes a failed one may have left are forgotten
@@ -166,11 +180,13 @@ def parse_file(data: bytes | PlainObj | BinaryStl, file_type: str, path: Path,
                       "structure recurses without end); is it corrupt?") from None
     except Exception as exc:  # noqa: BLE001 - any parser failure is a bad file
         raise BadFile(resolver.problem() or _parse_failure(file_type, exc)) from None
-    problem = resolver.problem() or _data_lost(logged.messages)
+    problem = _data_lost(logged.messages)
     if problem:
         raise BadFile(problem)
-    for name in dict.fromkeys(logged.failed_images):
-        note_texture_problem(name, "could not be opened (corrupt, truncated or too large)")
+    unread = resolver.unread()  # already explained by the resolver's warnings
+    for name in dict.fromkeys(n for n in logged.failed_images if n not in unread):
+        note_texture_problem(os.path.basename(name.replace("\\", "/")),
+                             "could not be opened (corrupt, truncated or too large)")
     if warnings_out is not None:
         warnings_out.extend(resolver.warnings())
     return scene if isinstance(scene, trimesh.Scene) else trimesh.Scene(scene)
@@ -193,7 +209,7 @@ class _Collect(logging.Handler):
         message = record.getMessage()
         if message.lower().startswith(IMAGE_FAILURES):
             name = getattr(self.resolver, "last_name", None) or "an embedded image"
-            self.failed_images.append(os.path.basename(name.replace("\\", "/")))
+            self.failed_images.append(name)
         elif record.levelno >= logging.WARNING:
             self.messages.append(message)
 

@@ -1,4 +1,4 @@
-"""Plain OBJ files read with numpy: the common large case, in a few times the file's size.
+"""Plain OBJ files read with numpy: the common large case, in about twice the file's size.
 
 trimesh's OBJ reader and the record-by-record checks of :mod:`.obj` hold Python strings and
 match objects per line, 7 to 25 times the file in memory. A *plain* file (ASCII, every line
@@ -7,6 +7,10 @@ or all ``v//vn`` with positive indices in range) is read here into exactly the a
 trimesh's reader builds from it, and `PlainObj.scene_kwargs` hands them to trimesh in its own
 keyword form. Anything else (materials, groups, UVs, polygons, relative or bad indices,
 odd numbers) returns None and takes the general way, with its checks and messages.
+
+The file is parsed a chunk of lines at a time (`CHUNK_BYTES`) into arrays sized by a first
+counting pass, so what the parse needs beyond the file's bytes and the arrays it returns
+is a few times one chunk, not a few copies of the file.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from trimesh.visual.texture import unmerge_faces
 
 _NEWLINE, _SPACE, _SLASH = ord("\n"), ord(" "), ord("/")
 _OTHER, _SKIPPED, _V, _VN, _F = range(5)  # line kinds
+_BLOCK = 1 << 16  # face rows renumbered at a time
 
 
 def _byte_set(chars: bytes) -> np.ndarray:
@@ -51,43 +56,121 @@ class PlainObj:
         mesh = {"file_type": "obj", "process": False}
         if faces_norm is not None:
             faces, mask_v, mask_vn = unmerge_faces(faces, faces_norm, maintain_faces=False)
-            mesh.update(faces=faces, vertices=v[mask_v].copy(), vertex_normals=vn[mask_vn])
+            mesh.update(faces=faces, vertices=v[mask_v], vertex_normals=vn[mask_vn])
         else:
-            used = np.zeros(len(v), dtype=bool)
-            used[faces] = True
-            inverse = np.zeros(len(v), dtype=np.int64)
-            inverse[used] = np.arange(used.sum())
-            mesh.update(faces=inverse[faces], vertices=v[used].copy())
+            mesh.update(faces=faces, vertices=_only_used(v, faces))
         mesh["visual"] = None
         return {"process": False, "geometry": {name: mesh},
                 "graph": [{"geometry": name, "frame_to": name}]}
 
 
+#: Bytes of the file classified and parsed at a time: the temporaries of one chunk (line
+#: offsets, copies of its records, token offsets, parsed numbers) are a few times this, not
+#: a few times the file.
+CHUNK_BYTES = 1 << 20
+
+
+def _only_used(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """The vertices some face uses, in order, with `faces` renumbered to them in place (as
+    trimesh's reader drops unused ones); no copy when every vertex is used (the usual case)."""
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces] = True
+    if used.all():
+        return vertices
+    inverse = np.cumsum(used) - 1
+    for start in range(0, len(faces), _BLOCK):  # no second (F, 3) array
+        faces[start:start + _BLOCK] = inverse[faces[start:start + _BLOCK]]
+    return vertices[used]
+
+
 def read_plain_obj(data: bytes) -> PlainObj | None:
-    """The arrays of a plain OBJ file (see the module docstring), or None for any other."""
+    """The arrays of a plain OBJ file (see the module docstring), or None for any other.
+
+    The file is read chunk by chunk twice: once to count its records, which sizes the
+    arrays, then to parse each chunk's records into them; so it peaks near the file's size
+    plus the arrays it returns.
+    """
     if not data.isascii() or any(b in data for b in (b"\r", b"\t", b"\\", b"\0", b"+e", b"-e")):
         return None
     text = np.frombuffer(data, np.uint8)
+    chunks = _chunks(data)
+    counts = np.zeros(5, np.int64)  # lines of each kind
+    for a, b in chunks:
+        counts += np.bincount(_line_kinds(*_lines(text[a:b])), minlength=5)
+    if counts[_OTHER] or not counts[_F]:
+        return None
+    out = PlainObj(np.empty((counts[_V], 3)),
+                   np.empty((counts[_VN], 3)) if counts[_VN] else None,
+                   np.empty((counts[_F], 3), np.int64), None)
+    done = np.zeros(5, np.int64)  # lines of each kind parsed so far
+    for a, b in chunks:
+        if not _parse_chunk(text[a:b], out, done):
+            return None
+    if not _in_range(out.faces, len(out.vertices)):
+        return None
+    if out.face_normals is not None and (out.normals is None or not _in_range(
+            out.face_normals, len(out.normals))):
+        return None
+    out.faces -= 1
+    if out.face_normals is not None:
+        out.face_normals -= 1
+    return out
+
+
+def _chunks(data: bytes) -> list[tuple[int, int]]:
+    """[start, end) byte ranges of about `CHUNK_BYTES` that each end after a newline (the
+    last one at the end of the file)."""
+    chunks, start = [], 0
+    while start < len(data):
+        if start + CHUNK_BYTES >= len(data):
+            end = len(data)
+        else:  # after the chunk's last newline, or the next one for a line longer than it
+            end = (data.rfind(b"\n", start, start + CHUNK_BYTES) + 1
+                   or data.find(b"\n", start + CHUNK_BYTES) + 1 or len(data))
+        chunks.append((start, end))
+        start = end
+    return chunks
+
+
+def _lines(text: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The chunk, where its lines start and where they end (at their newline or its end)."""
     ends = np.flatnonzero(text == _NEWLINE)
-    if not data.endswith(b"\n"):
+    if len(text) and text[-1] != _NEWLINE:
         ends = np.append(ends, len(text))
-    starts = np.concatenate([[0], ends[:-1] + 1])
+    return text, np.concatenate([[0], ends[:-1] + 1]), ends
+
+
+def _parse_chunk(text: np.ndarray, out: PlainObj, done: np.ndarray) -> bool:
+    """Parse one chunk's v, vn and f lines into `out` after the `done` ones (updated);
+    False when a record is not plain."""
+    text, starts, ends = _lines(text)
     kinds = _line_kinds(text, starts, ends)
-    if (kinds == _OTHER).any() or not (kinds == _F).any():
-        return None
-    vertices = _numbers(text, starts, kinds == _V, 1)
-    normals = _numbers(text, starts, kinds == _VN, 2) if (kinds == _VN).any() else None
-    corners = _corners(text, starts, kinds == _F)
-    if vertices is None or corners is None or ((kinds == _VN).any() and normals is None):
-        return None
+    for kind, target in ((_V, out.vertices), (_VN, out.normals)):
+        chosen = kinds == kind
+        if chosen.any():
+            values = _numbers(text, starts, chosen, 1 if kind == _V else 2)
+            if values is None:
+                return False
+            target[done[kind]:done[kind] + len(values)] = values
+            done[kind] += len(values)
+    chosen = kinds == _F
+    if not chosen.any():
+        return True
+    corners = _corners(text, starts, chosen)
+    if corners is None:
+        return False
     faces, face_normals = corners
-    if not _in_range(faces, len(vertices)):
-        return None
-    if face_normals is not None and (normals is None or not _in_range(face_normals,
-                                                                      len(normals))):
-        return None
-    return PlainObj(vertices, normals, faces - 1, None if face_normals is None
-                    else face_normals - 1)
+    first = done[_F] == 0
+    if first and face_normals is not None:
+        out.face_normals = np.empty_like(out.faces)
+    if (face_normals is None) != (out.face_normals is None):  # 'v' and 'v//vn' faces mixed
+        return False
+    rows = slice(done[_F], done[_F] + len(faces))
+    out.faces[rows] = faces
+    if face_normals is not None:
+        out.face_normals[rows] = face_normals
+    done[_F] += len(faces)
+    return True
 
 
 def _line_kinds(text: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:

@@ -49,7 +49,13 @@ def _vertex_count(tree: dict, primitive: dict) -> int | None:
 
 
 def _material_transform(material) -> np.ndarray | None:
-    """The base-colour texture's transform in our UV convention (v up), or None."""
+    """The base-colour texture's transform in our UV convention (v up), or None.
+
+    The rotation matrix is [[cos, sin], [-sin, cos]] on glTF's UVs (v down), as three.js,
+    Babylon.js and Blender apply it and as Khronos' TextureTransformTest sample expects; the
+    GLSL listing of the extension's specification has the opposite sign, which turns the
+    texture the wrong way in glTF's UV space (KhronosGroup/glTF#1563).
+    """
     try:
         info = material["pbrMetallicRoughness"]["baseColorTexture"]["extensions"][EXTENSION]
         offset = np.asarray(info.get("offset", (0.0, 0.0)), dtype=np.float64).reshape(2)
@@ -61,6 +67,6 @@ def _material_transform(material) -> np.ndarray | None:
         raise BadFile(f"its {EXTENSION} has NaN or Inf values")
     c, s = np.cos(rotation), np.sin(rotation)
     gltf = (np.array([[1, 0, offset[0]], [0, 1, offset[1]], [0, 0, 1]])
-            @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-            @ np.diag([scale[0], scale[1], 1.0]))  # translation * rotation * scale, as specified
+            @ np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
+            @ np.diag([scale[0], scale[1], 1.0]))  # translation * rotation * scale
     return _FLIP_V @ gltf @ _FLIP_V
