@@ -16,7 +16,8 @@ def _is_depth_object(rep) -> bool:
 
 def _hull_of(rep, mesh):
     """The visual hull of the compared depth object's own images (same bake)."""
-    return rep if rep.hull else VisualHull.of(rep.images, rep.params | {"derived": "hull"})
+    return rep if rep.hull else VisualHull.of(rep.images, rep.params | {"derived": "hull"},
+                                              rep.source_bounds)
 
 
 def _compare_variants() -> tuple[CompareVariant, ...]:

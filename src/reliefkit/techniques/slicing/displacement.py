@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import UsageError
+from ...scene.views import source_box
 
 MAX_TEXELS = 8192 * 8192
 MAX_TILE = 4096.0
@@ -45,6 +46,8 @@ class DisplacementMap:
     tile : (U, V) repeats of the texture over the uvs (> 0).
     wrap : the texture repeats (periodic lookups across its border) instead of clamping.
     params : bake provenance (never anything that changes rendering).
+    source_bounds : the box of the mesh it was baked from (None for a heightmap): views
+        frame the map by it, as they frame its mesh.
     """
 
     base: object
@@ -54,6 +57,7 @@ class DisplacementMap:
     tile: tuple = (1.0, 1.0)
     wrap: bool = False
     params: dict = field(default_factory=dict)
+    source_bounds: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         base = self.base
@@ -89,6 +93,7 @@ class DisplacementMap:
             raise UsageError(f"tile must be two numbers in (0, {MAX_TILE:g}], got {self.tile!r}")
         self.tile = tile
         self.wrap = bool(self.wrap)
+        self.source_bounds = source_box(self.source_bounds)
         n = np.asarray(base.normals, np.float64)
         if (np.linalg.norm(n, axis=1) < 1e-6).any():
             raise UsageError("the base mesh has zero-length vertex normals")

@@ -177,7 +177,8 @@ def bake_displacement(source, p: DisplacementParams, progress=None) -> Displacem
     scale = _scale(p, DEFAULT_MESH_SCALE * _diagonal(source.bounds))
     base = _usable(source)
     return DisplacementMap(base, color, height, scale, tile, wrap,
-                           params={"source": source.name, "texture": p.displacement})
+                           params={"source": source.name, "texture": p.displacement},
+                           source_bounds=source.bounds)
 
 
 def _usable(mesh):
@@ -237,4 +238,5 @@ def _projected(mesh, p: DisplacementParams, tile) -> DisplacementMap:
     scale = p.displacement_scale if p.displacement_scale is not None else float(extent[2])
     # a given scale stretches the projected heights; heights stay the box fractions
     return DisplacementMap(base, color, height, scale, (1.0, 1.0), False,
-                           params={"source": mesh.name, "texture": "projection"})
+                           params={"source": mesh.name, "texture": "projection"},
+                           source_bounds=mesh.bounds)
