@@ -72,8 +72,9 @@ def test_the_hull_fills_the_cup_seen_from_above(baked, tmp_path):
 
 @pytest.mark.parametrize("options, words", [
     (("--slicing", "raycast", "--passes", "stencil"), ("ray casting has no slices",)),
-    (("--alpha-test", "slab", "--passes", "stencil"), ("stencil passes test one image",)),
-    (("--slicing", "raycast", "--slices", "8"), ("--slices does not apply",)),
+    (("--slicing", "orthogonal", "--alpha-test", "slab", "--passes", "stencil"),
+     ("stencil passes test one image",)),
+    (("--slices", "8"), ("--slices set the slices", "ray casting (the default)")),
     (("--slicing", "sideways"), ("sideways",)),
     (("--slices", "0"), ("slices",)),
 ])
@@ -120,7 +121,7 @@ def test_framed_views_draw_the_whole_object(flat_van, tmp_path, view):
     pixel for pixel."""
     masks = {}
     for name, options in (("ray", ("--slicing", "raycast")),
-                          ("slab", ("--alpha-test", "slab", "--slices", "24"))):
+                          ("slab", ("--slicing", "orthogonal", "--slices", "24"))):
         out = run_cli("render", flat_van, "--size", "48x48", "--view", view, *options,
                       "-o", tmp_path / f"{name}.png", "--aovs", tmp_path / f"{name}.npz")
         assert out.returncode == 0, out.stderr
