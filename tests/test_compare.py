@@ -7,7 +7,7 @@ from slicing_scenes import cup_mesh
 
 from reliefkit import metrics
 from reliefkit.bake import bake
-from reliefkit.compare import comparison_tiles, compare
+from reliefkit.compare import compare, comparison_tiles
 from reliefkit.scene.views import framing_bounds, orbit_bounds
 
 

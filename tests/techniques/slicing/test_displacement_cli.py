@@ -164,7 +164,7 @@ def test_a_projected_mesh_covers_what_the_mesh_covers_from_above(gl, baked):
 
 def test_an_rgba_displacement_texture_keeps_its_colours_and_alpha_heights(tmp_path):
     """The paper's displacement texture: colour in RGB, displacement in alpha. Left half
-    alpha 0 (no displacement: masked out by orthogonal slicing), right half alpha 1 in red."""
+    alpha 0 (no displacement: the blue base itself), right half alpha 1 in red."""
     from PIL import Image
 
     rgba = np.zeros((16, 16, 4), np.uint8)
@@ -184,12 +184,16 @@ def test_an_rgba_displacement_texture_keeps_its_colours_and_alpha_heights(tmp_pa
     assert out.returncode == 0, out.stderr
     aovs = np.load(tmp_path / "t.npz")
     mask, pos, color = aovs["mask"], aovs["position"], aovs["color"]
-    assert mask.sum() > 200
-    assert (pos[mask][:, 0] > -0.15).all()  # nothing left of the middle (u < 0.5)
+    right = mask & (pos[..., 0] > 0.15)
+    left = mask & (pos[..., 0] < -0.15)
+    assert right.sum() > 200 and left.sum() > 200
     # the top (the highest slice, h = 15.5 / 16), bar the bilinear ramp at the step
-    assert (np.abs(pos[mask][:, 1] - 0.2) < 0.02).mean() > 0.85
+    assert (np.abs(pos[right][:, 1] - 0.2) < 0.02).mean() > 0.85
     assert pos[mask][:, 1].max() <= 0.2 + 1e-4
-    assert (np.abs(color[mask][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.85
+    assert (np.abs(color[right][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.85
+    # left of the step (u < 0.5), the base at height 0 in the texture's blue
+    np.testing.assert_allclose(pos[left][:, 1], 0.0, atol=1e-5)
+    assert (np.abs(color[left][:, :3] - (0, 0, 1)).max(axis=1) < 0.02).mean() > 0.85
 
 
 def test_a_bad_rgba_npy_texture_is_a_one_line_error(tmp_path):

@@ -8,9 +8,10 @@ The displacement texture is ``color`` (H, W, 4) float32 linear straight alpha an
 texture coordinates s = (i + 0.5) / W, t = (j + 0.5) / H, bilinear between texel centres,
 clamped at the border (or wrapped, ``wrap``, for periodic textures that tile). A base vertex
 with uv (u, v) reads the texture at (s, t) = (u * tile[0], v * tile[1]). Height 0 is no
-displacement; height 1 moves the base point by ``scale`` (world units) along the normal
-interpolated from the vertex normals (not renormalised, so the volume is exactly the union
-of the prisms below).
+displacement: the base itself is the surface there, unless the colour's alpha (bilinear)
+is below 0.5, where there is nothing (a projected mesh's background); height 1 moves the
+base point by ``scale`` (world units) along the normal interpolated from the vertex normals
+(not renormalised, so the volume is exactly the union of the prisms below).
 
 The displacement volume (§3.1, Fig. 3) extrudes every base triangle (p0, p1, p2) along its
 vertex normals into a prism with top p_i + scale * n_i; each prism is split into three

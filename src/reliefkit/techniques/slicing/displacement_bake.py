@@ -232,7 +232,7 @@ def _projected(mesh, p: DisplacementParams, tile) -> DisplacementMap:
 
     (color_rgb,) = dilate(proj.mask, color[..., :3])
     color[..., :3] = color_rgb
-    color[..., 3] = 1.0
+    color[..., 3] = proj.mask  # nothing where the mesh is not: an empty base (displacement.py)
     height = np.clip(proj.height, 0, 1).astype(np.float32)
     base = box_base(box, f"{mesh.name} (projected)")
     scale = p.displacement_scale if p.displacement_scale is not None else float(extent[2])

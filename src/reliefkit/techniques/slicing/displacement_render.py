@@ -122,11 +122,10 @@ class DisplacementDrawable(GLObjects):
                     raise
                 count = max(AUTO_MIN, count // 2)  # automatic: halve until the slices fit
         h, w = rep.height.shape
-        surface = opts.slicing == "surface"
-        test = (0 if opts.alpha_test == "fill" else 1) if surface else 2
+        test = opts.alpha_test if opts.slicing == "surface" else "fill"
         bound = 1.0 / (count - 1) if count > 1 else 1.0
         self.stats = {"slices": int(count), "slicing": opts.slicing,
-                      "alpha_test": opts.alpha_test if surface else "subtract",
+                      "alpha_test": test,
                       "slice_planes": int(tris.slices), "slice_polygons": int(tris.polygons),
                       "slice_triangles": int(tris.triangle_count),
                       "slice_spacing": float(tris.spacing),
@@ -144,7 +143,8 @@ class DisplacementDrawable(GLObjects):
                              | model_offset(camera, self.origin) | light.uniforms()
                              | {"u_height": _HEIGHT_UNIT, "u_color": _COLOR_UNIT,
                                 "u_hf_size": (w, h), "u_wrap": rep.wrap,
-                                "u_tile": tuple(rep.tile), "u_test": test,
+                                "u_tile": tuple(rep.tile),
+                                "u_test": ALPHA_TESTS.index(test),
                                 "u_bound": float(bound)})
                 self.height.use(_HEIGHT_UNIT)
                 self.color.use(_COLOR_UNIT)

@@ -3,8 +3,7 @@ linear + height (H, W) float32 in [0, 1]; and the terrain palette of heightmap i
 
 * ``fur``: tufts of hair on a jittered grid over a thin skin (height 0.12), each a cone of
   random height 0.55..1 (Fig. 1's furry donut).
-* ``bumps``: smooth round bumps on a jittered grid, zero between them (masked out by
-  orthogonal and screen slicing, §3.2).
+* ``bumps``: smooth round bumps on a jittered grid, zero between them (the base shows).
 * ``waves``: two crossing sine waves, heights 0.1..1.
 """
 
