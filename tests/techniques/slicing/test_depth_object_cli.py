@@ -128,3 +128,21 @@ def test_framed_views_draw_the_whole_object(flat_van, tmp_path, view):
         masks[name] = np.load(tmp_path / f"{name}.npz")["mask"]
     assert masks["ray"].sum() > 100
     assert (masks["ray"] != masks["slab"]).sum() <= 2
+
+
+def test_images_too_large_to_hold_are_refused_with_their_estimate(tmp_path):
+    """--res 8192 needs 12.4 GiB of images: refused before anything is allocated, so even a
+    process limited to 3 GiB of address space gets the estimate, not a MemoryError."""
+    import subprocess
+    import sys
+
+    resource = pytest.importorskip("resource")
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+
+    out = subprocess.run([sys.executable, "-m", "reliefkit.cli", "bake", "demo:cup", "--as",
+                          "depth-object", "--res", "8192", "-o", str(tmp_path / "x.rk")],
+                         capture_output=True, text=True, timeout=300, preexec_fn=limit)
+    assert_one_line_error(out, "res 8192", "12.4 GiB", "at most 4657", code=2)
+    assert not (tmp_path / "x.rk").exists()
