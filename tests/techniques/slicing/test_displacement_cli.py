@@ -202,3 +202,22 @@ def test_a_bad_rgba_npy_texture_is_a_one_line_error(tmp_path):
                   tmp_path / "bad.npy", "-o", tmp_path / "x.rk")
     assert_one_line_error(out, "(H, W, 4)")
     assert not (tmp_path / "x.rk").exists()
+
+
+@pytest.mark.parametrize("kind", ["fifo", "truncated"])
+def test_an_unreadable_displacement_file_is_a_one_line_error(tmp_path, kind):
+    """A FIFO is refused before it is opened (reading it would block); an .npy texture whose
+    body is shorter than its header says is a format error, not an internal one."""
+    import os
+
+    if kind == "fifo":
+        path = tmp_path / "pipe.png"
+        os.mkfifo(path)
+    else:
+        path = tmp_path / "short.npy"
+        np.save(path, np.full((16, 16, 4), 0.5, np.float32))
+        path.write_bytes(path.read_bytes()[:600])
+    out = run_cli("bake", "demo:plane", "--as", "displacement", "--displacement", path,
+                  "-o", tmp_path / "x.rk")
+    assert_one_line_error(out, str(path), "not a file" if kind == "fifo" else "not a readable")
+    assert not (tmp_path / "x.rk").exists()

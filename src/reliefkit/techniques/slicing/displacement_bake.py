@@ -96,11 +96,12 @@ def _file_texture(spec: str):
     """(colour, height) of a file: the paper's displacement texture (an RGBA .png, or an
     (H, W, 4) .npy of linear floats, with the displacement in alpha) or a grey heightmap
     (.png or a 2D .npy; colours from the terrain palette)."""
-    from ...scene.heightmap import is_heightmap, load_heightmap
+    from ...scene.heightmap import check_file, is_heightmap, load_heightmap
 
     if not is_heightmap(spec):
         raise UsageError(f"--displacement {spec}: not one of {', '.join(TEXTURES)}, nor a "
                          "heightmap or displacement texture (.png or .npy)")
+    check_file(spec)  # a FIFO would block the read
     rgba = _rgba_texture(spec)
     if rgba is not None:
         return rgba
@@ -142,7 +143,10 @@ def _rgba_texture(spec: str):
         if shape[2] != 4 or dtype.kind != "f" or max(shape[:2]) > 8192:
             raise FormatError(f"{path}: a displacement texture .npy must be (H, W, 4) float "
                               f"RGBA (at most 8192 per side), got {shape} {dtype}")
-        rgba = np.load(path, allow_pickle=False).astype(np.float64)
+        try:
+            rgba = np.load(path, allow_pickle=False).astype(np.float64)
+        except (OSError, ValueError) as exc:  # a body shorter than its header says
+            raise FormatError(f"{path}: not a readable .npy array ({exc})") from None
         if not np.isfinite(rgba).all():
             raise FormatError(f"{path}: the texture contains NaN or Inf values")
         color = np.clip(rgba[..., :3], 0.0, 1.0)
