@@ -13,7 +13,7 @@ import numpy as np
 
 from ...errors import FormatError, UsageError
 from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
-from .depth_images import MAX_RESOLUTION, DepthImages, face_boxes
+from .depth_images import MAX_RESOLUTION, DepthImages, check_side, face_boxes
 from .representation import DepthObject, VisualHull
 
 ARRAYS = {
@@ -40,6 +40,10 @@ def _check_cube(cube: np.ndarray) -> None:
     expected[:3, 3] = cube[:3, 3]
     if not (side > 0 and np.array_equal(cube, expected)):
         raise FormatError("cube_to_world must be a positive uniform scale and a translation")
+    try:
+        check_side(float(side))
+    except UsageError as exc:
+        raise FormatError(str(exc)) from None
 
 
 def _decoder(cls):

@@ -36,6 +36,9 @@ MARGIN = 0.02
 #: Indices of the faces in `CUBE_FACES` order (outward normal +x, -x, +y, -y, +z, -z).
 FACE_INDEX = {face: k for k, face in enumerate(CUBE_FACES)}
 MAX_RESOLUTION = 8192
+#: The smallest cube side: the GPU draws in float32, whose normal numbers end near 1e-38, so
+#: a smaller cube's texels (side / N) and inverse boxes are no longer numbers it can hold.
+MIN_SIDE = 1e-30
 #: Bytes per texel of the six images: depth float32, mask, colour RGBA float32, normal.
 TEXEL_BYTES = 4 + 1 + 16 + 12
 
@@ -122,6 +125,16 @@ class DepthImages:
         return bounds
 
 
+def check_side(side: float) -> None:
+    """Refuse a cube side outside [`MIN_SIDE`, `MAX_COORDINATE`] (no float32 draw, and no
+    float64 inverse, holds it)."""
+    from ...core.transforms import MAX_COORDINATE
+
+    if not (np.isfinite(side) and MIN_SIDE <= side <= MAX_COORDINATE):
+        raise UsageError(f"the depth images' cube side must be within [{MIN_SIDE:g}, "
+                         f"{MAX_COORDINATE:g}] world units, got {side:g}; scale the mesh")
+
+
 def cube_of(mesh, margin: float = MARGIN) -> np.ndarray:
     """cube_to_world of the mesh's bounding cube (largest side, grown by ``margin``)."""
     bounds = np.asarray(mesh.bounds, dtype=np.float64)
@@ -130,6 +143,7 @@ def cube_of(mesh, margin: float = MARGIN) -> np.ndarray:
         raise UsageError(f"mesh '{mesh.name}' has no extent (a point?); depth images need a "
                          "mesh with a non-zero bounding box")
     side = extent * (1.0 + 2.0 * margin)
+    check_side(side)
     centre = bounds.mean(axis=0)
     cube = np.eye(4) * side
     cube[3, 3] = 1.0
