@@ -187,3 +187,18 @@ def test_automatic_slices_halve_to_fit_the_polygon_budget(gl, rep, monkeypatch):
     assert fitted.stats["slices"] == 4
     with pytest.raises(UsageError, match="slice polygons"):
         render(rep, cam, slicing="screen", slices=8)
+
+
+@pytest.mark.parametrize("mode", ["orthogonal", "screen"])
+def test_a_displacement_thinner_than_a_pixel_is_its_base(gl, mode):
+    """Fur 1e-9 thick draws exactly the base mesh's pixels (skin and all, no holes between
+    the tufts), with no more slice polygons than a visible displacement needs: automatic
+    slices are never closer than a pixel, so their count does not grow as 1 / scale."""
+    from reliefkit.techniques.slicing.displacement_demo import furry_donut
+
+    thin, thick = furry_donut(res=32, scale=1e-9), furry_donut(res=32, scale=0.08)
+    cam = orbit_bounds(thin.base.bounds, 30.0, 35.0, 2.4, size=(96, 96))
+    frame = render(thin, cam, slicing=mode)
+    np.testing.assert_array_equal(frame.mask, render(thin.base, cam).mask)
+    assert frame.stats["slice_polygons"] <= render(thick, cam, slicing=mode).stats[
+        "slice_polygons"]

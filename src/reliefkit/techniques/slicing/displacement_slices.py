@@ -228,11 +228,12 @@ def _uv_gradients(rep) -> np.ndarray:
     return out
 
 
-def orthogonal_levels(rep, count: int, volume=None) -> tuple[np.ndarray, np.ndarray,
-                                                             np.ndarray]:
-    """The shared levels of the three directions: (h levels, u levels, v levels)."""
+def orthogonal_levels(rep, count: int, min_spacing: float = 0.0) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray]:
+    """The shared levels of the three directions: (h levels, u levels, v levels); the u and
+    v slices are scale / count apart, or ``min_spacing`` where that is wider."""
     h_levels = (np.arange(count) + 0.5) / count
-    spacing = rep.scale / count
+    spacing = max(rep.scale / count, min_spacing)
     grads = np.linalg.norm(_uv_gradients(rep), axis=2)   # (F, 2) uv units per world unit
     uv = np.asarray(rep.base.uvs, np.float64)
     out = [h_levels]
@@ -277,9 +278,12 @@ def _view_per_point(camera, points) -> np.ndarray:
     return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
 
 
-def slice_triangles(rep, camera, mode: str, count: int, volume=None) -> SliceTriangles:
+def slice_triangles(rep, camera, mode: str, count: int, volume=None,
+                    min_spacing: float = 0.0) -> SliceTriangles:
     """The slice polygons of ``rep`` for ``camera`` in slicing ``mode`` with ``count`` h
-    slices (see the module docstring)."""
+    slices (see the module docstring). Orthogonal u and v slices and screen planes, spaced
+    scale / count, are spaced ``min_spacing`` apart where that is wider: a volume thinner
+    than a pixel needs no planes closer than one (their count would grow as 1 / scale)."""
     if mode not in MODES:
         raise UsageError(f"slicing must be one of {', '.join(MODES)}, got {mode!r}")
     if isinstance(count, bool) or int(count) != count or count < 1:
@@ -294,7 +298,7 @@ def slice_triangles(rep, camera, mode: str, count: int, volume=None) -> SliceTri
     vol = volume if volume is not None else rep.volume()
     if mode == "orthogonal":
         choice = orthogonal_choice(rep, camera)
-        levels = orthogonal_levels(rep, count)
+        levels = orthogonal_levels(rep, count, min_spacing)
         parts, directions = [_offset_surface(rep, 0.0)], {}
         for k, name, axis in ((0, "a", 2), (1, "b", 0), (2, "c", 1)):
             tets = np.flatnonzero(choice[vol.prism_of] == k)
@@ -306,7 +310,7 @@ def slice_triangles(rep, camera, mode: str, count: int, volume=None) -> SliceTri
                                         sum(c[3] for c in parts)))
         return _joined(parts, rep.scale / count, "orthogonal", directions, parts[0][3])
     # screen
-    spacing = rep.scale / count
+    spacing = max(rep.scale / count, min_spacing)
     centre = 0.5 * (vol.positions.min(axis=0) + vol.positions.max(axis=0))
     f = view_direction(camera, centre)
     depth = vol.positions @ f
