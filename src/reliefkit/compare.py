@@ -27,7 +27,9 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
 
     Returns ``{"metrics": {variant: row}, "frames": {"mesh": Frame, variant: Frame},
     "errors": {variant: mask or None}, "columns": table columns, "bytes": {"mesh": n,
-    "representation": n}}`` (bytes as the .rk files store them, uncompressed).
+    "representation": n}, "default": variant}`` (bytes as the .rk files store them,
+    uncompressed; ``default`` is the variant that draws the representation as a plain
+    render does, see `default_variant`).
     """
     from . import metrics
     from .core.technique import technique_of
@@ -43,9 +45,11 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     advance = progress or (lambda done, total: None)
     truth = render(mesh, camera, light=light)
     advance(1, len(variants) + 1)
-    rows, frames, errors = {}, {"mesh": truth}, {}
+    rows, frames, errors, itself = {}, {"mesh": truth}, {}, []
     for k, variant in enumerate(variants):
         drawn = variant.derive(representation, mesh) if variant.derive else representation
+        if drawn is representation:
+            itself.append(variant)
         plain = render(drawn, camera, light=light, **variant.options)
         counted = render(drawn, camera, light=light, count_iterations=True, **variant.options)
         scores = metrics.compare(plain, truth, scene_size=mesh.radius)
@@ -68,20 +72,41 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     sizes = {"mesh": sum(array_bytes(mesh).values()),
              "representation": sum(array_bytes(representation).values())}
     return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns,
-            "bytes": sizes}
+            "bytes": sizes, "default": default_variant(representation, itself or variants)}
+
+
+def default_variant(representation, variants) -> str:
+    """The name of the first of ``variants`` whose options are the representation's render
+    defaults (what the bake produced, drawn as `reliefkit render` draws it), else the first
+    one's: the coverage tile shows it, not whichever variant happens to come last."""
+    from .render import render_options
+
+    defaults = {opt.name: opt.default for opt in render_options(representation)}
+    for variant in variants:
+        if all(defaults.get(name) == value for name, value in variant.options.items()):
+            return variant.name
+    return variants[0].name
 
 
 def comparison_sheet(result: dict, title: str):
-    """mesh and every variant on top; below, coverage against the mesh (green both, red
-    representation only, blue mesh only) and per variant the colour error, its technique's
-    error mask (wrong hits, ...) in red."""
-    from . import metrics
+    """`comparison_tiles` on a contact sheet, one row per kind of tile."""
     from .pictures import contact_sheet
+
+    return contact_sheet(comparison_tiles(result), columns=len(result["frames"]),
+                         title=title)
+
+
+def comparison_tiles(result: dict) -> list[tuple[str, np.ndarray]]:
+    """(caption, RGBA) tiles: mesh and every variant; then the default variant's coverage
+    against the mesh (green both, red representation only, blue mesh only), named, and per
+    variant the colour error, its technique's error mask (wrong hits, ...) in red."""
+    from . import metrics
 
     frames, truth = result["frames"], result["frames"]["mesh"]
     tiles = [(name, frame.rgba8(TILE_BACKGROUND)) for name, frame in frames.items()]
-    last = frames[list(result["errors"])[-1]]
-    tiles.append(("coverage vs mesh", _rgba(metrics.error_image(last, truth, "mask"))))
+    default = result["default"]
+    tiles.append((f"coverage vs mesh: {default}",
+                  _rgba(metrics.error_image(frames[default], truth, "mask"))))
     for name, mask in result["errors"].items():
         err = metrics.error_image(frames[name], truth, "color", scale=0.25)
         caption = f"{name}: error"
@@ -89,7 +114,7 @@ def comparison_sheet(result: dict, title: str):
             err[mask] = (1.0, 0.1, 0.1)
             caption += ", wrong in red"
         tiles.append((caption, _rgba(err)))
-    return contact_sheet(tiles, columns=len(frames), title=title)
+    return tiles
 
 
 def _rgba(rgb: np.ndarray) -> np.ndarray:

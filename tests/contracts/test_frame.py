@@ -41,7 +41,8 @@ def check_frame(frame, camera) -> None:
     assert not has_point[~frame.mask].any(), "a position where nothing was drawn"
     assert (frame.depth >= 0).all() and (frame.depth <= 1).all()
     assert (frame.depth[~frame.mask] == 1).all()
-    lengths = np.linalg.norm(frame.normal[has_point], axis=-1)
+    # in float64: a float32 component near 1e-23 underflows when squared
+    lengths = np.linalg.norm(frame.normal[has_point].astype(np.float64), axis=-1)
     np.testing.assert_allclose(lengths, 1.0, atol=1e-3)
     expected = window_depth(frame.position, frame.view, frame.proj, frame.depth)
     np.testing.assert_allclose(frame.depth[has_point], expected[has_point], atol=2e-4)

@@ -96,6 +96,11 @@ class ArraySpec:
     trailing: tuple[int | None, ...] | None = None
 
 
+#: The optional array of a baked representation that keeps its source mesh's bounds, so
+#: views frame it as they frame the mesh (`scene.views.framing_bounds`).
+SOURCE_BOUNDS = ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False, finite=True)
+
+
 @dataclass(frozen=True)
 class Codec:
     """How one representation class maps to arrays and JSON parameters.

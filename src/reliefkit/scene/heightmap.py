@@ -17,12 +17,19 @@ def is_heightmap(path) -> bool:
     return Path(str(path)).suffix.lower() in HEIGHTMAP_SUFFIXES
 
 
-def load_heightmap(path) -> np.ndarray:
-    """(H, W) float64 heights; row 0 is the image's top row, which a relief bake puts at the
-    far edge (-z) seen from above (`relief_from_heights`)."""
+def check_file(path) -> Path:
+    """``path``, refused unless it is a regular file: a folder, a FIFO (which would block the
+    read) or a device is a one-line `FormatError`."""
     path = Path(path)
     if not path.is_file():
         raise FormatError(f"{path}: {'is not a file' if path.exists() else 'no such file'}")
+    return path
+
+
+def load_heightmap(path) -> np.ndarray:
+    """(H, W) float64 heights; row 0 is the image's top row, which a relief bake puts at the
+    far edge (-z) seen from above (`relief_from_heights`)."""
+    path = check_file(path)
     heights = _load_npy(path) if path.suffix.lower() == ".npy" else _load_png(path)
     if heights.ndim != 2 or min(heights.shape) < 4 or max(heights.shape) > MAX_SIDE:
         raise FormatError(f"{path}: a heightmap must be 2D, between 4 and {MAX_SIDE} texels "

@@ -99,6 +99,17 @@ def framing_bounds(obj) -> np.ndarray:
     return np.asarray(source if source is not None else obj.bounds, dtype=np.float64)
 
 
+def source_box(value) -> np.ndarray | None:
+    """A representation's ``source_bounds`` checked: a finite (2, 3) float64 (min, max) box
+    with min <= max (flat meshes have flat boxes), or None when it was not baked from a mesh."""
+    if value is None:
+        return None
+    box = np.asarray(value, dtype=np.float64)
+    if box.shape != (2, 3) or not np.isfinite(box).all() or (box[0] > box[1]).any():
+        raise UsageError("source_bounds must be finite (min, max) corners with min <= max")
+    return box
+
+
 def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float | None = None,
                  size=DEFAULT_SIZE, fov_deg: float = 40.0) -> Camera:
     """Orbit the box centre at ``distance`` bounding-sphere radii (None: fit the view),

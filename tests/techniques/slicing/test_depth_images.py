@@ -100,3 +100,29 @@ def test_bad_arrays_are_usage_errors(box_images):
     with pytest.raises(UsageError, match=r"\[0, 1\]"):
         DepthImages(im.depth * 2, im.mask, im.color, im.normal, im.box_to_world,
                     im.cube_to_world)
+
+
+@pytest.mark.parametrize("side", [1e-200, 1e300])
+def test_a_cube_no_float_can_hold_is_refused(box_images, side):
+    """A forged .rk cube whose side squares to 0 or overflows is a one-line error, not a
+    singular matrix when it is drawn."""
+    from reliefkit.errors import FormatError
+    from reliefkit.techniques.slicing.codec import CODECS
+
+    im = box_images
+    cube = np.eye(4) * side
+    cube[3, 3] = 1.0
+    arrays = {"depth": im.depth, "mask": im.mask.astype(np.uint8), "color": im.color,
+              "normal": im.normal, "cube_to_world": cube}
+    with pytest.raises(FormatError, match="cube side must be within"):
+        CODECS[0].from_arrays(arrays, {})
+
+
+def test_a_mesh_too_small_for_float32_draws_is_refused(gl):
+    from reliefkit.scene.mesh import RenderMesh
+
+    mesh = box_mesh()
+    tiny = RenderMesh(mesh.world_positions * 1e-32, mesh.indices, mesh.normals, mesh.colors,
+                      name="tiny box")
+    with pytest.raises(UsageError, match="cube side must be within"):
+        bake_depth_images(tiny, 8)

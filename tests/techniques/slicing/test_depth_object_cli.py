@@ -72,8 +72,9 @@ def test_the_hull_fills_the_cup_seen_from_above(baked, tmp_path):
 
 @pytest.mark.parametrize("options, words", [
     (("--slicing", "raycast", "--passes", "stencil"), ("ray casting has no slices",)),
-    (("--alpha-test", "slab", "--passes", "stencil"), ("stencil passes test one image",)),
-    (("--slicing", "raycast", "--slices", "8"), ("--slices does not apply",)),
+    (("--slicing", "orthogonal", "--alpha-test", "slab", "--passes", "stencil"),
+     ("stencil passes test one image",)),
+    (("--slices", "8"), ("--slices set the slices", "ray casting (the default)")),
     (("--slicing", "sideways"), ("sideways",)),
     (("--slices", "0"), ("slices",)),
 ])
@@ -120,10 +121,28 @@ def test_framed_views_draw_the_whole_object(flat_van, tmp_path, view):
     pixel for pixel."""
     masks = {}
     for name, options in (("ray", ("--slicing", "raycast")),
-                          ("slab", ("--alpha-test", "slab", "--slices", "24"))):
+                          ("slab", ("--slicing", "orthogonal", "--slices", "24"))):
         out = run_cli("render", flat_van, "--size", "48x48", "--view", view, *options,
                       "-o", tmp_path / f"{name}.png", "--aovs", tmp_path / f"{name}.npz")
         assert out.returncode == 0, out.stderr
         masks[name] = np.load(tmp_path / f"{name}.npz")["mask"]
     assert masks["ray"].sum() > 100
     assert (masks["ray"] != masks["slab"]).sum() <= 2
+
+
+def test_images_too_large_to_hold_are_refused_with_their_estimate(tmp_path):
+    """--res 8192 needs 12.4 GiB of images: refused before anything is allocated, so even a
+    process limited to 3 GiB of address space gets the estimate, not a MemoryError."""
+    import subprocess
+    import sys
+
+    resource = pytest.importorskip("resource")
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+
+    out = subprocess.run([sys.executable, "-m", "reliefkit.cli", "bake", "demo:cup", "--as",
+                          "depth-object", "--res", "8192", "-o", str(tmp_path / "x.rk")],
+                         capture_output=True, text=True, timeout=300, preexec_fn=limit)
+    assert_one_line_error(out, "res 8192", "12.4 GiB", "at most 4657", code=2)
+    assert not (tmp_path / "x.rk").exists()

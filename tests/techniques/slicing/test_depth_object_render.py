@@ -43,6 +43,21 @@ def test_ray_casting_is_the_exact_reference(objects, name):
         assert s["wrong_fraction"] <= 0.002 and s["depth_rms_texels"] < 0.02, s
 
 
+@pytest.mark.parametrize("slicing", [None, "orthogonal", "screen"])
+def test_default_renders_are_the_exact_reference(objects, slicing):
+    """Left to their defaults, a render (ray casting) and the paper's slicings (the slab
+    test, here at 8 slices where the point test misses a third of the pixels) draw the
+    exact intersection."""
+    rep = objects["cup"]
+    options = {} if slicing is None else {"slicing": slicing, "slices": 8}
+    for cam in cameras(rep):
+        frame = render(rep, cam, **options)
+        s = against_reference(frame, rep.images, cam)
+        assert s["reference_pixels"] > 300
+        assert s["wrong_fraction"] <= 0.003 and s["depth_rms_texels"] < 0.1, s
+    assert frame.stats["slicing"] == (slicing or "raycast")
+
+
 @pytest.mark.parametrize("slicing", ["orthogonal", "screen"])
 def test_slab_test_is_exact_at_few_slices(objects, slicing):
     rep = objects["sphere"]
@@ -59,8 +74,8 @@ def test_point_test_converges_with_slices(objects, slicing):
     rep = objects["sphere"]
     cam = cameras(rep)[0]
     reference = exact_intersection(rep.images, cam)
-    scores = [against_reference(render(rep, cam, slicing=slicing, slices=n), rep.images, cam,
-                                reference=reference) for n in (8, 32, 128)]
+    scores = [against_reference(render(rep, cam, slicing=slicing, slices=n, alpha_test="point"),
+                                rep.images, cam, reference=reference) for n in (8, 32, 128)]
     wrong = [s["wrong_fraction"] for s in scores]
     rms = [s["depth_rms_texels"] for s in scores]
     assert wrong[0] > wrong[1] > wrong[2] and wrong[0] > 0.3 and wrong[2] < 0.05, wrong
@@ -73,8 +88,9 @@ def test_stencil_passes_draw_the_single_pass_picture(objects, hull):
     rep = objects["cup"]
     rep = VisualHull.of(rep.images) if hull else rep
     cam = cameras(rep)[0]
-    single = render(rep, cam, slices=24)
-    stencil = render(rep, cam, slices=24, passes="stencil")
+    single = render(rep, cam, slicing="orthogonal", slices=24, alpha_test="point")
+    stencil = render(rep, cam, slicing="orthogonal", slices=24, passes="stencil")
+    assert stencil.stats["alpha_test"] == "point"  # the stencil passes' own test
     assert single.mask.sum() > 300
     assert np.array_equal(single.mask, stencil.mask)
     m = single.mask
@@ -134,9 +150,11 @@ def test_bad_option_combinations_are_refused(objects):
     with pytest.raises(UsageError, match="ray casting has no slices"):
         render(rep, cam, slicing="raycast", passes="stencil")
     with pytest.raises(UsageError, match="stencil passes test one image"):
-        render(rep, cam, alpha_test="slab", passes="stencil")
-    with pytest.raises(UsageError, match="--slices does not apply"):
-        render(rep, cam, slicing="raycast", slices=10)
+        render(rep, cam, slicing="screen", alpha_test="slab", passes="stencil")
+    with pytest.raises(UsageError, match="--slices set the slices"):
+        render(rep, cam, slices=10)
+    with pytest.raises(UsageError, match="--alpha-test set the slices"):
+        render(rep, cam, slicing="raycast", alpha_test="point")
 
 
 def test_stats_count_the_fill(objects):

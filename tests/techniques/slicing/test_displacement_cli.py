@@ -164,7 +164,7 @@ def test_a_projected_mesh_covers_what_the_mesh_covers_from_above(gl, baked):
 
 def test_an_rgba_displacement_texture_keeps_its_colours_and_alpha_heights(tmp_path):
     """The paper's displacement texture: colour in RGB, displacement in alpha. Left half
-    alpha 0 (no displacement: masked out by orthogonal slicing), right half alpha 1 in red."""
+    alpha 0 (no displacement: the blue base itself), right half alpha 1 in red."""
     from PIL import Image
 
     rgba = np.zeros((16, 16, 4), np.uint8)
@@ -184,12 +184,16 @@ def test_an_rgba_displacement_texture_keeps_its_colours_and_alpha_heights(tmp_pa
     assert out.returncode == 0, out.stderr
     aovs = np.load(tmp_path / "t.npz")
     mask, pos, color = aovs["mask"], aovs["position"], aovs["color"]
-    assert mask.sum() > 200
-    assert (pos[mask][:, 0] > -0.15).all()  # nothing left of the middle (u < 0.5)
+    right = mask & (pos[..., 0] > 0.15)
+    left = mask & (pos[..., 0] < -0.15)
+    assert right.sum() > 200 and left.sum() > 200
     # the top (the highest slice, h = 15.5 / 16), bar the bilinear ramp at the step
-    assert (np.abs(pos[mask][:, 1] - 0.2) < 0.02).mean() > 0.85
+    assert (np.abs(pos[right][:, 1] - 0.2) < 0.02).mean() > 0.85
     assert pos[mask][:, 1].max() <= 0.2 + 1e-4
-    assert (np.abs(color[mask][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.85
+    assert (np.abs(color[right][:, :3] - (1, 0, 0)).max(axis=1) < 0.02).mean() > 0.85
+    # left of the step (u < 0.5), the base at height 0 in the texture's blue
+    np.testing.assert_allclose(pos[left][:, 1], 0.0, atol=1e-5)
+    assert (np.abs(color[left][:, :3] - (0, 0, 1)).max(axis=1) < 0.02).mean() > 0.85
 
 
 def test_a_bad_rgba_npy_texture_is_a_one_line_error(tmp_path):
@@ -197,4 +201,23 @@ def test_a_bad_rgba_npy_texture_is_a_one_line_error(tmp_path):
     out = run_cli("bake", "demo:plane", "--as", "displacement", "--displacement",
                   tmp_path / "bad.npy", "-o", tmp_path / "x.rk")
     assert_one_line_error(out, "(H, W, 4)")
+    assert not (tmp_path / "x.rk").exists()
+
+
+@pytest.mark.parametrize("kind", ["fifo", "truncated"])
+def test_an_unreadable_displacement_file_is_a_one_line_error(tmp_path, kind):
+    """A FIFO is refused before it is opened (reading it would block); an .npy texture whose
+    body is shorter than its header says is a format error, not an internal one."""
+    import os
+
+    if kind == "fifo":
+        path = tmp_path / "pipe.png"
+        os.mkfifo(path)
+    else:
+        path = tmp_path / "short.npy"
+        np.save(path, np.full((16, 16, 4), 0.5, np.float32))
+        path.write_bytes(path.read_bytes()[:600])
+    out = run_cli("bake", "demo:plane", "--as", "displacement", "--displacement", path,
+                  "-o", tmp_path / "x.rk")
+    assert_one_line_error(out, str(path), "not a file" if kind == "fifo" else "not a readable")
     assert not (tmp_path / "x.rk").exists()

@@ -62,23 +62,20 @@ def test_wrong_hits_fall_with_the_slice_count(gl, rep, mode, test, tmp_path):
     assert out["depth_error_texels"] < 0.5
 
 
-def test_orthogonal_and_screen_mask_out_zero_displacement(gl, rep):
+@pytest.mark.parametrize("mode", ["surface", "orthogonal", "screen"])
+def test_every_slicing_draws_the_base_where_the_height_is_zero(gl, rep, mode):
+    """Height 0 is surface, not empty: the hole's floor is drawn on the base plane, and the
+    picture is the exact reference's with the floor."""
     cam = orbit_bounds(rep.bounds, 7.0, 80.0, 2.0, size=(96, 96))
-    ref, _ = reference_hits(rep, cam, floor=False)
-    # pixels that look straight down into the hole's centre
     hole_world = np.array([2 * HOLE[0] - 1, 0.0, 2 * HOLE[1] - 1])
     assert rep.one_polygon_box() is not None
-    for mode in ("orthogonal", "screen"):
-        frame = render(rep, cam, slicing=mode, slices=32)
-        near_hole = np.linalg.norm(frame.position - hole_world, axis=-1) < 0.1
-        assert not near_hole.any(), mode
-        assert (frame.mask & ~ref).sum() <= 0.002 * ref.sum()
-    fill = render(rep, cam, slicing="surface", slices=64, alpha_test="fill")
-    on_base = (np.linalg.norm(fill.position - hole_world, axis=-1) < 0.1)
-    assert on_base.sum() > 20  # the basic method draws the base where the height is 0
-    np.testing.assert_allclose(fill.position[on_base][:, 1], 0.0, atol=1e-5)
+    frame = render(rep, cam, slicing=mode, slices=64)
+    on_base = np.linalg.norm(frame.position - hole_world, axis=-1) < 0.1
+    assert on_base.sum() > 20, mode
+    np.testing.assert_allclose(frame.position[on_base][:, 1], 0.0, atol=1e-5)
     floor_ref, _ = reference_hits(rep, cam, floor=True)
-    assert (fill.mask != floor_ref).sum() <= 0.01 * floor_ref.sum()
+    assert (frame.mask != floor_ref).sum() <= 0.01 * floor_ref.sum()
+    assert wrong_hits(frame, rep, cam)["wrong_fraction"] <= 0.01
 
 
 def test_bound_sees_through_where_fill_fills(gl, rep):
@@ -190,3 +187,18 @@ def test_automatic_slices_halve_to_fit_the_polygon_budget(gl, rep, monkeypatch):
     assert fitted.stats["slices"] == 4
     with pytest.raises(UsageError, match="slice polygons"):
         render(rep, cam, slicing="screen", slices=8)
+
+
+@pytest.mark.parametrize("mode", ["orthogonal", "screen"])
+def test_a_displacement_thinner_than_a_pixel_is_its_base(gl, mode):
+    """Fur 1e-9 thick draws exactly the base mesh's pixels (skin and all, no holes between
+    the tufts), with no more slice polygons than a visible displacement needs: automatic
+    slices are never closer than a pixel, so their count does not grow as 1 / scale."""
+    from reliefkit.techniques.slicing.displacement_demo import furry_donut
+
+    thin, thick = furry_donut(res=32, scale=1e-9), furry_donut(res=32, scale=0.08)
+    cam = orbit_bounds(thin.base.bounds, 30.0, 35.0, 2.4, size=(96, 96))
+    frame = render(thin, cam, slicing=mode)
+    np.testing.assert_array_equal(frame.mask, render(thin.base, cam).mask)
+    assert frame.stats["slice_polygons"] <= render(thick, cam, slicing=mode).stats[
+        "slice_polygons"]

@@ -108,11 +108,15 @@ def test_screen_slices_are_exact_cross_sections_of_the_volume(which):
                               np.full((4, 4), 0.5, np.float32), 0.1, (2.0, 2.0), True)
     cam = Camera.orbit(tuple(rep.bounds.mean(axis=0)), 25, 40, 6.0, size=(64, 64))
     tris = slice_triangles(rep, cam, "screen", 40)
-    assert tris.area() * tris.spacing == pytest.approx(rep.volume().total_volume(), rel=2e-3)
+    assert tris.base == len(rep.base.indices)  # the base, then the planes' cuts
+    cuts = tris.positions[3 * tris.base:].reshape(-1, 3, 3)
+    area = 0.5 * np.linalg.norm(np.cross(cuts[:, 1] - cuts[:, 0], cuts[:, 2] - cuts[:, 0]),
+                                axis=1).sum()
+    assert area * tris.spacing == pytest.approx(rep.volume().total_volume(), rel=2e-3)
     # every plane is perpendicular to the view direction: vertices of a triangle share depth
     f = np.asarray(cam.target) - np.asarray(cam.eye)
     f /= np.linalg.norm(f)
-    d = (tris.positions @ f).reshape(-1, 3)
+    d = (cuts.reshape(-1, 3) @ f).reshape(-1, 3)
     assert np.ptp(d, axis=1).max() < 1e-9
 
 
@@ -137,8 +141,9 @@ def test_orthogonal_direction_is_the_most_perpendicular_to_the_view():
     assert (orthogonal_choice(rep, along_z) == 2).all()
     tris = slice_triangles(rep, along_x, "orthogonal", 5)
     assert tris.directions == {"a": 0, "b": 2, "c": 0}
-    # b slices are planes u = const: x constant per triangle
-    x = tris.positions[:, 0].reshape(-1, 3)
+    # after the base, b slices are planes u = const: x constant per triangle
+    assert tris.base == 2 and (tris.box[:6, 2] == 0).all()
+    x = tris.positions[6:, 0].reshape(-1, 3)
     assert np.ptp(x, axis=1).max() < 1e-12 and len(np.unique(x[:, 0].round(9))) == 20
 
 

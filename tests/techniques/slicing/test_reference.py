@@ -199,3 +199,14 @@ def test_occupied_voxels_hold_every_carved_voxel_centre(sphere_images):
     assert not (carved & ~occupied).any()
     # and only the boundary layer differs: a box meeting a voxel without its centre
     assert occupied.sum() - carved.sum() < 0.1 * carved.sum()
+
+
+def test_occupied_columns_are_the_voxels_any_along_each_axis(sphere_images, cup_images):
+    """The bake report's per-column occupancy (N^2 memory) is the N^3 occupancy reduced."""
+    from reliefkit.techniques.slicing.reference import occupied_columns, occupied_voxels
+
+    for images in (sphere_images, cup_images, visual_hull(cup_images)):
+        voxels = occupied_voxels(images)
+        columns = occupied_columns(images)
+        for axis in range(3):
+            np.testing.assert_array_equal(columns[axis], voxels.any(axis=axis))

@@ -66,7 +66,8 @@ def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
     thinned = int((fitted < thickness).sum())
     return TexturedShell(base, fitted, texture,
                          {"source": source.name, "thickness": thickness,
-                          "dropped_triangles": dropped, "thinned_vertices": thinned})
+                          "dropped_triangles": dropped, "thinned_vertices": thinned},
+                         source_bounds=source.bounds)
 
 
 def usable_part(mesh):

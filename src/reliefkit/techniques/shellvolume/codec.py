@@ -5,8 +5,9 @@ Arrays: ``positions`` float64 (V, 3) world, ``indices`` int32 (F, 3), ``normals`
 (D, H, W, 4), ``texture_normal`` float32 (D, H, W, 3), optional ``texture_glow`` float32
 (D, H, W); params ``texture`` (its name), ``tile`` [U, V] and ``alpha_length`` (the
 object-space length the alphas are the opacity of: 1, or the shell thickness the generated
-textures are authored over). The shell's tetrahedra are
-rebuilt from these when the file is read (nothing else is precomputed).
+textures are authored over); optional ``source_bounds`` float64 (2, 3), the baked mesh's box
+that views frame the shell by. The shell's tetrahedra are rebuilt from these when the file
+is read (nothing else is precomputed).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 
 from ...errors import FormatError, MeshError, UsageError
 from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
-from ...io.rk import ArraySpec, Codec
+from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .representation import TexturedShell
 from .textures import MAX_VOXELS, VolumeTexture
 
@@ -24,6 +25,7 @@ ARRAYS = BASE_MESH_ARRAYS | {
     "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True),
     "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True),
     "texture_glow": ArraySpec(("float32",), ndim=3, required=False, finite=True),
+    "source_bounds": SOURCE_BOUNDS,
 }
 
 
@@ -32,7 +34,7 @@ def _to_arrays(rep: TexturedShell) -> tuple[dict, dict]:
     arrays = {"positions": base.world_positions, "indices": base.indices.astype(np.int32),
               "normals": base.normals, "uvs": base.uvs, "thickness": rep.thickness,
               "texture_rgba": tex.rgba, "texture_normal": tex.normal,
-              "texture_glow": tex.glow}
+              "texture_glow": tex.glow, "source_bounds": rep.source_bounds}
     own = ("texture", "tile", "alpha_length")
     params = {k: v for k, v in rep.params.items() if k not in own}
     return arrays, params | {"texture": tex.name, "tile": list(tex.tile),
@@ -66,7 +68,8 @@ def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
         colors = np.broadcast_to(np.float32(0.8), (count, 4))
         base = RenderMesh(positions, arrays["indices"], arrays["normals"], colors,
                           arrays["uvs"], name=params.get("source", "shell base"))
-        return TexturedShell(base, arrays["thickness"], texture, params)
+        return TexturedShell(base, arrays["thickness"], texture, params,
+                             arrays.get("source_bounds"))
     except (UsageError, MeshError, ValueError) as exc:
         raise FormatError(f"invalid shell volume: {exc}") from None
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import UsageError
+from ...scene.views import source_box
 from .shell import ShellVolume, build_shell
 from .textures import VolumeTexture
 
@@ -27,13 +28,15 @@ class TexturedShell:
     RenderMesh with uvs), filled with ``texture`` tiled ``texture.tile`` times over the uvs.
 
     ``shell`` is built at construction (`build_shell`), so a bad base or thickness is refused
-    here, with the reason.
+    here, with the reason. ``source_bounds`` is the box of the mesh it was baked from (None
+    if unknown): views frame the shell by it, as they frame its mesh.
     """
 
     base: object
     thickness: np.ndarray
     texture: VolumeTexture
     params: dict = field(default_factory=dict)
+    source_bounds: np.ndarray | None = None
     shell: ShellVolume = field(init=False)
 
     def __post_init__(self) -> None:
@@ -42,6 +45,7 @@ class TexturedShell:
                              f"{type(self.texture).__name__}")
         self.thickness = np.broadcast_to(np.asarray(self.thickness, np.float64),
                                          (len(self.base.positions),)).copy()
+        self.source_bounds = source_box(self.source_bounds)
         self.shell = build_shell(self.base, self.thickness)
 
     @property

@@ -17,9 +17,9 @@ class DepthObjectParams:
 
 def bake_depth_object(source, p: DepthObjectParams, progress=None) -> DepthObject:
     images = bake_depth_images(source, p.res)
-    return DepthObject(images, {"source": source.name, "res": p.res})
+    return DepthObject(images, {"source": source.name, "res": p.res}, source.bounds)
 
 
 def bake_visual_hull(source, p: DepthObjectParams, progress=None) -> VisualHull:
     images = bake_depth_images(source, p.res)
-    return VisualHull.of(images, {"source": source.name, "res": p.res})
+    return VisualHull.of(images, {"source": source.name, "res": p.res}, source.bounds)

@@ -36,6 +36,7 @@ from ...bench.report import machine, machine_line, write_report
 TARGET_IOU, TARGET_RMS = 0.98, 1.0     # depth object at 256² per face vs the exact reference
 TARGET_WRONG = 0.005                   # some slice count per mode reaches this
 TARGET_TEXTURING_DB = 2.0              # blend3 over nearest, vehicle
+POINT = "point"                        # the paper's alpha test, which the tables measure
 
 
 @dataclass
@@ -103,8 +104,9 @@ def _variants(cfg: BenchConfig):
     """(label, options) of the quality table."""
     out = []
     for slicing in ("orthogonal", "screen"):
-        out += [(f"{slicing} {n}", {"slicing": slicing, "slices": n}) for n in cfg.slice_counts]
-        out.append((f"{slicing} auto", {"slicing": slicing}))
+        paper = {"slicing": slicing, "alpha_test": POINT}
+        out += [(f"{slicing} {n}", paper | {"slices": n}) for n in cfg.slice_counts]
+        out.append((f"{slicing} auto", paper))
         out.append((f"{slicing} auto, slab test", {"slicing": slicing, "alpha_test": "slab"}))
     out.append(("ray cast", {"slicing": "raycast"}))
     return out
@@ -144,7 +146,8 @@ def quality(cfg: BenchConfig, log) -> list[dict]:
                              "variant": label} | _scores(frame, mesh_frame, rep, cam,
                                                           reference))
             for label, options in (("ray cast", {"slicing": "raycast"}),
-                                   ("orthogonal auto", {"slicing": "orthogonal"})):
+                                   ("orthogonal auto", {"slicing": "orthogonal",
+                                                        "alpha_test": POINT})):
                 frame = render(hull, cam, **options)
                 rows.append({"asset": asset, "view": list(view), "object": "visual hull",
                              "variant": label} | _scores(frame, mesh_frame, hull, cam,
@@ -217,9 +220,10 @@ def fig12(cfg: BenchConfig, log) -> dict:
         cam = _covering(rep, pixels, cfg.size)
         covered = int(render(rep, cam, slicing="raycast").mask.sum())
         row = {"coverage": pixels, "covered_pixels": covered}
-        for name, options in (("orthogonal", {"slicing": "orthogonal",
+        for name, options in (("orthogonal", {"slicing": "orthogonal", "alpha_test": POINT,
                                               "slices": cfg.fixed_slices}),
-                              ("screen", {"slicing": "screen", "slices": cfg.fixed_slices}),
+                              ("screen", {"slicing": "screen", "alpha_test": POINT,
+                                          "slices": cfg.fixed_slices}),
                               ("raycast", {"slicing": "raycast"})):
             row[f"{name}_ms"] = time_render(rep, cam, repeats=cfg.repeats, **options)["wall_ms"]
         coverage_rows.append(row)
@@ -230,7 +234,7 @@ def fig12(cfg: BenchConfig, log) -> dict:
         row = {"slices": n, "raycast_ms": raycast_ms}
         for name in ("orthogonal", "screen"):
             row[f"{name}_ms"] = time_render(rep, cam, repeats=cfg.repeats, slicing=name,
-                                            slices=n)["wall_ms"]
+                                            slices=n, alpha_test=POINT)["wall_ms"]
         slice_rows.append(row)
     return {"asset": cfg.assets[0], "fixed_slices": cfg.fixed_slices,
             "fixed_coverage": cfg.fixed_coverage, "coverage": coverage_rows,
@@ -247,7 +251,7 @@ def passes(cfg: BenchConfig, log) -> list[dict]:
     for name, obj in (("depth object", rep), ("visual hull", hull)):
         cam = _covering(obj, cfg.fixed_coverage, cfg.size)
         log(f"passes: {name}")
-        options = {"slicing": "orthogonal", "slices": cfg.fixed_slices}
+        options = {"slicing": "orthogonal", "slices": cfg.fixed_slices, "alpha_test": POINT}
         single = render(obj, cam, **options)
         stencil = render(obj, cam, passes="stencil", **options)
         m = single.mask | stencil.mask

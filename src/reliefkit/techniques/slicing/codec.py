@@ -3,7 +3,8 @@
 Arrays: ``depth`` float32 (6, N, N) in [0, 1], ``mask`` uint8 (6, N, N) 0 or 1, ``color``
 float32 (6, N, N, 4) linear straight alpha, ``normal`` float32 (6, N, N, 3), and
 ``cube_to_world`` float64 (4, 4) (a uniform scale and a translation: the faces' boxes are
-derived from it). See `depth_images` for the conventions.
+derived from it), and optionally ``source_bounds`` float64 (2, 3), the baked mesh's box that
+views frame the object by. See `depth_images` for the conventions.
 """
 
 from __future__ import annotations
@@ -11,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FormatError, UsageError
-from ...io.rk import ArraySpec, Codec
-from .depth_images import MAX_RESOLUTION, DepthImages, face_boxes
+from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
+from .depth_images import MAX_RESOLUTION, DepthImages, check_side, face_boxes
 from .representation import DepthObject, VisualHull
 
 ARRAYS = {
@@ -21,13 +22,15 @@ ARRAYS = {
     "color": ArraySpec(("float32",), ndim=4, trailing=(None, None, 4), finite=True),
     "normal": ArraySpec(("float32",), ndim=4, trailing=(None, None, 3), finite=True),
     "cube_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
+    "source_bounds": SOURCE_BOUNDS,
 }
 
 
 def _to_arrays(rep: DepthObject) -> tuple[dict, dict]:
     im = rep.images
     return ({"depth": im.depth, "mask": im.mask.astype(np.uint8), "color": im.color,
-             "normal": im.normal, "cube_to_world": im.cube_to_world}, dict(rep.params))
+             "normal": im.normal, "cube_to_world": im.cube_to_world,
+             "source_bounds": rep.source_bounds}, dict(rep.params))
 
 
 def _check_cube(cube: np.ndarray) -> None:
@@ -37,6 +40,10 @@ def _check_cube(cube: np.ndarray) -> None:
     expected[:3, 3] = cube[:3, 3]
     if not (side > 0 and np.array_equal(cube, expected)):
         raise FormatError("cube_to_world must be a positive uniform scale and a translation")
+    try:
+        check_side(float(side))
+    except UsageError as exc:
+        raise FormatError(str(exc)) from None
 
 
 def _decoder(cls):
@@ -60,7 +67,7 @@ def _decoder(cls):
         try:
             images = DepthImages(depth, mask.astype(bool), arrays["color"], arrays["normal"],
                                  face_boxes(cube), cube)
-            return cls(images, dict(params))
+            return cls(images, dict(params), arrays.get("source_bounds"))
         except UsageError as exc:
             raise FormatError(f"invalid {kind}: {exc}") from None
 

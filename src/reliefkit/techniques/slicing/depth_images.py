@@ -36,6 +36,11 @@ MARGIN = 0.02
 #: Indices of the faces in `CUBE_FACES` order (outward normal +x, -x, +y, -y, +z, -z).
 FACE_INDEX = {face: k for k, face in enumerate(CUBE_FACES)}
 MAX_RESOLUTION = 8192
+#: The smallest cube side: the GPU draws in float32, whose normal numbers end near 1e-38, so
+#: a smaller cube's texels (side / N) and inverse boxes are no longer numbers it can hold.
+MIN_SIDE = 1e-30
+#: Bytes per texel of the six images: depth float32, mask, colour RGBA float32, normal.
+TEXEL_BYTES = 4 + 1 + 16 + 12
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,6 +125,16 @@ class DepthImages:
         return bounds
 
 
+def check_side(side: float) -> None:
+    """Refuse a cube side outside [`MIN_SIDE`, `MAX_COORDINATE`] (no float32 draw, and no
+    float64 inverse, holds it)."""
+    from ...core.transforms import MAX_COORDINATE
+
+    if not (np.isfinite(side) and MIN_SIDE <= side <= MAX_COORDINATE):
+        raise UsageError(f"the depth images' cube side must be within [{MIN_SIDE:g}, "
+                         f"{MAX_COORDINATE:g}] world units, got {side:g}; scale the mesh")
+
+
 def cube_of(mesh, margin: float = MARGIN) -> np.ndarray:
     """cube_to_world of the mesh's bounding cube (largest side, grown by ``margin``)."""
     bounds = np.asarray(mesh.bounds, dtype=np.float64)
@@ -128,6 +143,7 @@ def cube_of(mesh, margin: float = MARGIN) -> np.ndarray:
         raise UsageError(f"mesh '{mesh.name}' has no extent (a point?); depth images need a "
                          "mesh with a non-zero bounding box")
     side = extent * (1.0 + 2.0 * margin)
+    check_side(side)
     centre = bounds.mean(axis=0)
     cube = np.eye(4) * side
     cube[3, 3] = 1.0
@@ -148,13 +164,35 @@ def face_boxes(cube_to_world: np.ndarray) -> np.ndarray:
     return boxes
 
 
+def check_size(n: int) -> None:
+    """Refuse, before anything is allocated, six N x N images that no .rk file could hold
+    (`io.rk.DEFAULT_MAX_BYTES`) or whose colours no GPU texture array could (they are
+    uploaded as one when drawn), with the estimate and the largest N that fits."""
+    from ...gl.textures import MAX_TEXTURE_ARRAY_BYTES
+    from ...io.rk import DEFAULT_MAX_BYTES
+    from ...units import format_bytes
+
+    arrays, colours = 6 * n * n * TEXEL_BYTES, 6 * n * n * 16
+    if arrays <= DEFAULT_MAX_BYTES and colours <= MAX_TEXTURE_ARRAY_BYTES:
+        return
+    largest = int(min(DEFAULT_MAX_BYTES / (6 * TEXEL_BYTES),
+                      MAX_TEXTURE_ARRAY_BYTES / (6 * 16)) ** 0.5)
+    raise UsageError(f"res {n}: six {n}x{n} depth images need {format_bytes(arrays)} of "
+                     f"arrays (a .rk file holds at most {format_bytes(DEFAULT_MAX_BYTES)}) "
+                     f"and {format_bytes(colours)} of colour texture when drawn (at most "
+                     f"{format_bytes(MAX_TEXTURE_ARRAY_BYTES)}); use a res of at most "
+                     f"{largest}")
+
+
 def bake_depth_images(mesh, resolution: int = 256, *, margin: float = MARGIN,
                       ctx=None) -> DepthImages:
-    """Rasterize ``mesh`` through the six faces of its bounding cube (one GL draw each)."""
+    """Rasterize ``mesh`` through the six faces of its bounding cube (one GL draw each),
+    after `check_size`."""
     if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer) \
             or not 2 <= resolution <= MAX_RESOLUTION:
         raise UsageError(f"resolution must be an integer in [2, {MAX_RESOLUTION}], "
                          f"got {resolution!r}")
+    check_size(int(resolution))
     if not 0 <= margin < 1:
         raise UsageError(f"margin must be in [0, 1), got {margin}")
     n = int(resolution)

@@ -16,15 +16,19 @@ def _is_depth_object(rep) -> bool:
 
 def _hull_of(rep, mesh):
     """The visual hull of the compared depth object's own images (same bake)."""
-    return rep if rep.hull else VisualHull.of(rep.images, rep.params | {"derived": "hull"})
+    return rep if rep.hull else VisualHull.of(rep.images, rep.params | {"derived": "hull"},
+                                              rep.source_bounds)
 
 
 def _compare_variants() -> tuple[CompareVariant, ...]:
-    """Each way of drawing the images, then the visual hull of the same images (§5)."""
+    """The default drawing first, each other way of drawing the images, then the visual hull
+    of the same images (§5)."""
     on = _is_depth_object
-    return (CompareVariant("orthogonal slices", {"slicing": "orthogonal"}, on),
+    return (CompareVariant("ray cast", {"slicing": "raycast"}, on),
+            CompareVariant("orthogonal slices", {"slicing": "orthogonal"}, on),
             CompareVariant("screen slices", {"slicing": "screen"}, on),
-            CompareVariant("ray cast", {"slicing": "raycast"}, on),
+            CompareVariant("orthogonal slices, point test", {"slicing": "orthogonal",
+                                                             "alpha_test": "point"}, on),
             CompareVariant("stencil passes", {"slicing": "orthogonal", "passes": "stencil"},
                            on),
             CompareVariant("nearest image", {"slicing": "raycast", "texturing": "nearest"},
@@ -90,9 +94,10 @@ PART = Part(
     cli_examples={
         "bake": ["reliefkit bake demo:vehicle --as depth-object --res 256 -o van.rk",
                  "reliefkit bake model.glb --as visual-hull --res 128 -o hull.rk"],
-        "render": ["reliefkit render van.rk --slicing screen --slices 200 -o van.png",
-                   "reliefkit render van.rk --passes stencil --texturing nearest -o van.png",
-                   "reliefkit render van.rk --slicing raycast --aovs van.npz --stats van.json"],
+        "render": ["reliefkit render van.rk -o van.png --aovs van.npz --stats van.json",
+                   "reliefkit render van.rk --slicing screen --slices 200 -o van.png",
+                   "reliefkit render van.rk --slicing orthogonal --passes stencil "
+                   "--texturing nearest -o van.png"],
         "compare": ["reliefkit compare demo:vehicle --as depth-object --out cmp-van"],
     },
 )

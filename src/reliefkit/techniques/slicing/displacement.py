@@ -8,9 +8,10 @@ The displacement texture is ``color`` (H, W, 4) float32 linear straight alpha an
 texture coordinates s = (i + 0.5) / W, t = (j + 0.5) / H, bilinear between texel centres,
 clamped at the border (or wrapped, ``wrap``, for periodic textures that tile). A base vertex
 with uv (u, v) reads the texture at (s, t) = (u * tile[0], v * tile[1]). Height 0 is no
-displacement; height 1 moves the base point by ``scale`` (world units) along the normal
-interpolated from the vertex normals (not renormalised, so the volume is exactly the union
-of the prisms below).
+displacement: the base itself is the surface there, unless the colour's alpha (bilinear)
+is below 0.5, where there is nothing (a projected mesh's background); height 1 moves the
+base point by ``scale`` (world units) along the normal interpolated from the vertex normals
+(not renormalised, so the volume is exactly the union of the prisms below).
 
 The displacement volume (§3.1, Fig. 3) extrudes every base triangle (p0, p1, p2) along its
 vertex normals into a prism with top p_i + scale * n_i; each prism is split into three
@@ -29,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import UsageError
+from ...scene.views import source_box
 
 MAX_TEXELS = 8192 * 8192
 MAX_TILE = 4096.0
@@ -45,6 +47,8 @@ class DisplacementMap:
     tile : (U, V) repeats of the texture over the uvs (> 0).
     wrap : the texture repeats (periodic lookups across its border) instead of clamping.
     params : bake provenance (never anything that changes rendering).
+    source_bounds : the box of the mesh it was baked from (None for a heightmap): views
+        frame the map by it, as they frame its mesh.
     """
 
     base: object
@@ -54,6 +58,7 @@ class DisplacementMap:
     tile: tuple = (1.0, 1.0)
     wrap: bool = False
     params: dict = field(default_factory=dict)
+    source_bounds: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         base = self.base
@@ -89,6 +94,7 @@ class DisplacementMap:
             raise UsageError(f"tile must be two numbers in (0, {MAX_TILE:g}], got {self.tile!r}")
         self.tile = tile
         self.wrap = bool(self.wrap)
+        self.source_bounds = source_box(self.source_bounds)
         n = np.asarray(base.normals, np.float64)
         if (np.linalg.norm(n, axis=1) < 1e-6).any():
             raise UsageError("the base mesh has zero-length vertex normals")

@@ -96,11 +96,12 @@ def _file_texture(spec: str):
     """(colour, height) of a file: the paper's displacement texture (an RGBA .png, or an
     (H, W, 4) .npy of linear floats, with the displacement in alpha) or a grey heightmap
     (.png or a 2D .npy; colours from the terrain palette)."""
-    from ...scene.heightmap import is_heightmap, load_heightmap
+    from ...scene.heightmap import check_file, is_heightmap, load_heightmap
 
     if not is_heightmap(spec):
         raise UsageError(f"--displacement {spec}: not one of {', '.join(TEXTURES)}, nor a "
                          "heightmap or displacement texture (.png or .npy)")
+    check_file(spec)  # a FIFO would block the read
     rgba = _rgba_texture(spec)
     if rgba is not None:
         return rgba
@@ -142,7 +143,10 @@ def _rgba_texture(spec: str):
         if shape[2] != 4 or dtype.kind != "f" or max(shape[:2]) > 8192:
             raise FormatError(f"{path}: a displacement texture .npy must be (H, W, 4) float "
                               f"RGBA (at most 8192 per side), got {shape} {dtype}")
-        rgba = np.load(path, allow_pickle=False).astype(np.float64)
+        try:
+            rgba = np.load(path, allow_pickle=False).astype(np.float64)
+        except (OSError, ValueError) as exc:  # a body shorter than its header says
+            raise FormatError(f"{path}: not a readable .npy array ({exc})") from None
         if not np.isfinite(rgba).all():
             raise FormatError(f"{path}: the texture contains NaN or Inf values")
         color = np.clip(rgba[..., :3], 0.0, 1.0)
@@ -177,7 +181,8 @@ def bake_displacement(source, p: DisplacementParams, progress=None) -> Displacem
     scale = _scale(p, DEFAULT_MESH_SCALE * _diagonal(source.bounds))
     base = _usable(source)
     return DisplacementMap(base, color, height, scale, tile, wrap,
-                           params={"source": source.name, "texture": p.displacement})
+                           params={"source": source.name, "texture": p.displacement},
+                           source_bounds=source.bounds)
 
 
 def _usable(mesh):
@@ -231,10 +236,11 @@ def _projected(mesh, p: DisplacementParams, tile) -> DisplacementMap:
 
     (color_rgb,) = dilate(proj.mask, color[..., :3])
     color[..., :3] = color_rgb
-    color[..., 3] = 1.0
+    color[..., 3] = proj.mask  # nothing where the mesh is not: an empty base (displacement.py)
     height = np.clip(proj.height, 0, 1).astype(np.float32)
     base = box_base(box, f"{mesh.name} (projected)")
     scale = p.displacement_scale if p.displacement_scale is not None else float(extent[2])
     # a given scale stretches the projected heights; heights stay the box fractions
     return DisplacementMap(base, color, height, scale, (1.0, 1.0), False,
-                           params={"source": mesh.name, "texture": "projection"})
+                           params={"source": mesh.name, "texture": "projection"},
+                           source_bounds=mesh.bounds)

@@ -4,7 +4,8 @@ Arrays: ``positions`` float64 (V, 3) world, ``indices`` int32 (F, 3), ``normals`
 (V, 3), ``uvs`` float32 (V, 2), ``color`` float32 (H, W, 4) linear straight alpha, ``height``
 float32 (H, W) in [0, 1]. Typed params (they change rendering, so they are checked here):
 ``scale`` (a positive number), ``tile`` [U, V] (positive numbers), ``wrap`` (a bool); the
-rest (``source``, ``texture``) is provenance. The volume's tetrahedra are rebuilt when drawn.
+rest (``source``, ``texture``) is provenance. Optional ``source_bounds`` float64 (2, 3): the baked
+mesh's box, which views frame the map by. The volume's tetrahedra are rebuilt when drawn.
 """
 
 from __future__ import annotations
@@ -13,12 +14,13 @@ import numpy as np
 
 from ...errors import FormatError, MeshError, UsageError
 from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
-from ...io.rk import ArraySpec, Codec
+from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
 ARRAYS = BASE_MESH_ARRAYS | {
     "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True),
     "height": ArraySpec(("float32",), ndim=2, finite=True),
+    "source_bounds": SOURCE_BOUNDS,
 }
 OWN = ("scale", "tile", "wrap")
 
@@ -27,7 +29,7 @@ def _to_arrays(rep: DisplacementMap) -> tuple[dict, dict]:
     base = rep.base
     arrays = {"positions": base.world_positions, "indices": base.indices.astype(np.int32),
               "normals": base.normals, "uvs": base.uvs, "color": rep.color,
-              "height": rep.height}
+              "height": rep.height, "source_bounds": rep.source_bounds}
     params = {k: v for k, v in rep.params.items() if k not in OWN}
     return arrays, params | {"scale": rep.scale, "tile": list(rep.tile), "wrap": rep.wrap}
 
@@ -67,7 +69,8 @@ def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
         base = RenderMesh(positions, arrays["indices"], arrays["normals"], colors,
                           arrays["uvs"], name=str(params.get("source", "displacement base")))
         return DisplacementMap(base, color, height, float(scale),
-                               (float(tile[0]), float(tile[1])), wrap, params)
+                               (float(tile[0]), float(tile[1])), wrap, params,
+                               arrays.get("source_bounds"))
     except (UsageError, MeshError, ValueError) as exc:
         raise FormatError(f"invalid displacement map: {exc}") from None
 

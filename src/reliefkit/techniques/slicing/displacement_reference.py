@@ -4,9 +4,10 @@ A flat base polygon with constant normals and an affine uv map, tile (1, 1), dis
 clamped texture is a heightfield on a box (`DisplacementMap.one_polygon_box`): each pixel's
 ray is clipped to the box and intersected exactly with the bilinear heightfield by
 `reliefkit.reference.heightfield.intersect_rays` (the relief textures' reference). What
-counts as a hit depends on the alpha test: the ``fill`` test draws the base where the height
-is 0 (a hit on the box's floor counts), the subtracting test of orthogonal and screen
-slicing masks zero displacement out (§3.2; floor hits on empty texels are misses).
+counts as a hit depends on the alpha test: the ``fill`` test (surface slicing's default, and
+orthogonal and screen slicing's, which draw the base too) draws the base where the height is
+0, so a hit on the box's floor counts where the colour's alpha is at least 0.5 (a projected
+mesh's background is empty); for the ``bound`` test floor hits on zero texels are misses.
 """
 
 from __future__ import annotations
@@ -59,11 +60,13 @@ def reference_hits(rep: DisplacementMap, camera, *, floor: bool) -> tuple[np.nda
     hit = t <= 1.0 + 1e-9
     rows, t, p0, d = rows[hit], np.minimum(t[hit], 1.0), p0[hit], (p1 - p0)[hit]
     q = p0 + t[:, None] * d
-    if not floor:
-        hh, ww = height.shape
-        empty = (q[:, 2] < FLOOR_EPS) & (surface_height(height, q[:, 0] * ww,
-                                                        q[:, 1] * hh) <= FLOOR_EPS)
-        rows, q = rows[~empty], q[~empty]
+    hh, ww = height.shape
+    on_floor = (q[:, 2] < FLOOR_EPS) & (surface_height(height, q[:, 0] * ww,
+                                                       q[:, 1] * hh) <= FLOOR_EPS)
+    if floor:
+        alpha = surface_height(rep.color[..., 3].astype(np.float64), q[:, 0] * ww, q[:, 1] * hh)
+        on_floor &= alpha < 0.5
+    rows, q = rows[~on_floor], q[~on_floor]
     mask = np.zeros(w * h, bool)
     mask[rows] = True
     pos = np.full((w * h, 3), np.nan)

@@ -7,7 +7,9 @@ keeps the nearest). The number of h slices K is the ``slices`` option, or automa
 spacing scale / K of at most one pixel's world footprint at the object (so the eye cannot see
 between slices seen face-on), but no finer than one height texel's world size (finer slices
 show nothing new), K clamped to [2, 512] (`auto_slices`), and halved while the frame would
-need more than `displacement_slices.MAX_POLYGONS` polygons.
+need more than `displacement_slices.MAX_POLYGONS` polygons; the slices across the volume
+(orthogonal u and v, screen planes) are then never closer than that spacing either, so a
+displacement thinner than a pixel costs the base and a few slices, not 1 / scale of them.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from ...gl.textures import texture2d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .displacement import DisplacementMap
 from .displacement_slices import MODES, TooManyPolygons, slice_triangles
-from .slices import auto_slice_count, projected_area
+from .slices import auto_slice_count, pixel_world_size, projected_area
 
 PROGRAM = "slicing:displacement.glsl"
 PROGRAMS = (ProgramVariant(PROGRAM, {}), ProgramVariant(PROGRAM, {"UNLIT": True}))
@@ -67,9 +69,16 @@ def texel_world_size(rep: DisplacementMap) -> float:
     return per_uv / max(w * rep.tile[0], h * rep.tile[1])
 
 
+def finest_spacing(rep: DisplacementMap, camera) -> float:
+    """The closest useful slice spacing: one pixel's world size at the object's centre, but
+    no finer than one height texel's world size."""
+    lo, hi = rep.bounds
+    return max(pixel_world_size(camera, 0.5 * (lo + hi)), texel_world_size(rep))
+
+
 def auto_slices(rep: DisplacementMap, camera) -> int:
-    """K = ceil(scale / spacing), spacing = max(one pixel's world size at the object, one
-    height texel's world size), clamped to [AUTO_MIN, AUTO_MAX] (`slices.auto_slice_count`)."""
+    """K = ceil(scale / spacing), spacing = `finest_spacing`, clamped to [AUTO_MIN,
+    AUTO_MAX] (`slices.auto_slice_count`)."""
     lo, hi = rep.bounds
     return auto_slice_count(rep.scale, camera, 0.5 * (lo + hi), texel_world_size(rep),
                             maximum=AUTO_MAX)
@@ -113,20 +122,20 @@ class DisplacementDrawable(GLObjects):
 
         rep, opts, ctx = self.rep, self.options, self.ctx
         count = opts.slices if opts.slices is not None else auto_slices(rep, camera)
+        finest = finest_spacing(rep, camera) if opts.slices is None else 0.0
         while True:
             try:
-                tris = slice_triangles(rep, camera, opts.slicing, count, self.volume)
+                tris = slice_triangles(rep, camera, opts.slicing, count, self.volume, finest)
                 break
             except TooManyPolygons:
                 if opts.slices is not None or count <= AUTO_MIN:
                     raise
                 count = max(AUTO_MIN, count // 2)  # automatic: halve until the slices fit
         h, w = rep.height.shape
-        surface = opts.slicing == "surface"
-        test = (0 if opts.alpha_test == "fill" else 1) if surface else 2
+        test = opts.alpha_test if opts.slicing == "surface" else "fill"
         bound = 1.0 / (count - 1) if count > 1 else 1.0
         self.stats = {"slices": int(count), "slicing": opts.slicing,
-                      "alpha_test": opts.alpha_test if surface else "subtract",
+                      "alpha_test": test,
                       "slice_planes": int(tris.slices), "slice_polygons": int(tris.polygons),
                       "slice_triangles": int(tris.triangle_count),
                       "slice_spacing": float(tris.spacing),
@@ -144,7 +153,8 @@ class DisplacementDrawable(GLObjects):
                              | model_offset(camera, self.origin) | light.uniforms()
                              | {"u_height": _HEIGHT_UNIT, "u_color": _COLOR_UNIT,
                                 "u_hf_size": (w, h), "u_wrap": rep.wrap,
-                                "u_tile": tuple(rep.tile), "u_test": test,
+                                "u_tile": tuple(rep.tile),
+                                "u_test": ALPHA_TESTS.index(test),
                                 "u_bound": float(bound)})
                 self.height.use(_HEIGHT_UNIT)
                 self.color.use(_COLOR_UNIT)

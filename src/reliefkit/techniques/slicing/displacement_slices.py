@@ -22,7 +22,8 @@ gradient through):
   meets: no texture borders, the polygons cover exactly the volume's cross-sections.
 
 A plane cuts a tetrahedron in a triangle (one vertex on one side) or a quad (two and two);
-quads are drawn as two triangles.
+quads are drawn as two triangles. Orthogonal and screen slicing also draw the base itself
+(the offset surface h = 0): height 0 is surface, and no slice of theirs lies at h = 0.
 """
 
 from __future__ import annotations
@@ -85,9 +86,11 @@ class SliceTriangles:
         the vertex belongs to.
     polygons : slice polygons (tetrahedron cuts, or offset triangles) drawn.
     slices : slicing planes / surfaces used (for orthogonal: the sum over the three
-        directions of the levels that cut something).
+        directions of the levels that cut something), the base included.
     spacing : world spacing of the h slices (scale / K, or scale / (K - 1) for surface).
     mode : the slicing.
+    base : how many of the first triangles are the base itself (h = 0), drawn by orthogonal
+        and screen slicing besides their cuts.
     """
 
     positions: np.ndarray
@@ -98,6 +101,7 @@ class SliceTriangles:
     spacing: float
     mode: str
     directions: dict
+    base: int = 0
 
     @property
     def triangle_count(self) -> int:
@@ -109,9 +113,10 @@ class SliceTriangles:
                                           axis=1).sum())
 
 
-def cut_tetrahedra(positions, box, tets, jacobian, values, levels) -> tuple:
+def cut_tetrahedra(positions, box, tets, jacobian, values, levels, reserved: int = 0) -> tuple:
     """Polygons where the levels ``levels`` (sorted (L,)) of the scalar ``values`` (per volume
-    vertex, affine inside each tetrahedron) cut the tetrahedra ``tets``.
+    vertex, affine inside each tetrahedron) cut the tetrahedra ``tets``; refused before they
+    are built when they and the ``reserved`` polygons of the same frame exceed `MAX_POLYGONS`.
 
     Returns (positions (3M, 3), box (3M, 3), jacobian (3M, 3, 3), polygons, levels used).
     """
@@ -121,8 +126,8 @@ def cut_tetrahedra(positions, box, tets, jacobian, values, levels) -> tuple:
     hi = np.searchsorted(levels, s.max(axis=1), side="left")
     n = np.maximum(hi - lo, 0)
     total = int(n.sum())
-    if total > MAX_POLYGONS:
-        raise TooManyPolygons(f"{total} slice polygons would be needed (at most "
+    if total + reserved > MAX_POLYGONS:
+        raise TooManyPolygons(f"{total + reserved} slice polygons would be needed (at most "
                               f"{MAX_POLYGONS}); use fewer slices (--slices)")
     empty = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3, 3)), 0, 0)
     if total == 0:
@@ -161,34 +166,41 @@ def cut_tetrahedra(positions, box, tets, jacobian, values, levels) -> tuple:
             np.repeat(jac, 3, axis=0), int(len(tet)), used_levels)
 
 
-def _offset_surfaces(rep, count: int) -> SliceTriangles:
+def _offset_surface(rep, h: float) -> tuple:
+    """The base mesh moved by h * scale along its normals: (positions (3F, 3), box (3F, 3),
+    jacobian (3F, 3, 3), polygons F, 1 level)."""
     base = rep.base
     tris = np.asarray(base.indices, np.int64)
-    p = base.world_positions
     n = np.asarray(base.normals, np.float64)
-    uv = np.asarray(base.uvs, np.float64)
-    levels = np.linspace(0.0, 1.0, count) if count > 1 else np.zeros(1)
-    pos, box, jac = [], [], []
-    tri_uv = uv[tris]
+    tri_uv = np.asarray(base.uvs, np.float64)[tris]
     duv = np.stack([tri_uv[:, 1] - tri_uv[:, 0], tri_uv[:, 2] - tri_uv[:, 0]], axis=2)
-    det = np.linalg.det(duv)
-    good = np.abs(det) > 1e-14
+    good = np.abs(np.linalg.det(duv)) > 1e-14
     inv = np.zeros_like(duv)
     inv[good] = np.linalg.inv(duv[good])
-    for h in levels:
-        q = p + (h * rep.scale) * n
-        tp = q[tris]                                            # (F, 3, 3)
-        dp = np.stack([tp[:, 1] - tp[:, 0], tp[:, 2] - tp[:, 0]], axis=2)  # (F, 3, 2)
-        juv = dp @ inv                                          # (F, 3, 2): d/du, d/dv
-        jh = rep.scale * n[tris]                                # (F, 3 vertices, 3)
-        j = np.concatenate([np.repeat(juv[:, None], 3, axis=1), jh[..., None]], axis=3)
-        pos.append(tp.reshape(-1, 3))
-        box.append(np.concatenate([tri_uv, np.full((*tris.shape, 1), h)], axis=2)
-                   .reshape(-1, 3))
-        jac.append(j.reshape(-1, 3, 3))
+    tp = (base.world_positions + (h * rep.scale) * n)[tris]    # (F, 3, 3)
+    dp = np.stack([tp[:, 1] - tp[:, 0], tp[:, 2] - tp[:, 0]], axis=2)  # (F, 3, 2)
+    juv = dp @ inv                                              # (F, 3, 2): d/du, d/dv
+    jh = rep.scale * n[tris]                                    # (F, 3 vertices, 3)
+    j = np.concatenate([np.repeat(juv[:, None], 3, axis=1), jh[..., None]], axis=3)
+    box = np.concatenate([tri_uv, np.full((*tris.shape, 1), h)], axis=2)
+    return tp.reshape(-1, 3), box.reshape(-1, 3), j.reshape(-1, 3, 3), len(tris), 1
+
+
+def _offset_surfaces(rep, count: int) -> SliceTriangles:
+    levels = np.linspace(0.0, 1.0, count) if count > 1 else np.zeros(1)
+    surfaces = [_offset_surface(rep, h) for h in levels]
     spacing = rep.scale / (count - 1) if count > 1 else rep.scale
-    return SliceTriangles(np.concatenate(pos), np.concatenate(box), np.concatenate(jac),
-                          len(tris) * count, count, spacing, "surface", {"a": len(tris)})
+    return _joined(surfaces, spacing, "surface", {"a": surfaces[0][3]})
+
+
+def _joined(parts, spacing: float, mode: str, directions: dict,
+            base: int = 0) -> SliceTriangles:
+    """One `SliceTriangles` of several (positions, box, jacobian, polygons, levels) parts."""
+    return SliceTriangles(np.concatenate([c[0] for c in parts]),
+                          np.concatenate([c[1] for c in parts]),
+                          np.concatenate([c[2] for c in parts]),
+                          sum(c[3] for c in parts), sum(c[4] for c in parts), spacing, mode,
+                          directions, base)
 
 
 def _uv_gradients(rep) -> np.ndarray:
@@ -216,11 +228,12 @@ def _uv_gradients(rep) -> np.ndarray:
     return out
 
 
-def orthogonal_levels(rep, count: int, volume=None) -> tuple[np.ndarray, np.ndarray,
-                                                             np.ndarray]:
-    """The shared levels of the three directions: (h levels, u levels, v levels)."""
+def orthogonal_levels(rep, count: int, min_spacing: float = 0.0) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray]:
+    """The shared levels of the three directions: (h levels, u levels, v levels); the u and
+    v slices are scale / count apart, or ``min_spacing`` where that is wider."""
     h_levels = (np.arange(count) + 0.5) / count
-    spacing = rep.scale / count
+    spacing = max(rep.scale / count, min_spacing)
     grads = np.linalg.norm(_uv_gradients(rep), axis=2)   # (F, 2) uv units per world unit
     uv = np.asarray(rep.base.uvs, np.float64)
     out = [h_levels]
@@ -265,9 +278,12 @@ def _view_per_point(camera, points) -> np.ndarray:
     return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
 
 
-def slice_triangles(rep, camera, mode: str, count: int, volume=None) -> SliceTriangles:
+def slice_triangles(rep, camera, mode: str, count: int, volume=None,
+                    min_spacing: float = 0.0) -> SliceTriangles:
     """The slice polygons of ``rep`` for ``camera`` in slicing ``mode`` with ``count`` h
-    slices (see the module docstring)."""
+    slices (see the module docstring). Orthogonal u and v slices and screen planes, spaced
+    scale / count, are spaced ``min_spacing`` apart where that is wider: a volume thinner
+    than a pixel needs no planes closer than one (their count would grow as 1 / scale)."""
     if mode not in MODES:
         raise UsageError(f"slicing must be one of {', '.join(MODES)}, got {mode!r}")
     if isinstance(count, bool) or int(count) != count or count < 1:
@@ -282,32 +298,25 @@ def slice_triangles(rep, camera, mode: str, count: int, volume=None) -> SliceTri
     vol = volume if volume is not None else rep.volume()
     if mode == "orthogonal":
         choice = orthogonal_choice(rep, camera)
-        levels = orthogonal_levels(rep, count)
-        parts, used, polygons, directions = [], 0, 0, {}
+        levels = orthogonal_levels(rep, count, min_spacing)
+        parts, directions = [_offset_surface(rep, 0.0)], {}
         for k, name, axis in ((0, "a", 2), (1, "b", 0), (2, "c", 1)):
             tets = np.flatnonzero(choice[vol.prism_of] == k)
             directions[name] = int(np.count_nonzero(choice == k))
             if not len(tets) or not len(levels[k]):
                 continue
-            cut = cut_tetrahedra(vol.positions, vol.box, vol.tets[tets], vol.jacobian[tets],
-                                 vol.box[:, axis], levels[k])
-            parts.append(cut)
-            polygons += cut[3]
-            used += cut[4]
-        if not parts:
-            parts = [(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3, 3)), 0, 0)]
-        return SliceTriangles(np.concatenate([c[0] for c in parts]),
-                              np.concatenate([c[1] for c in parts]),
-                              np.concatenate([c[2] for c in parts]), polygons, used,
-                              rep.scale / count, "orthogonal", directions)
+            parts.append(cut_tetrahedra(vol.positions, vol.box, vol.tets[tets],
+                                        vol.jacobian[tets], vol.box[:, axis], levels[k],
+                                        sum(c[3] for c in parts)))
+        return _joined(parts, rep.scale / count, "orthogonal", directions, parts[0][3])
     # screen
-    spacing = rep.scale / count
+    spacing = max(rep.scale / count, min_spacing)
     centre = 0.5 * (vol.positions.min(axis=0) + vol.positions.max(axis=0))
     f = view_direction(camera, centre)
     depth = vol.positions @ f
     near, far = float(depth.min()), float(depth.max())
     planes = min(max(1, math.ceil((far - near) / spacing - 1e-9)), MAX_PLANES)
     levels = near + (far - near) * (np.arange(planes) + 0.5) / planes
-    cut = cut_tetrahedra(vol.positions, vol.box, vol.tets, vol.jacobian, depth, levels)
-    return SliceTriangles(cut[0], cut[1], cut[2], cut[3], cut[4], (far - near) / planes,
-                          "screen", {"planes": planes})
+    base = _offset_surface(rep, 0.0)
+    cut = cut_tetrahedra(vol.positions, vol.box, vol.tets, vol.jacobian, depth, levels, base[3])
+    return _joined([base, cut], (far - near) / planes, "screen", {"planes": planes}, base[3])

@@ -3,8 +3,7 @@ linear + height (H, W) float32 in [0, 1]; and the terrain palette of heightmap i
 
 * ``fur``: tufts of hair on a jittered grid over a thin skin (height 0.12), each a cone of
   random height 0.55..1 (Fig. 1's furry donut).
-* ``bumps``: smooth round bumps on a jittered grid, zero between them (masked out by
-  orthogonal and screen slicing, §3.2).
+* ``bumps``: smooth round bumps on a jittered grid, zero between them (the base shows).
 * ``waves``: two crossing sine waves, heights 0.1..1.
 """
 
@@ -14,10 +13,22 @@ import numpy as np
 
 from ...errors import UsageError
 
+#: Texels generated at a time: the textures are made a band of rows at a time, so their
+#: float64 temporaries stay this size whatever the resolution.
+BAND_TEXELS = 1 << 20
 
-def _grid(res: int):
+
+def _banded(res: int, band):
+    """(colour (res, res, 4) float32, height (res, res) float32) filled a band of rows at a
+    time by ``band(x, y) -> (colour, height)`` of the texel centres x, y (rows, res)."""
+    color = np.empty((res, res, 4), np.float32)
+    height = np.empty((res, res), np.float32)
     s = (np.arange(res) + 0.5) / res
-    return np.meshgrid(s, s)
+    rows = max(1, BAND_TEXELS // res)
+    for r0 in range(0, res, rows):
+        x, y = np.meshgrid(s, s[r0:r0 + rows])
+        color[r0:r0 + rows], height[r0:r0 + rows] = band(x, y)
+    return color, height
 
 
 def _periodic_distance(x, y, cx, cy):
@@ -37,51 +48,75 @@ def _jittered(cells: int, seed: int):
 
 
 def fur(res: int = 64, seed: int = 1):
-    x, y = _grid(res)
     cells = max(2, res // 6)
     cx, cy, rng = _jittered(cells, seed)
     tall = 0.55 + 0.45 * rng.random(len(cx))
-    radius = 0.45 / cells
-    height = np.full(x.shape, 0.12)
-    for k in range(len(cx)):
-        d = _periodic_distance(x, y, cx[k], cy[k])
-        height = np.maximum(height, tall[k] * np.clip(1 - d / radius, 0, 1))
-    shade = 0.35 + 0.65 * height
-    color = np.stack([0.45 * shade, 0.27 * shade, 0.12 * shade, np.ones_like(x)], -1)
-    return color.astype(np.float32), height.astype(np.float32)
+    radius = 0.45 / cells  # a tuft (centre 0.2..0.8 into its cell) reaches the next cells only
+
+    def band(x, y):
+        height = np.full(x.shape, 0.12)
+        i, j = np.floor(x * cells).astype(np.int64), np.floor(y * cells).astype(np.int64)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                k = ((j + dj) % cells) * cells + (i + di) % cells
+                d = _periodic_distance(x, y, cx[k], cy[k])
+                height = np.maximum(height, tall[k] * np.clip(1 - d / radius, 0, 1))
+        shade = 0.35 + 0.65 * height
+        return np.stack([0.45 * shade, 0.27 * shade, 0.12 * shade, np.ones_like(x)], -1), height
+
+    return _banded(res, band)
 
 
 def bumps(res: int = 64, seed: int = 2):
-    x, y = _grid(res)
     cells = 4
     cx, cy, rng = _jittered(cells, seed)
-    radius = 0.38 / cells
-    height = np.zeros(x.shape)
-    for k in range(len(cx)):
-        d = _periodic_distance(x, y, cx[k], cy[k])
-        r = (0.8 + 0.4 * rng.random()) * radius
-        height = np.maximum(height, np.sqrt(np.clip(1 - (d / r) ** 2, 0, 1)))
-    color = np.stack([0.2 + 0.6 * height, 0.35 + 0.2 * height, 0.7 - 0.4 * height,
-                      np.ones_like(x)], -1)
-    return color.astype(np.float32), height.astype(np.float32)
+    radii = [(0.8 + 0.4 * rng.random()) * 0.38 / cells for _ in range(len(cx))]
+
+    def band(x, y):
+        height = np.zeros(x.shape)
+        for k, r in enumerate(radii):
+            d = _periodic_distance(x, y, cx[k], cy[k])
+            height = np.maximum(height, np.sqrt(np.clip(1 - (d / r) ** 2, 0, 1)))
+        return np.stack([0.2 + 0.6 * height, 0.35 + 0.2 * height, 0.7 - 0.4 * height,
+                         np.ones_like(x)], -1), height
+
+    return _banded(res, band)
 
 
 def waves(res: int = 64, seed: int = 0):
-    x, y = _grid(res)
-    height = 0.1 + 0.9 * (0.5 + 0.25 * np.sin(2 * np.pi * 2 * x) + 0.25 * np.sin(
-        2 * np.pi * 3 * y))
-    color = np.stack([0.1 + 0.3 * height, 0.3 + 0.4 * height, 0.5 + 0.4 * height,
-                      np.ones_like(x)], -1)
-    return color.astype(np.float32), np.clip(height, 0, 1).astype(np.float32)
+    def band(x, y):
+        height = 0.1 + 0.9 * (0.5 + 0.25 * np.sin(2 * np.pi * 2 * x) + 0.25 * np.sin(
+            2 * np.pi * 3 * y))
+        return np.stack([0.1 + 0.3 * height, 0.3 + 0.4 * height, 0.5 + 0.4 * height,
+                         np.ones_like(x)], -1), np.clip(height, 0, 1)
+
+    return _banded(res, band)
 
 
 TEXTURES = {"fur": fur, "bumps": bumps, "waves": waves}
+#: The largest procedural texture made: fur, the slowest, takes about `SECONDS_PER_MTEXEL`
+#: per million texels (2.3 s measured at 2048² on a loaded 2-core machine, 2026-12-06), so
+#: 4096² is about 40 s; the texture holds 20 bytes a texel (colour and height, float32).
+MAX_TEXELS = 4096 * 4096
+SECONDS_PER_MTEXEL = 2.5
+TEXEL_BYTES = 20
 
 
 def make_texture(name: str, res: int):
+    """The procedural texture ``name`` at ``res`` texels per side, refused with its time and
+    memory estimate above `MAX_TEXELS`."""
     if name not in TEXTURES:
         raise UsageError(f"unknown displacement texture {name!r} (choose from "
                          f"{', '.join(TEXTURES)}, or give a heightmap .png/.npy)")
+    texels = int(res) ** 2
+    if texels > MAX_TEXELS:
+        from ...units import format_bytes
+
+        minutes = SECONDS_PER_MTEXEL * texels / 1e6 / 60
+        raise UsageError(f"a {name} texture of {res}x{res} texels would take up to about "
+                         f"{minutes:.0f} minutes here and {format_bytes(TEXEL_BYTES * texels)} "
+                         f"(the limit is {MAX_TEXELS ** 0.5:.0f}x{MAX_TEXELS ** 0.5:.0f}); use "
+                         "a smaller --res, and --tile to repeat it")
     return TEXTURES[name](res=int(res))
 
 

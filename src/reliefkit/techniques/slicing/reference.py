@@ -207,7 +207,8 @@ def voxel_carve(images: DepthImages, n: int) -> np.ndarray:
 
 def occupied_voxels(images: DepthImages) -> np.ndarray:
     """(N, N, N) bool [x, y, z]: the cube voxels where the nearest-texel object is not
-    empty (its box there meets the voxel with a positive or zero extent on every axis)."""
+    empty (its box there meets the voxel with a positive or zero extent on every axis).
+    N^3 booleans: a check for small N (`occupied_columns` is the same per column in N^2)."""
     _check(images)
     n = images.resolution
     b = images.column_bounds()  # (axis, lo/hi, i, j): x: [y, z], y: [x, z], z: [x, y]
@@ -225,11 +226,50 @@ def occupied_voxels(images: DepthImages) -> np.ndarray:
     return x & y & z
 
 
+@njit(cache=True)
+def _fits(bounds, axis, v, n) -> bool:
+    """Whether the object's interval along ``axis`` at voxel v's column meets the voxel."""
+    lo, hi = _column(bounds, axis, v, n)
+    return max(lo, v[axis] / n) <= min(hi, (v[axis] + 1) / n)
+
+
+@njit(cache=True)
+def _occupied_columns(bounds, n, out):
+    v = np.empty(3, np.int64)
+    for a in range(3):
+        p, q = (1, 2) if a == 0 else ((0, 2) if a == 1 else (0, 1))
+        for i in range(n):
+            for j in range(n):
+                lo, hi = bounds[a, 0, i, j], bounds[a, 1, i, j]
+                if lo > hi:
+                    continue
+                v[p], v[q] = i, j
+                first = max(0, min(n - 1, int(np.floor(lo * n))))
+                last = max(0, min(n - 1, int(np.ceil(hi * n))))
+                for c in range(first, last + 1):
+                    v[a] = c
+                    if _fits(bounds, 0, v, n) and _fits(bounds, 1, v, n) and \
+                            _fits(bounds, 2, v, n):
+                        out[a, i, j] = True
+                        break
+
+
+def occupied_columns(images: DepthImages) -> np.ndarray:
+    """(3, N, N) bool: per cube axis a, whether the column of voxels along a at the other
+    two voxel indices (in increasing axis order) holds any `occupied_voxels` voxel; computed
+    column by column (only the voxels within a's own interval), never as an N^3 array."""
+    _check(images)
+    n = images.resolution
+    out = np.zeros((3, n, n), bool)
+    _occupied_columns(images.column_bounds(), n, out)
+    return out
+
+
 def carved_fraction(images: DepthImages) -> np.ndarray:
     """(6,) per face: the fraction of its silhouette whose texel column holds no part of the
     object, i.e. what the other images carve away (open or paper-thin surfaces seen edge-on
     by them: a ground plane, a sheet). Closed solids give about 0."""
-    occupied = occupied_voxels(images)
+    occupied = occupied_columns(images)
     from .depth_images import FACE_INDEX
 
     out = np.zeros(6)
@@ -238,7 +278,7 @@ def carved_fraction(images: DepthImages) -> np.ndarray:
         if not mask.any():
             continue
         axis = "xyz".index(face[-1])
-        column = occupied.any(axis=axis)  # indexed by the other two axes in order
+        column = occupied[axis]  # indexed by the other two axes in order
         rows, cols = np.nonzero(mask)
         from ...bake.project import axis_frame
 

@@ -1,18 +1,23 @@
 """Drawing depth objects and visual hulls (§4-§5): slices through the cube, or ray casting.
 
-Slicing (`slicing` orthogonal or screen): the cube is cut into a stack of slices (slices.py),
-nearest first, and every fragment of a slice is kept only where it lies inside the volume of
-every tested image. ``passes="single"`` tests all images in one fragment shader; ``"stencil"``
+Ray casting (``slicing="raycast"``, the default, beyond the paper): the object's box is
+drawn and each pixel's ray walks the N^3 voxels; inside a voxel the nearest-texel object is
+one box (see reference.py), so the hit is exact, the same as the CPU reference's, and one
+pass costs about as much as a hundred slices.
+
+Slicing (`slicing` orthogonal or screen, the paper's): the cube is cut into a stack of slices
+(slices.py), nearest first, and every fragment of a slice is kept only where it lies inside
+the volume of every tested image. The slab test (the default) walks the pixel's ray through
+the voxels over the slab the slice stands for, so slices are exact at any count too; the
+paper's point test checks the slice's own point only, and misses what lies between slices.
+``passes="single"`` tests all images in one fragment shader; ``"stencil"``
 is §4.1's multi-pass algorithm on a stencil buffer: per slice, one pass per image counts in
 the stencil where its test passes (only where the count so far is complete), one pass
 textures the pixels whose count is complete and marks them done, one pass resets the rest;
 the slices go front to back so the first complete slice wins, with no depth test. The paper
 draws colour in every counting pass and erases it with the background; writing colour once,
-where the count is complete, gives the same picture.
-
-Ray casting (``slicing="raycast"``, beyond the paper): the cube's faces are drawn and each
-pixel's ray walks the N^3 voxels; inside a voxel the nearest-texel object is one box (see
-reference.py), so the hit is exact, the same as the CPU reference's.
+where the count is complete, gives the same picture; the stencil passes test one image at a
+time, so they take the point test.
 
 Texturing (§4.2): the three images closest to the view direction, or the single nearest
 (``texturing``), restricted to the images that see the point (a point is seen by image k
@@ -60,10 +65,10 @@ PROGRAMS = tuple(ProgramVariant(PROGRAM, d) for d in (
 class DepthObjectRenderOptions:
     """The render options of depth objects and visual hulls."""
 
-    slicing: str = param("orthogonal", "slices along the cube axis most perpendicular to "
-                         "the view (§3.2), parallel to the screen cut exactly to the cube "
-                         "(§3.3), or no slices: each pixel's ray cast through the images",
-                         choices=SLICINGS)
+    slicing: str = param("raycast", "no slices: each pixel's ray cast through the images "
+                         "(exact); or the paper's slices along the cube axis most "
+                         "perpendicular to the view (§3.2), or parallel to the screen cut "
+                         "exactly to the cube (§3.3)", choices=SLICINGS)
     slices: int | None = param(None, "number of slices (none: one per pixel of the cube on "
                                "screen, never closer than half a texel)", kind="int", lo=1,
                                hi=16384)
@@ -72,9 +77,10 @@ class DepthObjectRenderOptions:
     texturing: str = param("blend3", "view-dependent texturing from the three images "
                            "closest to the view, or from the nearest one (§4.2)",
                            choices=TEXTURINGS)
-    alpha_test: str = param("point", "slices: test the slice's own point (the paper's alpha "
-                            "test), or the whole slab of the ray the slice stands for "
-                            "(exact at any slice count)", choices=ALPHA_TESTS)
+    alpha_test: str | None = param(None, "slices: test the whole slab of the ray the slice "
+                                   "stands for (exact at any slice count), or the slice's "
+                                   "own point (the paper's alpha test); none: slab, point for "
+                                   "the stencil passes", kind="str", choices=ALPHA_TESTS)
     visibility: bool = param(True, "texture each point only from the images that see it "
                              "(off: the paper's texturing, which also paints hidden parts "
                              "with whatever an image saw in front of them)")
@@ -108,11 +114,16 @@ class DepthObjectDrawable(GLObjects):
         if opts.slicing == "raycast" and opts.passes == "stencil":
             raise UsageError("--passes stencil counts image tests per slice; ray casting "
                              "has no slices (use --slicing orthogonal or screen)")
-        if opts.alpha_test == "slab" and opts.passes == "stencil":
+        self.alpha_test = opts.alpha_test or ("point" if opts.passes == "stencil" else "slab")
+        if self.alpha_test == "slab" and opts.passes == "stencil":
             raise UsageError("--alpha-test slab tests all images together; the stencil "
                              "passes test one image at a time (use --alpha-test point)")
-        if opts.slicing == "raycast" and opts.slices is not None:
-            raise UsageError("--slices does not apply to --slicing raycast")
+        if opts.slicing == "raycast":
+            given = [flag for flag, value in (("--slices", opts.slices),
+                                              ("--alpha-test", opts.alpha_test)) if value]
+            if given:
+                raise UsageError(f"{' and '.join(given)} set the slices of --slicing "
+                                 "orthogonal or screen; ray casting (the default) has none")
         self.extra_attachments = 1 if instrument and opts.slicing == "raycast" else 0
         self.instrument = instrument
         images = rep.images
@@ -147,7 +158,7 @@ class DepthObjectDrawable(GLObjects):
             self.copy_vao = self.keep(ctx.vertex_array(self.copy_program, []))
         else:
             self.programs = {"main": program(ctx, PROGRAM, common | {
-                "SLAB": opts.alpha_test == "slab"})}
+                "SLAB": self.alpha_test == "slab"})}
         check_gl_error(ctx, "uploading a depth object")
 
     def _cube_proxy(self) -> None:
@@ -257,7 +268,7 @@ class DepthObjectDrawable(GLObjects):
             draws = 1
         self.stats = {"slicing": opts.slicing, "slices": stack.slice_count,
                       "passes": opts.passes, "texturing": opts.texturing, "draws": draws,
-                      "alpha_test": opts.alpha_test,
+                      "alpha_test": self.alpha_test,
                       "slice_polygons": int(np.count_nonzero(np.diff(stack.first_triangle))),
                       "fill_pixels": stack.area_pixels(camera)}
 
@@ -266,7 +277,7 @@ class DepthObjectDrawable(GLObjects):
         it (cube-side units): `VISIBLE_TEXELS`, plus a slice spacing for the point test,
         whose points lie up to that far inside the surface."""
         slack = stack.spacing / self.rep.images.side if stack is not None and \
-            self.options.alpha_test == "point" else 0.0
+            self.alpha_test == "point" else 0.0
         return VISIBLE_TEXELS / self.rep.resolution + slack
 
     def _draw_stencil(self, camera, stack) -> int:

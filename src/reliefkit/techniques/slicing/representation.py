@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import UsageError
+from ...scene.views import source_box
 from .depth_images import DepthImages, visual_hull
 
 #: `DepthObject.bake_report` warns when more of one image's silhouette than this is carved
@@ -23,10 +24,13 @@ CARVED_WARNING = 0.05
 
 @dataclass(eq=False)
 class DepthObject:
-    """An image-based depth object: `images` (six depth images, see `depth_images`)."""
+    """An image-based depth object: `images` (six depth images, see `depth_images`), and the
+    bounds of the mesh they were baked from (`source_bounds`, None if unknown): views frame
+    the object by them, as they frame its mesh, not by the padded cube or `bounds`."""
 
     images: DepthImages
     params: dict = field(default_factory=dict)
+    source_bounds: np.ndarray | None = None
 
     #: Whether only silhouettes are stored (depth 0 inside every mask).
     hull = False
@@ -35,6 +39,7 @@ class DepthObject:
         if not isinstance(self.images, DepthImages):
             raise UsageError(f"a depth object needs DepthImages, got "
                              f"{type(self.images).__name__}")
+        self.source_bounds = source_box(self.source_bounds)
 
     @property
     def resolution(self) -> int:
@@ -114,5 +119,6 @@ class VisualHull(DepthObject):
                              "silhouette (build it with VisualHull.of(images))")
 
     @classmethod
-    def of(cls, images: DepthImages, params: dict | None = None) -> VisualHull:
-        return cls(visual_hull(images), dict(params or {}))
+    def of(cls, images: DepthImages, params: dict | None = None,
+           source_bounds: np.ndarray | None = None) -> VisualHull:
+        return cls(visual_hull(images), dict(params or {}), source_bounds)

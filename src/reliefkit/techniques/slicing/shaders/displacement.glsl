@@ -3,8 +3,11 @@
 // their vertices; each fragment reads the displacement texture at (u, v) and is kept by an
 // alpha test against its h (a discard), then drawn opaque with the depth test:
 //   u_test 0  fill (Dietrich, §3.1): height >= h, fills the inside, draws the base h = 0
+//             (orthogonal and screen slicing too: their slices and the base, so height 0
+//             is surface)
 //   u_test 1  bound (Schaufler, §3.1): |height - h| <= u_bound (one slice spacing)
-//   u_test 2  subtract the ramp (§3.2, §3.3): height - h > 0 (zero displacement masked out)
+// Where the height is 0 and the colour's alpha is below 0.5 there is nothing (a projected
+// mesh's background): no fragment is kept there.
 // The normal is that of the displaced surface S(u, v) = X(u, v, height(u, v)) through the
 // slice's tangent frame (the tetrahedron's Jacobian d X / d(u, v, h)).
 //! defines: UNLIT
@@ -50,15 +53,15 @@ in vec3 v_jv;
 in vec3 v_jh;
 
 bool keep(float height, float h) {
-    if (u_test == 0) return height >= h;
     if (u_test == 1) return abs(height - h) <= u_bound;
-    return height - h > 0.0;
+    return height >= h;
 }
 
 void main() {
     vec2 st = v_uvh.xy * u_tile;
     float height = disp_height(st);
-    if (!keep(height, v_uvh.z)) discard;
+    vec4 base = texture(u_color, st);
+    if (!keep(height, v_uvh.z) || (height <= 0.0 && base.a < 0.5)) discard;
     // the height gradient by central differences one texel apart, in base uv units
     vec2 texel = 1.0 / vec2(u_hf_size);
     float dhs = (disp_height(st + vec2(texel.x, 0.0)) - disp_height(st - vec2(texel.x, 0.0)))
@@ -71,11 +74,10 @@ void main() {
     float len = length(n);
     n = len > 1e-20 ? n / len : normalize(v_jh);
     if (dot(n, v_jh) < 0.0) n = -n;  // away from the base, whatever the uv orientation
-    vec3 base = texture(u_color, st).rgb;
 #if defined UNLIT
-    vec3 rgb = base;
+    vec3 rgb = base.rgb;
 #else
-    vec3 rgb = shade_phong(base, n, towards_eye(v_world), 1.0);
+    vec3 rgb = shade_phong(base.rgb, n, towards_eye(v_world), 1.0);
 #endif
     write_frame(vec4(rgb, 1.0), v_world, n);
     write_iterations(1, 0, true);
