@@ -24,9 +24,15 @@ Choices (the paper leaves them open):
   normal faces +w (the box's outside, where its plane's faces face; the plane is chosen
   nearly tangent to the model) and those facing -w. Each half is voxelized separately; where
   both occupy a voxel the +w one wins, so a thin double-sided sheet shows its outer side's
-  colour and normal instead of a mix (whose normal cancels). Column-wise (the shells) the
-  outside sample is the highest occupied voxel, the one seen first from the w = 1 side.
-  Solid-mode inside information is not used: a box holds a patch of the mesh, never closed.
+  colour and normal instead of a mix (whose normal cancels). ``"average"`` averages the
+  surfaces that share a voxel. Solid-mode inside information is not used: a box holds a
+  patch of the mesh, never closed.
+* The shells, with either choice, keep each column's outermost surface: the colour and
+  normal of its highest occupied voxel, the one seen first from the w = 1 side (the box's
+  outside), and, for the shell, the middle of the run of occupied voxels ending there as its
+  displacement. One colour and displacement per texel cannot show two surfaces, and those
+  below the outermost are hidden by it in the mesh (a roof's rafters, the far side of a
+  leg); averaging the whole column showed them through and put the shell between them.
 * Automatic shell thickness: the standard deviation of the acquired displacements over all
   covered texels of all boxes (the paper: "over all acquired texel positions"; one global
   value, as `BillboardBoxes` has one thickness), clamped to [1/D, 1] so a shell is at least
@@ -97,8 +103,9 @@ def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float 
     ``epsilon``, ``max_planes`` and ``texel_size`` choose the planes as for the flat cloud
     (`bake_billboard_cloud`). ``thickness`` (shell only) is the shell's interval width as a
     fraction of the box depth, in (0, 1], or None for the automatic one (see the module).
-    ``surfaces`` is how samples of several surfaces in one voxel or column combine:
-    ``"average"`` (equal weights) or ``"outside"`` (the one seen from the box's outside).
+    ``surfaces`` is how samples of several surfaces in one voxel combine: ``"average"``
+    (equal weights) or ``"outside"`` (the one seen from the box's outside); the shells keep
+    each column's outermost surface either way.
     ``progress(done, total)`` counts faces assigned to planes, then the flat cloud's planes
     baked, then the boxes. Raises UsageError for bad options or work that would not fit.
     """
@@ -123,7 +130,7 @@ def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float 
         box_to_world = plane_box(plane, plan.epsilon)
         voxels = _box_voxels(mesh, plane, box_to_world, depth, surfaces, ctx)
         transforms.append(box_to_world)
-        maps.append(_variant_maps(voxels, variant, surfaces))
+        maps.append(_variant_maps(voxels, variant))
         report(faces + count + k + 1)
 
     shell = None
@@ -260,22 +267,17 @@ def _inside_box(mesh: RenderMesh, faces: np.ndarray, box_to_world: np.ndarray) -
 
 # -- the variants -----------------------------------------------------------------------
 
-def _variant_maps(voxels: _Voxels, variant: str, surfaces: str) -> _Maps:
+def _variant_maps(voxels: _Voxels, variant: str) -> _Maps:
     if variant == "volumetric":
         return _Maps(_encode_color(voxels.color, voxels.occupied),
                      _encode_normal(voxels.normal), None, voxels.occupied)
     covered = voxels.occupied.any(axis=0)
     lowest, highest = _column_extremes(voxels.occupied)
-    color, normal = _column_attributes(voxels, highest if surfaces == "outside" else None)
+    color, normal = _outermost(voxels, highest)
     d = voxels.depth
     if variant == "shell":
-        if surfaces == "outside":
-            w = (highest + 0.5) / d
-        else:
-            centres = (np.arange(d) + 0.5) / d
-            count = np.maximum(voxels.occupied.sum(axis=0), 1)
-            w = np.tensordot(centres, voxels.occupied.astype(np.float64), axes=1) / count
-        displacement = _encode_w(np.where(covered, w, 0.0))[..., None]
+        middle = (_outer_run_bottom(voxels.occupied, highest) + highest + 1) / 2 / d
+        displacement = _encode_w(np.where(covered, middle, 0.0))[..., None]
         return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement, None)
     interval = np.stack([np.where(covered, lowest / d, 0.0),
                          np.where(covered, (highest + 1) / d, 0.0)], axis=-1)
@@ -292,18 +294,24 @@ def _column_extremes(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lowest, highest
 
 
-def _column_attributes(voxels: _Voxels, pick: np.ndarray | None):
-    """(H, W, 4) colour and (H, W, 3) unit normal per column: of the voxel ``pick`` (the
-    outside one), or the equal-weight mean over the column's occupied voxels."""
-    if pick is not None:
-        index = pick[None, ..., None]
-        color = np.take_along_axis(voxels.color, index, axis=0)[0]
-        normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
-        return color, normal
-    count = voxels.occupied.sum(axis=0)[..., None].astype(np.float32)
-    color = np.divide(voxels.color.sum(axis=0), count, out=np.zeros(count.shape[:2] + (4,),
-                      np.float32), where=count > 0)
-    return color, _unit(voxels.normal.sum(axis=0))
+def _outer_run_bottom(occupied: np.ndarray, highest: np.ndarray) -> np.ndarray:
+    """(H, W) index of the lowest voxel of the run of occupied voxels that ends at
+    ``highest``: the outermost surface's extent in each column (a sloped sheet spans
+    several voxels; whatever lies below the first gap is another surface)."""
+    d = occupied.shape[0]
+    gaps = ~occupied & (np.arange(d)[:, None, None] < highest[None])
+    return np.where(gaps.any(axis=0), d - np.argmax(gaps[::-1], axis=0), 0)
+
+
+def _outermost(voxels: _Voxels, highest: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(H, W, 4) colour and (H, W, 3) normal of each column's highest occupied voxel: the
+    surface seen from the box's outside. A shell stores one colour per texel, and the
+    surfaces below the outermost one are hidden behind it (a roof's rafters, a body's far
+    side); averaging them in would show what the mesh hides."""
+    index = highest[None, ..., None]
+    color = np.take_along_axis(voxels.color, index, axis=0)[0]
+    normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
+    return color, normal
 
 
 def _auto_thickness(maps: list[_Maps], depth: int) -> float:
@@ -337,11 +345,6 @@ def _encode_color(linear: np.ndarray, occupied: np.ndarray) -> np.ndarray:
     """sRGB uint8 colour with alpha 255 where occupied, 0 elsewhere."""
     rgba = np.concatenate([linear[..., :3], occupied[..., None].astype(np.float32)], axis=-1)
     return to_rgba8(rgba)
-
-
-def _unit(vectors: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(vectors, axis=-1, keepdims=True)
-    return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-6)
 
 
 def _encode_normal(normal: np.ndarray) -> np.ndarray:
