@@ -177,7 +177,7 @@ def tables(name: str, mesh, reps: dict, seconds: dict) -> tuple[dict, dict, dict
     """Table 1 and Table 2 rows, and the decimated meshes by the representation they match."""
     generation = reps["bbc"].params["generation"]
     t1 = {"asset": name, "faces": mesh.triangle_count, "planes": reps["bbc"].count,
-          "skipped": generation["skipped"], "generation_s": generation["seconds"],
+          "skipped": generation["skipped"], "generation_s": reps["bbc"].generation_seconds,
           "voxels_across": reps["volumetric"].params["voxels_across"],
           "thickness": reps["shell"].thickness,
           **{f"{k}_bake_s": v for k, v in seconds.items()}}

@@ -37,10 +37,7 @@ Choices (the paper leaves them open):
   covered texels of all boxes (the paper: "over all acquired texel positions"; one global
   value, as `BillboardBoxes` has one thickness), clamped to [1/D, 1] so a shell is at least
   one voxel thick.
-* Distance: per voxel centre, the Euclidean distance to the nearest occupied voxel centre,
-  measured in units of the smallest of the three voxel sides, rounded down (a stored step
-  never exceeds the true one) and clamped at `MAX_DISTANCE`. For the shells, an occupied
-  voxel is a cell that overlaps the texel's interval in w.
+* The distance textures: see `distance` (the same code checks a file's on load).
 """
 
 from __future__ import annotations
@@ -54,8 +51,9 @@ from ...colorspace import to_rgba8
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
 from .bake import bake_plan, plane_box
-from .boxes import MAX_DISTANCE, VARIANTS, BillboardBox, BillboardBoxes
+from .boxes import VARIANTS, BillboardBox, BillboardBoxes, shell_thickness
 from .cloud import BillboardPlane, build_billboard_cloud
+from .distance import DISP_SCALE, distance_texture, occupancy
 
 SURFACES = ("average", "outside")
 #: Most voxels all boxes together may have (256 M: 2 GiB of volumetric colour, normal and
@@ -63,7 +61,6 @@ SURFACES = ("average", "outside")
 MAX_TOTAL_VOXELS = 1 << 28
 #: A voxel whose surface coverage exceeds this is occupied: any sample line meets the surface.
 OCCUPIED_ABOVE = 0.0
-_DISP_SCALE = 65535
 _EDGE = 1e-5  # box units: vertices are kept this far inside the box (half-open voxel bounds)
 _NOTHING_INSIDE = "no part of the mesh was found inside"
 
@@ -84,14 +81,12 @@ class _Voxels:
 
 @dataclass(eq=False)
 class _Maps:
-    """A box's maps before the distance texture: what `BillboardBox` stores, plus the
-    occupancy the distance is measured to (volumetric and thick shell) or None (the shell's
-    depends on the cloud-wide thickness)."""
+    """A box's maps before the distance texture (the shell's depends on the cloud-wide
+    thickness)."""
 
     color: np.ndarray
     normal: np.ndarray
     displacement: np.ndarray | None
-    occupied: np.ndarray | None
 
 
 def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float = 0.05,
@@ -136,10 +131,10 @@ def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float 
     shell = None
     if variant == "shell":
         shell = _auto_thickness(maps, depth) if thickness is None else float(thickness)
-        for m in maps:
-            m.occupied = _shell_occupancy(m, shell, depth)
     boxes = [BillboardBox(box_to_world=t, color=m.color, normal=m.normal,
-                          distance=_distance(m.occupied, t), displacement=m.displacement)
+                          distance=distance_texture(occupancy(variant, m.color, m.displacement,
+                                                              depth, shell), t),
+                          displacement=m.displacement)
              for t, m in zip(transforms, maps, strict=True)]
     params = {"variant": variant, "epsilon": plan.epsilon_fraction,
               "texel_size": plan.texel_size, "voxels_across": depth,
@@ -162,10 +157,7 @@ def _check_options(variant, thickness, surfaces) -> None:
         return
     if variant != "shell":
         raise UsageError(f"thickness applies only to the shell variant, not {variant!r}")
-    if isinstance(thickness, bool) or not isinstance(thickness, (int, float, np.number)) \
-            or not 0 < float(thickness) <= 1:
-        raise UsageError(f"thickness must be a number in (0, 1] (a fraction of the box "
-                         f"depth) or None for automatic, got {thickness!r}")
+    shell_thickness(thickness)
 
 
 def _check_size(planes: tuple[BillboardPlane, ...], depth: int, texel: float) -> None:
@@ -270,7 +262,7 @@ def _inside_box(mesh: RenderMesh, faces: np.ndarray, box_to_world: np.ndarray) -
 def _variant_maps(voxels: _Voxels, variant: str) -> _Maps:
     if variant == "volumetric":
         return _Maps(_encode_color(voxels.color, voxels.occupied),
-                     _encode_normal(voxels.normal), None, voxels.occupied)
+                     _encode_normal(voxels.normal), None)
     covered = voxels.occupied.any(axis=0)
     lowest, highest = _column_extremes(voxels.occupied)
     color, normal = _outermost(voxels, highest)
@@ -278,12 +270,10 @@ def _variant_maps(voxels: _Voxels, variant: str) -> _Maps:
     if variant == "shell":
         middle = (_outer_run_bottom(voxels.occupied, highest) + highest + 1) / 2 / d
         displacement = _encode_w(np.where(covered, middle, 0.0))[..., None]
-        return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement, None)
+        return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement)
     interval = np.stack([np.where(covered, lowest / d, 0.0),
                          np.where(covered, (highest + 1) / d, 0.0)], axis=-1)
-    displacement = _encode_w(interval)
-    return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement,
-                 _interval_occupancy(displacement, covered, d))
+    return _Maps(_encode_color(color, covered), _encode_normal(normal), _encode_w(interval))
 
 
 def _column_extremes(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -318,28 +308,11 @@ def _auto_thickness(maps: list[_Maps], depth: int) -> float:
     """The standard deviation of the stored displacements of every covered texel of every
     box, clamped to [one voxel, the whole box]."""
     values = np.concatenate([m.displacement[..., 0][m.color[..., 3] >= 128] for m in maps])
-    spread = float(np.std(values / _DISP_SCALE)) if values.size else 0.0
+    spread = float(np.std(values / DISP_SCALE)) if values.size else 0.0
     return min(max(spread, 1.0 / depth), 1.0)
 
 
-def _shell_occupancy(maps: _Maps, thickness: float, depth: int) -> np.ndarray:
-    """The cells the shell's intervals [d - t/2, d + t/2] (within [0, 1]) overlap."""
-    d = maps.displacement[..., 0] / _DISP_SCALE
-    interval = np.stack([np.clip(d - thickness / 2, 0, 1), np.clip(d + thickness / 2, 0, 1)],
-                        axis=-1)
-    return _interval_occupancy(interval * _DISP_SCALE, maps.color[..., 3] >= 128, depth)
-
-
-def _interval_occupancy(interval: np.ndarray, covered: np.ndarray, depth: int) -> np.ndarray:
-    """(D, H, W): cell k of a covered column is occupied when [k/D, (k+1)/D] overlaps its
-    interval (given in units of 1/65535) by more than the encoding's rounding."""
-    lo, hi = (interval[..., i].astype(np.float64) / _DISP_SCALE for i in (0, 1))
-    tol = 1.0 / _DISP_SCALE
-    k = np.arange(depth, dtype=np.float64)[:, None, None]
-    return covered[None] & (k / depth < hi[None] - tol) & ((k + 1) / depth > lo[None] + tol)
-
-
-# -- encodings and the distance texture -------------------------------------------------
+# -- encodings --------------------------------------------------------------------------
 
 def _encode_color(linear: np.ndarray, occupied: np.ndarray) -> np.ndarray:
     """sRGB uint8 colour with alpha 255 where occupied, 0 elsewhere."""
@@ -353,25 +326,4 @@ def _encode_normal(normal: np.ndarray) -> np.ndarray:
 
 
 def _encode_w(w: np.ndarray) -> np.ndarray:
-    return np.round(np.clip(w, 0.0, 1.0) * _DISP_SCALE).astype(np.uint16)
-
-
-def _distance(occupied: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
-    """(D, H, W) uint8: from each voxel centre to the nearest occupied voxel centre, in
-    units of the smallest voxel side, rounded down, clamped at MAX_DISTANCE (all of it
-    where the box is empty)."""
-    from scipy.ndimage import distance_transform_edt
-
-    if not occupied.any():
-        return np.full(occupied.shape, MAX_DISTANCE, np.uint8)
-    sides = voxel_sides(box_to_world, occupied.shape)
-    distance = distance_transform_edt(~occupied, sampling=sides / sides.min())
-    return np.minimum(np.floor(distance + 1e-6), MAX_DISTANCE).astype(np.uint8)
-
-
-def voxel_sides(box_to_world: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
-    """World lengths of a (D, H, W) grid's voxel sides, in array order (w, v, u)."""
-    lengths = np.linalg.norm(np.asarray(box_to_world)[:3, :3], axis=0)
-    d, h, w = shape
-    return np.array([lengths[2] / d, lengths[1] / h, lengths[0] / w])
-
+    return np.round(np.clip(w, 0.0, 1.0) * DISP_SCALE).astype(np.uint16)

@@ -81,13 +81,13 @@ class BillboardCloudPlan:
     skipped_reason: str | None = field(default=None)
 
     def summary(self) -> dict:
-        """Plane and face counts, what was skipped and why, time and texture size."""
+        """Plane and face counts, what was skipped and why, and texture size (not the time:
+        the summary goes into the file, which depends only on the bake's inputs)."""
         return {
             "planes": len(self.planes),
             "faces_per_plane": [int(len(p.faces)) for p in self.planes],
             "skipped": int(len(self.skipped)),
             "skipped_reason": self.skipped_reason,
-            "seconds": round(self.seconds, 3),
             "texels": int(sum(p.resolution[0] * p.resolution[1] for p in self.planes)),
         }
 
