@@ -133,8 +133,8 @@ def _check_distances(rep: BillboardBoxes) -> None:
         unsafe = int((box.distance > box_distance(box, rep.variant, rep.thickness)).sum())
         if unsafe:
             raise FormatError(f"dmbbc box {k}: its distance texture exceeds the distance to "
-                              f"its occupied cells at {unsafe:,} voxels (a damaged or "
-                              "forged file)")
+                              f"its occupied cells in {unsafe:,} of its {box.distance.size:,} "
+                              "voxels (a damaged or forged file)")
 
 
 CODECS = (
