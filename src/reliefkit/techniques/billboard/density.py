@@ -16,8 +16,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ...reference.heightfield import JIT_OPTIONS
 
-@njit(parallel=True, cache=True, nogil=True, error_model="numpy")
+
+@njit(parallel=True, **JIT_OPTIONS)
 def add_faces(diff, points, tris, normals, areas, dirs, eps, eps2, base, outer, penalty,
               sign):
     """Add ``sign`` x the increments of faces ``tris`` (indices into ``points``) to ``diff``.
