@@ -101,26 +101,34 @@ def convex_proxy(planes: np.ndarray, near=(0.0, 0.0, 0.0)) -> Proxy:
     """Triangulated intersection of halfspaces ``planes @ (x, 1) <= 0``.
 
     Solved around ``near`` (a world point close to the region, e.g. a box's centre) and then
-    around a point inside: the solvers' tolerances are relative to the coordinates'
-    magnitude, which far from the world origin would swamp the box.
+    around a point inside, in units of the planes' largest distance from ``near``: the
+    solvers' tolerances are absolute, which far from the world origin would swamp the box,
+    and for a tiny box (a mesh scaled by 1e-9) exceed it.
     """
     planes = _normalise(np.asarray(planes, dtype=np.float64))
     near = np.asarray(near, dtype=np.float64)
-    origin = near + _interior_point(_moved(planes, near))
-    local = _moved(planes, origin)
-    vertices = HalfspaceIntersection(local, np.zeros(3)).intersections
-    hull = ConvexHull(vertices)
+    around_near = _moved(planes, near)
+    size = float(np.abs(around_near[:, 3]).max()) or 1.0
+    origin = near + size * _interior_point(_scaled(around_near, size))
+    unit = HalfspaceIntersection(_scaled(_moved(planes, origin), size),
+                                 np.zeros(3)).intersections
+    hull = ConvexHull(unit)
     tris = hull.simplices.copy()
-    centre = vertices[hull.vertices].mean(axis=0)
-    a, b, c = (vertices[tris[:, k]] for k in range(3))
+    centre = unit[hull.vertices].mean(axis=0)
+    a, b, c = (unit[tris[:, k]] for k in range(3))
     outward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - centre) > 0
     tris[~outward] = tris[~outward][:, ::-1]
-    return Proxy(vertices.astype(np.float32), tris.astype(np.uint32), planes, origin)
+    return Proxy((size * unit).astype(np.float32), tris.astype(np.uint32), planes, origin)
 
 
 def _moved(planes: np.ndarray, origin: np.ndarray) -> np.ndarray:
     """The planes in coordinates relative to ``origin``."""
     return np.hstack([planes[:, :3], planes[:, 3:] + planes[:, :3] @ origin[:, None]])
+
+
+def _scaled(planes: np.ndarray, size: float) -> np.ndarray:
+    """The planes in coordinates divided by ``size``."""
+    return np.hstack([planes[:, :3], planes[:, 3:] / size])
 
 
 def _interior_point(planes: np.ndarray) -> np.ndarray:

@@ -16,8 +16,10 @@ def _results(vol_iou=0.9, bbc_iou=0.8, ratio=4.0, wrong=0.0, seconds=5.0, skippe
     return {"quality": [{"asset": "a", "distance": "near", "radii": 1.5, **scores}],
             "equal_error": [{"asset": "a", "variant": "volumetric", "ratio": ratio,
                              "uniform_samples": 4, "sphere_wrong": wrong}],
-            "generation": {"triangles": 100_000, "seconds": seconds, "skipped": skipped,
-                           "cpus": 2, "full_run": full},
+            "generation": [{"mesh": "m", "triangles": 100_000, "seconds": seconds,
+                            "skipped": skipped, "cpus": 2, "full_run": full},
+                           {"mesh": "curved", "triangles": 81_920, "seconds": 1.0,
+                            "skipped": 0, "cpus": 2, "full_run": full}],
             "dolly": [{"asset": "a", "switch_radii": 30.0, "switch_change": change,
                        "switch_motion": motion, "switch_static": static}]}
 
@@ -52,8 +54,8 @@ def test_tiny_run_writes_json_and_markdown(tmp_path, monkeypatch):
     monkeypatch.delenv(bench.MESH_ENV, raising=False)
     cfg = bench.BenchConfig(assets=("vehicle",), texel_divisor=48, size=48,
                             azimuths=(30.0,), repeats=1, uniform_samples=(1, 4),
-                            big_asset="vehicle", big_subdivisions=0, generation_tries=1,
-                            fig6_points=2, dolly_frames=12, quick=True)
+                            big_asset="vehicle", big_subdivisions=0, curved_subdivisions=2,
+                            generation_tries=1, fig6_points=2, dolly_frames=12, quick=True)
     lines = []
     results = bench.run(cfg, log=lines.append)
     paths = bench.write(results, tmp_path)
@@ -63,7 +65,8 @@ def test_tiny_run_writes_json_and_markdown(tmp_path, monkeypatch):
     q = data["quality"][0]
     assert data["targets"][0]["met"] == (q["volumetric"]["iou"] > q["bbc"]["iou"]
                                          and q["volumetric"]["ssim"] > q["bbc"]["ssim"])
-    assert not data["generation"]["full_run"]
+    assert [g["full_run"] for g in data["generation"]] == [False, False]
+    assert data["generation"][1]["triangles"] == 20 * 4 ** 2  # the bumpy sphere, curved
     assert any(bench.MESH_ENV in note for note in data["notes"])
     text = paths[1].read_text()
     assert "#### Table 1" in text and "#### Targets" in text and "vehicle" in text

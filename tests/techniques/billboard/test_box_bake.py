@@ -6,40 +6,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from billboard_scenes import colour_of, flat, quads, stacked
 
 from reliefkit.colorspace import srgb_decode
 from reliefkit.errors import UsageError
 from reliefkit.scene.mesh import RenderMesh
 from reliefkit.techniques.billboard.bake import bake_billboard_cloud
-from reliefkit.techniques.billboard.box_bake import bake_boxes, voxel_sides
+from reliefkit.techniques.billboard.box_bake import bake_boxes
 from reliefkit.techniques.billboard.boxes import MAX_DISTANCE
-
-
-def colour_of(points: np.ndarray) -> np.ndarray:
-    """The test meshes' linear colour at world points: linear in position."""
-    p = np.asarray(points, dtype=np.float64)
-    return np.stack([0.2 + 0.3 * (p[..., 0] + 1), 0.2 + 0.3 * (p[..., 1] + 1),
-                     0.2 + 0.3 * (p[..., 2] + 1), np.ones(p.shape[:-1])], axis=-1)
-
-
-def quads(*corner_sets, colours=None) -> RenderMesh:
-    """Flat-shaded quads (4 corners each, counter-clockwise seen from their normal side)."""
-    positions, indices, normals, colors = [], [], [], []
-    for q, corners in enumerate(corner_sets):
-        c = np.asarray(corners, dtype=np.float64)
-        n = np.cross(c[1] - c[0], c[2] - c[0])
-        positions.append(c)
-        indices += [[4 * q, 4 * q + 1, 4 * q + 2], [4 * q, 4 * q + 2, 4 * q + 3]]
-        normals.append(np.tile(n / np.linalg.norm(n), (4, 1)))
-        colors.append(colour_of(c) if colours is None else np.tile(colours[q], (4, 1)))
-    return RenderMesh(np.concatenate(positions), indices, np.concatenate(normals),
-                      np.concatenate(colors), name="quads")
-
-
-def flat(z: float, half=(1.0, 0.5), down=False) -> np.ndarray:
-    x, y = half
-    corners = np.array([[-x, -y, z], [x, -y, z], [x, y, z], [-x, y, z]])
-    return corners[::-1] if down else corners
+from reliefkit.techniques.billboard.distance import voxel_sides
 
 
 def cube(subdivisions: int = 3) -> RenderMesh:
@@ -221,11 +196,6 @@ def test_outside_prefers_the_outer_side_of_a_thin_double_sided_sheet(gl):
 
 # -- 3, 4: shells -----------------------------------------------------------------------
 
-def stacked(gap: float = 0.1) -> RenderMesh:
-    """Two parallel quads ``gap`` apart: within epsilon 0.05 (0.112) of one plane."""
-    return quads(flat(0.0), flat(gap, half=(0.9, 0.45)))
-
-
 def test_a_shell_of_a_plane_parallel_quad_displaces_to_its_w(gl):
     mesh = quads(flat(0.0))
     boxes = bake_boxes(mesh, "shell", epsilon=0.05, texel_size=0.045, thickness=0.3)
@@ -256,29 +226,87 @@ def test_automatic_thickness_is_the_spread_of_the_displacements(gl):
     assert one.thickness == pytest.approx(1 / one.boxes[0].resolution[2])  # no spread: clamp
 
 
-def test_a_shell_of_stacked_quads_picks_the_upper_or_the_mean(gl):
-    mesh = stacked()
-    kw = {"epsilon": 0.05, "texel_size": 0.03, "thickness": 0.2}
-    upper = bake_boxes(mesh, "shell", surfaces="outside", **kw)
-    mean = bake_boxes(mesh, "shell", **kw)
-    assert len(upper.boxes) == len(mean.boxes) == 1
-    box_up, box_mean = upper.boxes[0], mean.boxes[0]
-    depth = box_up.resolution[2]
-    w_low, k_low = plane_w(box_up, flat(0.0)[:3])
-    w_high, k_high = plane_w(box_up, flat(0.1)[:3])
-    assert (k_high > k_low).all()
-    points = column_points(box_up)
+@pytest.mark.parametrize("surfaces", ["average", "outside"])
+def test_a_shell_of_stacked_quads_keeps_the_upper_one(gl, surfaces):
+    """The lower quad is hidden under the upper one from the box's outside: the shell sits on
+    the upper quad and shows its colour, whichever way shared voxels combine."""
+    boxes = bake_boxes(stacked(), "shell", epsilon=0.05, texel_size=0.03, thickness=0.2,
+                       surfaces=surfaces)
+    (box,) = boxes.boxes
+    depth = box.resolution[2]
+    w_high, k_high = plane_w(box, flat(0.1)[:3])
+    _, k_low = plane_w(box, flat(0.0)[:3])
+    assert (k_high > k_low + 1).all()  # a gap between the two: two surfaces
+    points = column_points(box)
     both = (np.abs(points[..., 0]) < 0.85) & (np.abs(points[..., 1]) < 0.4)
-    d_up = box_up.displacement[..., 0] / 65535
-    d_mean = box_mean.displacement[..., 0] / 65535
-    assert np.allclose(d_up[both], ((k_high + 0.5) / depth)[both], atol=1 / 65535)
-    assert np.allclose(d_mean[both], ((k_low + k_high + 1) / 2 / depth)[both], atol=1 / 65535)
-    # the upper quad's colour, or the mean of both
-    rgb_up, rgb_mean = decoded_rgb(box_up.color[both]), decoded_rgb(box_mean.color[both])
-    high = colour_of(column_points(box_up, w_high))[both][:, :3]
-    low = colour_of(column_points(box_up, w_low))[both][:, :3]
-    assert np.abs(rgb_up - high).max() < 0.01
-    assert np.abs(rgb_mean - (high + low) / 2).max() < 0.01
+    d = box.displacement[..., 0] / 65535
+    assert np.allclose(d[both], ((k_high + 0.5) / depth)[both], atol=1 / 65535)
+    high = colour_of(column_points(box, w_high))[both][:, :3]
+    assert np.abs(decoded_rgb(box.color[both]) - high).max() < 0.01
+
+
+def sawtooth_z(x: np.ndarray) -> np.ndarray:
+    """Teeth 0.2 wide between z = -0.1 and 0.1: slopes of 2, two voxels per column."""
+    phase = np.mod(x + 1, 0.2) / 0.1
+    return 0.1 * (np.minimum(phase, 2 - phase) * 2 - 1)
+
+
+def test_a_shell_of_a_steep_surface_sits_in_the_middle_of_its_voxels(gl):
+    """Where one surface crosses several voxels of a column, the shell's displacement is the
+    middle of that run: within half a voxel of where the surface crosses the column's centre
+    line (not its highest voxel, which sits up to the run's half length above it)."""
+    x = np.linspace(-1, 1, 21)
+    mesh = quads(*[[[a, -0.5, sawtooth_z(a)], [b, -0.5, sawtooth_z(b)],
+                    [b, 0.5, sawtooth_z(b)], [a, 0.5, sawtooth_z(a)]]
+                   for a, b in zip(x[:-1], x[1:], strict=True)])
+    (box,) = bake_boxes(mesh, "shell", epsilon=0.05, texel_size=0.02, thickness=0.2).boxes
+    depth = box.resolution[2]
+    points = column_points(box)
+    surface = np.stack([points[..., 0], points[..., 1], sawtooth_z(points[..., 0])], -1)
+    w = to_box(box, surface)[..., 2]
+    kink = np.abs(np.mod(points[..., 0] + 1 + 0.05, 0.1) - 0.05)  # distance to a kink
+    steep = interior(box) & (kink > 0.02) & (box.color[..., 3] == 255)
+    d = box.displacement[..., 0] / 65535
+    assert steep.sum() > 100
+    assert np.abs(d - w)[steep].max() <= 0.75 / depth
+
+
+def closed_box_around_a_red_plate() -> RenderMesh:
+    """A closed grey cube of side 2 and, hidden inside it 0.1 under the lid (within
+    epsilon 0.05, 0.17, of the lid's plane), a red double-sided plate."""
+    grey, red = (0.5, 0.5, 0.5, 1.0), (0.9, 0.05, 0.05, 1.0)
+    square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float)
+    sides = []
+    for axis in range(3):
+        for sign in (-1, 1):
+            corners = np.insert(square, axis, sign, axis=1)
+            normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+            sides.append(corners if normal[axis] * sign > 0 else corners[::-1])
+    plate = [flat(0.9, half=(0.8, 0.8)), flat(0.89, half=(0.8, 0.8), down=True)]
+    return quads(*sides, *plate, colours=[grey] * 6 + [red] * 2)
+
+
+@pytest.mark.parametrize("variant", ["shell", "thick-shell"])
+def test_shells_do_not_show_what_a_closed_model_hides(gl, variant):
+    """The plate shares the lid's box and columns; the mesh hides it, so must the shells with
+    the default surfaces (averaging each column showed it through the lid as a red tint)."""
+    from reliefkit.render import render
+    from reliefkit.scene.camera import Camera
+    from reliefkit.scene.light import DirectionalLight
+
+    mesh = closed_box_around_a_red_plate()
+    boxes = bake_boxes(mesh, variant, epsilon=0.05, texel_size=0.05)
+    centres = [b.box_to_world[:3] @ [0.5, 0.5, 0.5, 1] for b in boxes.boxes]
+    assert sum(c[2] > 0.5 for c in centres) == 1  # the plate is in the lid's box
+    camera = Camera(eye=(0.6, 1.0, 3.5), target=(0, 0, 0), up=(0, 1, 0), size=(96, 96),
+                    fov_deg=40, near=0.5, far=10)
+    light = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)
+    truth, frame = render(mesh, camera, light=light), render(boxes, camera, light=light)
+    both = truth.mask & frame.mask
+    assert both.sum() > 0.9 * truth.mask.sum()
+    assert np.abs(truth.color[truth.mask, :3] - 0.5).max() < 0.01  # the mesh shows grey only
+    tint = frame.color[both, 0] - frame.color[both, 1]
+    assert np.abs(frame.color[both, :3] - 0.5).max() < 0.02, f"red tint up to {tint.max():.3f}"
 
 
 def test_a_thick_shell_of_stacked_quads_spans_both_cells(gl):

@@ -348,6 +348,26 @@ def test_far_from_the_origin_renders_the_same(boxes_drawable, variant):
     assert wrong_hits(far_frame, moved, far_camera)["wrong_fraction"] <= 1e-3
 
 
+def test_a_tiny_box_renders_like_a_unit_one(boxes_drawable):
+    """Scaled by 1e-9 (world and camera), a box draws the same pixels: its proxy is solved
+    in units of its own size (absolute solver tolerances failed it with a QhullError)."""
+    scale = 1e-9
+    boxes, tiny = scenes()["thick-shell"], scenes()["thick-shell"]
+    for box in tiny.boxes:
+        box.box_to_world = np.diag([scale] * 3 + [1.0]) @ box.box_to_world
+    eye, near, far = np.array([2.2, 1.0, 1.6]), 0.5, 10.0
+    camera = Camera(eye=tuple(eye), target=(0, 0, 0), size=SIZE, fov_deg=45, near=near,
+                    far=far)
+    tiny_camera = Camera(eye=tuple(scale * eye), target=(0, 0, 0), size=SIZE, fov_deg=45,
+                         near=scale * near, far=scale * far)
+    unit = render(boxes, camera, light=FLAT, march="exact")
+    small = render(tiny, tiny_camera, light=FLAT, march="exact")
+    assert unit.mask.sum() > 300
+    assert (unit.mask != small.mask).mean() <= 1e-3
+    both = unit.mask & small.mask
+    assert (np.abs(unit.color[both] - small.color[both]).max(axis=1) < 3e-3).mean() > 0.995
+
+
 @pytest.mark.parametrize("march", box_render.MARCHES)
 def test_instrumented_pass_draws_the_same_pixels(boxes_drawable, march):
     boxes = scenes()["thick-shell"]

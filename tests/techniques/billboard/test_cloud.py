@@ -236,6 +236,31 @@ def test_removing_faces_leaves_the_density_of_the_rest():
         assert np.allclose(g.diff, fresh.diff, rtol=0, atol=1e-9 * scale)
 
 
+def test_the_density_is_every_faces_gain_and_penalty_bin_by_bin():
+    """The difference arrays' density against a direct sum over (face, direction, bin): +area
+    x |cos| where the bin's rho is valid for the face (every vertex within epsilon), -10x
+    that on the outer miss band (the plane would be valid moved outwards by < epsilon), for
+    faces that fit in 2 epsilon. Bin coordinates in float32, as the grid rounds them."""
+    mesh = uv_sphere(8, 16)
+    diag = _diagonal(mesh)
+    faces = _Faces(mesh, 0.05 * diag)
+    g = _Grid(faces, _hemisphere_directions(0.1), 0.1, diag, 0.025 * diag, 10.0)
+    eps = np.float32(faces.eps / g.width)
+    proj = (faces.tri / g.width).astype(np.float32) @ g.dirs32.T          # (F, 3, D)
+    low = proj.min(axis=1) + np.float32(-g.start / g.width)          # (F, D) bin units
+    high = proj.max(axis=1) + np.float32(-g.start / g.width)
+    gain = faces.area[:, None] * np.abs(faces.normal @ g.dirs.T) * (high - low <= 2 * eps)
+    k = np.arange(g.bins, dtype=np.float32)[None, None, :]
+    low, high, gain = low[..., None], high[..., None], gain[..., None]
+    valid = (k >= high - eps) & (k <= low + eps)
+    outer = (k >= g.first_outer) & (k >= high - 2 * eps) & (k < high - eps)
+    inner = (k < g.first_outer) & (k > low + eps) & (k <= low + 2 * eps)
+    expected = (gain * (valid - 10.0 * (outer | inner))).sum(axis=0)   # (D, bins)
+    density = np.cumsum(g.diff[:, :-1], axis=1)
+    assert np.abs(expected).max() > 0 and (outer | inner).any()
+    np.testing.assert_allclose(density, expected, rtol=0, atol=1e-5 * np.abs(expected).max())
+
+
 def test_the_rho_sweep_finds_the_highest_density_in_its_window():
     """The windowed sweep against the penalized density evaluated face by face."""
     mesh = make_asset("vehicle")

@@ -107,3 +107,24 @@ def test_pixels_hand_over_to_the_cloud_in_proportion(gl):
     both = lod.mask & cloud.mask
     same = (np.abs(lod.color - cloud.color).max(axis=-1) < 1e-6) & both
     assert 0.3 < same.sum() / both.sum() < 0.7
+
+
+@pytest.mark.parametrize("refused, accepted, message", [
+    ({"lod": "auto", "flatten": 0.5}, {"flatten": 0.5}, "flatten applies with lod off"),
+    ({"transition": 0.3}, {"lod": "auto", "transition": 0.3},
+     "transition applies only with lod auto"),
+    ({"march": "sphere", "samples": 4}, {"march": "uniform", "samples": 4},
+     "samples applies only to the uniform march"),
+])
+def test_options_that_another_option_voids_are_refused(gl, refused, accepted, message):
+    """--flatten with --lod auto was honoured near and dropped beyond the switch; the other
+    two were ignored outright."""
+    from reliefkit.errors import UsageError
+    from reliefkit.techniques.billboard import TECHNIQUE
+
+    boxes = TECHNIQUE.samples()["dmbbc"]
+    camera = Camera.orbit((0, 0, 0), 30, 20, 4.0, size=(32, 32))
+    with pytest.raises(UsageError, match=message) as error:
+        render(boxes, camera, **refused)
+    assert "\n" not in str(error.value)
+    assert render(boxes, camera, **accepted).mask.any()

@@ -66,7 +66,7 @@ def bake_plan(mesh: RenderMesh, plan: BillboardCloudPlan, *, progress=None,
         u_axes=np.stack([p.u_axis for p in plan.planes]),
         v_axes=np.stack([p.v_axis for p in plan.planes]),
         rects=rects, color=color, normal=normal, epsilon=plan.epsilon,
-        source_bounds=mesh.bounds, params=params)
+        source_bounds=mesh.bounds, params=params, generation_seconds=plan.seconds)
 
 
 def plane_box(plane: BillboardPlane, epsilon: float) -> np.ndarray:

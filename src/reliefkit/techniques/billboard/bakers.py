@@ -50,8 +50,9 @@ class BillboardBoxesParams:
                                     "the box depth (none: the standard deviation of the "
                                     "displacements, the paper's suggestion)", kind="float",
                                     lo=1e-6, hi=1.0)
-    surfaces: str = param("average", "several surfaces in one voxel or texel: average them "
-                          "or keep the one seen from outside", choices=SURFACES)
+    surfaces: str = param("average", "several surfaces in one voxel: average them or keep "
+                          "the one seen from outside (the shells keep each texel's outermost "
+                          "surface either way)", choices=SURFACES)
 
 
 def bake_dmbbc(source, p: BillboardBoxesParams, progress=None):

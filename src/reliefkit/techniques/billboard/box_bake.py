@@ -24,17 +24,20 @@ Choices (the paper leaves them open):
   normal faces +w (the box's outside, where its plane's faces face; the plane is chosen
   nearly tangent to the model) and those facing -w. Each half is voxelized separately; where
   both occupy a voxel the +w one wins, so a thin double-sided sheet shows its outer side's
-  colour and normal instead of a mix (whose normal cancels). Column-wise (the shells) the
-  outside sample is the highest occupied voxel, the one seen first from the w = 1 side.
-  Solid-mode inside information is not used: a box holds a patch of the mesh, never closed.
+  colour and normal instead of a mix (whose normal cancels). ``"average"`` averages the
+  surfaces that share a voxel. Solid-mode inside information is not used: a box holds a
+  patch of the mesh, never closed.
+* The shells, with either choice, keep each column's outermost surface: the colour and
+  normal of its highest occupied voxel, the one seen first from the w = 1 side (the box's
+  outside), and, for the shell, the middle of the run of occupied voxels ending there as its
+  displacement. One colour and displacement per texel cannot show two surfaces, and those
+  below the outermost are hidden by it in the mesh (a roof's rafters, the far side of a
+  leg); averaging the whole column showed them through and put the shell between them.
 * Automatic shell thickness: the standard deviation of the acquired displacements over all
   covered texels of all boxes (the paper: "over all acquired texel positions"; one global
   value, as `BillboardBoxes` has one thickness), clamped to [1/D, 1] so a shell is at least
   one voxel thick.
-* Distance: per voxel centre, the Euclidean distance to the nearest occupied voxel centre,
-  measured in units of the smallest of the three voxel sides, rounded down (a stored step
-  never exceeds the true one) and clamped at `MAX_DISTANCE`. For the shells, an occupied
-  voxel is a cell that overlaps the texel's interval in w.
+* The distance textures: see `distance` (the same code checks a file's on load).
 """
 
 from __future__ import annotations
@@ -48,8 +51,9 @@ from ...colorspace import to_rgba8
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
 from .bake import bake_plan, plane_box
-from .boxes import MAX_DISTANCE, VARIANTS, BillboardBox, BillboardBoxes
+from .boxes import VARIANTS, BillboardBox, BillboardBoxes, shell_thickness
 from .cloud import BillboardPlane, build_billboard_cloud
+from .distance import DISP_SCALE, distance_texture, occupancy
 
 SURFACES = ("average", "outside")
 #: Most voxels all boxes together may have (256 M: 2 GiB of volumetric colour, normal and
@@ -57,7 +61,6 @@ SURFACES = ("average", "outside")
 MAX_TOTAL_VOXELS = 1 << 28
 #: A voxel whose surface coverage exceeds this is occupied: any sample line meets the surface.
 OCCUPIED_ABOVE = 0.0
-_DISP_SCALE = 65535
 _EDGE = 1e-5  # box units: vertices are kept this far inside the box (half-open voxel bounds)
 _NOTHING_INSIDE = "no part of the mesh was found inside"
 
@@ -78,14 +81,12 @@ class _Voxels:
 
 @dataclass(eq=False)
 class _Maps:
-    """A box's maps before the distance texture: what `BillboardBox` stores, plus the
-    occupancy the distance is measured to (volumetric and thick shell) or None (the shell's
-    depends on the cloud-wide thickness)."""
+    """A box's maps before the distance texture (the shell's depends on the cloud-wide
+    thickness)."""
 
     color: np.ndarray
     normal: np.ndarray
     displacement: np.ndarray | None
-    occupied: np.ndarray | None
 
 
 def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float = 0.05,
@@ -97,8 +98,9 @@ def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float 
     ``epsilon``, ``max_planes`` and ``texel_size`` choose the planes as for the flat cloud
     (`bake_billboard_cloud`). ``thickness`` (shell only) is the shell's interval width as a
     fraction of the box depth, in (0, 1], or None for the automatic one (see the module).
-    ``surfaces`` is how samples of several surfaces in one voxel or column combine:
-    ``"average"`` (equal weights) or ``"outside"`` (the one seen from the box's outside).
+    ``surfaces`` is how samples of several surfaces in one voxel combine: ``"average"``
+    (equal weights) or ``"outside"`` (the one seen from the box's outside); the shells keep
+    each column's outermost surface either way.
     ``progress(done, total)`` counts faces assigned to planes, then the flat cloud's planes
     baked, then the boxes. Raises UsageError for bad options or work that would not fit.
     """
@@ -123,16 +125,16 @@ def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float 
         box_to_world = plane_box(plane, plan.epsilon)
         voxels = _box_voxels(mesh, plane, box_to_world, depth, surfaces, ctx)
         transforms.append(box_to_world)
-        maps.append(_variant_maps(voxels, variant, surfaces))
+        maps.append(_variant_maps(voxels, variant))
         report(faces + count + k + 1)
 
     shell = None
     if variant == "shell":
         shell = _auto_thickness(maps, depth) if thickness is None else float(thickness)
-        for m in maps:
-            m.occupied = _shell_occupancy(m, shell, depth)
     boxes = [BillboardBox(box_to_world=t, color=m.color, normal=m.normal,
-                          distance=_distance(m.occupied, t), displacement=m.displacement)
+                          distance=distance_texture(occupancy(variant, m.color, m.displacement,
+                                                              depth, shell), t),
+                          displacement=m.displacement)
              for t, m in zip(transforms, maps, strict=True)]
     params = {"variant": variant, "epsilon": plan.epsilon_fraction,
               "texel_size": plan.texel_size, "voxels_across": depth,
@@ -155,10 +157,7 @@ def _check_options(variant, thickness, surfaces) -> None:
         return
     if variant != "shell":
         raise UsageError(f"thickness applies only to the shell variant, not {variant!r}")
-    if isinstance(thickness, bool) or not isinstance(thickness, (int, float, np.number)) \
-            or not 0 < float(thickness) <= 1:
-        raise UsageError(f"thickness must be a number in (0, 1] (a fraction of the box "
-                         f"depth) or None for automatic, got {thickness!r}")
+    shell_thickness(thickness)
 
 
 def _check_size(planes: tuple[BillboardPlane, ...], depth: int, texel: float) -> None:
@@ -260,28 +259,21 @@ def _inside_box(mesh: RenderMesh, faces: np.ndarray, box_to_world: np.ndarray) -
 
 # -- the variants -----------------------------------------------------------------------
 
-def _variant_maps(voxels: _Voxels, variant: str, surfaces: str) -> _Maps:
+def _variant_maps(voxels: _Voxels, variant: str) -> _Maps:
     if variant == "volumetric":
         return _Maps(_encode_color(voxels.color, voxels.occupied),
-                     _encode_normal(voxels.normal), None, voxels.occupied)
+                     _encode_normal(voxels.normal), None)
     covered = voxels.occupied.any(axis=0)
     lowest, highest = _column_extremes(voxels.occupied)
-    color, normal = _column_attributes(voxels, highest if surfaces == "outside" else None)
+    color, normal = _outermost(voxels, highest)
     d = voxels.depth
     if variant == "shell":
-        if surfaces == "outside":
-            w = (highest + 0.5) / d
-        else:
-            centres = (np.arange(d) + 0.5) / d
-            count = np.maximum(voxels.occupied.sum(axis=0), 1)
-            w = np.tensordot(centres, voxels.occupied.astype(np.float64), axes=1) / count
-        displacement = _encode_w(np.where(covered, w, 0.0))[..., None]
-        return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement, None)
+        middle = (_outer_run_bottom(voxels.occupied, highest) + highest + 1) / 2 / d
+        displacement = _encode_w(np.where(covered, middle, 0.0))[..., None]
+        return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement)
     interval = np.stack([np.where(covered, lowest / d, 0.0),
                          np.where(covered, (highest + 1) / d, 0.0)], axis=-1)
-    displacement = _encode_w(interval)
-    return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement,
-                 _interval_occupancy(displacement, covered, d))
+    return _Maps(_encode_color(color, covered), _encode_normal(normal), _encode_w(interval))
 
 
 def _column_extremes(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -292,56 +284,40 @@ def _column_extremes(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lowest, highest
 
 
-def _column_attributes(voxels: _Voxels, pick: np.ndarray | None):
-    """(H, W, 4) colour and (H, W, 3) unit normal per column: of the voxel ``pick`` (the
-    outside one), or the equal-weight mean over the column's occupied voxels."""
-    if pick is not None:
-        index = pick[None, ..., None]
-        color = np.take_along_axis(voxels.color, index, axis=0)[0]
-        normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
-        return color, normal
-    count = voxels.occupied.sum(axis=0)[..., None].astype(np.float32)
-    color = np.divide(voxels.color.sum(axis=0), count, out=np.zeros(count.shape[:2] + (4,),
-                      np.float32), where=count > 0)
-    return color, _unit(voxels.normal.sum(axis=0))
+def _outer_run_bottom(occupied: np.ndarray, highest: np.ndarray) -> np.ndarray:
+    """(H, W) index of the lowest voxel of the run of occupied voxels that ends at
+    ``highest``: the outermost surface's extent in each column (a sloped sheet spans
+    several voxels; whatever lies below the first gap is another surface)."""
+    d = occupied.shape[0]
+    gaps = ~occupied & (np.arange(d)[:, None, None] < highest[None])
+    return np.where(gaps.any(axis=0), d - np.argmax(gaps[::-1], axis=0), 0)
+
+
+def _outermost(voxels: _Voxels, highest: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(H, W, 4) colour and (H, W, 3) normal of each column's highest occupied voxel: the
+    surface seen from the box's outside. A shell stores one colour per texel, and the
+    surfaces below the outermost one are hidden behind it (a roof's rafters, a body's far
+    side); averaging them in would show what the mesh hides."""
+    index = highest[None, ..., None]
+    color = np.take_along_axis(voxels.color, index, axis=0)[0]
+    normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
+    return color, normal
 
 
 def _auto_thickness(maps: list[_Maps], depth: int) -> float:
     """The standard deviation of the stored displacements of every covered texel of every
     box, clamped to [one voxel, the whole box]."""
     values = np.concatenate([m.displacement[..., 0][m.color[..., 3] >= 128] for m in maps])
-    spread = float(np.std(values / _DISP_SCALE)) if values.size else 0.0
+    spread = float(np.std(values / DISP_SCALE)) if values.size else 0.0
     return min(max(spread, 1.0 / depth), 1.0)
 
 
-def _shell_occupancy(maps: _Maps, thickness: float, depth: int) -> np.ndarray:
-    """The cells the shell's intervals [d - t/2, d + t/2] (within [0, 1]) overlap."""
-    d = maps.displacement[..., 0] / _DISP_SCALE
-    interval = np.stack([np.clip(d - thickness / 2, 0, 1), np.clip(d + thickness / 2, 0, 1)],
-                        axis=-1)
-    return _interval_occupancy(interval * _DISP_SCALE, maps.color[..., 3] >= 128, depth)
-
-
-def _interval_occupancy(interval: np.ndarray, covered: np.ndarray, depth: int) -> np.ndarray:
-    """(D, H, W): cell k of a covered column is occupied when [k/D, (k+1)/D] overlaps its
-    interval (given in units of 1/65535) by more than the encoding's rounding."""
-    lo, hi = (interval[..., i].astype(np.float64) / _DISP_SCALE for i in (0, 1))
-    tol = 1.0 / _DISP_SCALE
-    k = np.arange(depth, dtype=np.float64)[:, None, None]
-    return covered[None] & (k / depth < hi[None] - tol) & ((k + 1) / depth > lo[None] + tol)
-
-
-# -- encodings and the distance texture -------------------------------------------------
+# -- encodings --------------------------------------------------------------------------
 
 def _encode_color(linear: np.ndarray, occupied: np.ndarray) -> np.ndarray:
     """sRGB uint8 colour with alpha 255 where occupied, 0 elsewhere."""
     rgba = np.concatenate([linear[..., :3], occupied[..., None].astype(np.float32)], axis=-1)
     return to_rgba8(rgba)
-
-
-def _unit(vectors: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(vectors, axis=-1, keepdims=True)
-    return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-6)
 
 
 def _encode_normal(normal: np.ndarray) -> np.ndarray:
@@ -350,25 +326,4 @@ def _encode_normal(normal: np.ndarray) -> np.ndarray:
 
 
 def _encode_w(w: np.ndarray) -> np.ndarray:
-    return np.round(np.clip(w, 0.0, 1.0) * _DISP_SCALE).astype(np.uint16)
-
-
-def _distance(occupied: np.ndarray, box_to_world: np.ndarray) -> np.ndarray:
-    """(D, H, W) uint8: from each voxel centre to the nearest occupied voxel centre, in
-    units of the smallest voxel side, rounded down, clamped at MAX_DISTANCE (all of it
-    where the box is empty)."""
-    from scipy.ndimage import distance_transform_edt
-
-    if not occupied.any():
-        return np.full(occupied.shape, MAX_DISTANCE, np.uint8)
-    sides = voxel_sides(box_to_world, occupied.shape)
-    distance = distance_transform_edt(~occupied, sampling=sides / sides.min())
-    return np.minimum(np.floor(distance + 1e-6), MAX_DISTANCE).astype(np.uint8)
-
-
-def voxel_sides(box_to_world: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
-    """World lengths of a (D, H, W) grid's voxel sides, in array order (w, v, u)."""
-    lengths = np.linalg.norm(np.asarray(box_to_world)[:3, :3], axis=0)
-    d, h, w = shape
-    return np.array([lengths[2] / d, lengths[1] / h, lengths[0] / w])
-
+    return np.round(np.clip(w, 0.0, 1.0) * DISP_SCALE).astype(np.uint16)

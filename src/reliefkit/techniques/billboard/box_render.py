@@ -96,6 +96,19 @@ class BoxRenderOptions:
                               "switch distance", lo=0.0, hi=0.999)
 
 
+def _check_applicable(opts: BoxRenderOptions) -> None:
+    """Refuse options the other options make meaningless (they were silently ignored, or,
+    for flatten under lod auto, honoured near and dropped far)."""
+    default = BoxRenderOptions()
+    if opts.lod == "auto" and opts.flatten != default.flatten:
+        raise UsageError("flatten applies with lod off: lod auto sets the flattening from "
+                         "the distance (§3.4.2); give one or the other")
+    if opts.lod != "auto" and opts.transition != default.transition:
+        raise UsageError("transition applies only with lod auto")
+    if opts.march != "uniform" and opts.samples != default.samples:
+        raise UsageError(f"samples applies only to the uniform march, not {opts.march}")
+
+
 def scale_w(factor: float) -> np.ndarray:
     """Box coordinates scaled by ``factor`` along w about the box's mid-plane w = 0.5."""
     m = np.eye(4)
@@ -223,6 +236,7 @@ class BillboardBoxesDrawable:
         opts = options or BoxRenderOptions()
         if opts.march not in MARCHES:
             raise UsageError(f"march must be one of {', '.join(MARCHES)}, got {opts.march!r}")
+        _check_applicable(opts)
         self.ctx, self.boxes, self.options = ctx, boxes, opts
         self.extra_attachments = 1 if instrument else 0
         check_box_sizes(ctx, boxes)
@@ -247,17 +261,17 @@ class BillboardBoxesDrawable:
         check_gl_error(ctx, "uploading billboard boxes")
 
     def draw(self, camera, light) -> None:
-        lod = 1.0
+        flatten = self.options.flatten  # lod auto's own where it applies (not both)
         if self.cloud is not None and isinstance(camera, Camera):
-            lod = flatten_factor(camera, self.boxes.epsilon, self.boxes.center,
-                                 self.options.transition)
-        flatten = self.options.flatten * lod
+            flatten = flatten_factor(camera, self.boxes.epsilon, self.boxes.center,
+                                     self.options.transition)
         self.drawn = {"lod": "boxes", "flatten": flatten}
         if self.cloud is not None and flatten <= 0.0:
             self.drawn["lod"] = "billboard cloud"
             self.cloud.draw(camera, light)
             return
-        self._draw_boxes(camera, light, flatten, handoff=1.0 - lod)
+        self._draw_boxes(camera, light, flatten,
+                         handoff=1.0 - flatten if self.cloud is not None else 0.0)
 
     def _handoff_uniforms(self, camera, handoff: float) -> dict:
         """What the shader needs to fade into the cloud's own filtered colour and normal."""

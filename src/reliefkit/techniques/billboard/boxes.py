@@ -87,10 +87,7 @@ class BillboardBoxes:
         for k, box in enumerate(self.boxes):
             _check_box(box, self.variant, f"box {k}")
         if self.variant == "shell":
-            if self.thickness is None or not 0 < float(self.thickness) <= 1:
-                raise UsageError(f"a shell needs a thickness in (0, 1] (of the box's depth), "
-                                 f"got {self.thickness!r}")
-            self.thickness = float(self.thickness)
+            self.thickness = shell_thickness(self.thickness, "a shell's thickness")
         elif self.thickness is not None:
             raise UsageError(f"only shells have a thickness, not a {self.variant}")
         if not any((b.color[..., 3] >= 128).any() for b in self.boxes):
@@ -152,6 +149,16 @@ class BillboardBoxes:
                 "thickness": self.thickness, "epsilon": self.epsilon,
                 "bounds_min": lo.tolist(), "bounds_max": hi.tolist(),
                 "bytes": self.memory_bytes(), "params": self.params}
+
+
+def shell_thickness(value, what: str = "thickness") -> float:
+    """``value`` as a shell's thickness: a real number (not a string or a bool) in (0, 1],
+    a fraction of the box depth."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.number) \
+            or not 0 < float(value) <= 1:
+        raise UsageError(f"{what} must be a number in (0, 1] (a fraction of the box depth), "
+                         f"got {value!r}")
+    return float(value)
 
 
 def _check_box(box: BillboardBox, variant: str, where: str) -> None:

@@ -22,12 +22,10 @@ import numpy as np
 
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
+from .density import add_faces
 from .rectangles import min_area_rectangle, plane_basis
 
 PENALTY_WEIGHT = 10.0   # w_penalty of Décoret et al. 2003, section 4.2
-# (face, direction) pairs projected at once: small enough that the temporaries stay in cache
-# (1 << 20 ran about 3 times slower, mostly memory traffic and page faults)
-_PAIRS_PER_CHUNK = 1 << 15
 _SLACK = 1e-9            # relative safety margin so that rounding never breaks validity
 
 
@@ -81,13 +79,13 @@ class BillboardCloudPlan:
     skipped_reason: str | None = field(default=None)
 
     def summary(self) -> dict:
-        """Plane and face counts, what was skipped and why, time and texture size."""
+        """Plane and face counts, what was skipped and why, and texture size (not the time:
+        the summary goes into the file, which depends only on the bake's inputs)."""
         return {
             "planes": len(self.planes),
             "faces_per_plane": [int(len(p.faces)) for p in self.planes],
             "skipped": int(len(self.skipped)),
             "skipped_reason": self.skipped_reason,
-            "seconds": round(self.seconds, 3),
             "texels": int(sum(p.resolution[0] * p.resolution[1] for p in self.planes)),
         }
 
@@ -232,7 +230,8 @@ def _hemisphere_directions(step: float) -> np.ndarray:
 
 class _Grid:
     """The density over (direction, rho) bins, kept as per-direction difference arrays so that
-    adding or removing a face is a few scattered increments (np.bincount) and one cumsum.
+    adding or removing a face is four increments per direction (`density.add_faces`) and
+    finding the densest bin one cumsum.
 
     A bin holds the plane through its centre rho; a face counts in the bins whose centre lies
     in its valid range. The grid has a spare bin below and above every possible range, so no
@@ -276,68 +275,18 @@ class _Grid:
             self._update(idx, -1.0)
 
     def _update(self, idx: np.ndarray, sign: float) -> None:
+        """Add ``sign`` x the increments of faces idx (`density.add_faces`). Each distinct
+        vertex is projected once per direction (neighbouring faces share them)."""
         idx = idx[~self.faces.degenerate[idx]]        # zero area: no density, no penalty
-        chunk = max(1, _PAIRS_PER_CHUNK // len(self.dirs))
-        for s in range(0, len(idx), chunk):
-            flat, weights = self._increments(idx[s:s + chunk])
-            self.diff += sign * np.bincount(flat, weights, self.diff.size).reshape(self.diff.shape)
-
-    def _increments(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Flat difference-array indices and weights of faces idx over every direction.
-
-        Projections are plain elementwise products (no BLAS), so a face gives bit-identical
-        bins whichever chunk it is in, and removing it cancels adding it exactly. Per
-        (face, direction): +gain on the bins of its valid range [hi_proj - eps, lo_proj + eps],
-        -penalty * gain on its outer miss band, [lo - eps, lo) where rho >= 0 and
-        (hi, hi + eps] where rho < 0 (planes that would hold the face if moved outwards).
-        The four entries are written straight into preallocated (4, faces, directions)
-        arrays: band start, range start, range end, band end.
-        """
-        f, d = self.faces, self.dirs32
+        if not idx.size:
+            return
+        f = self.faces
+        used, where = np.unique(f.corners[idx], return_inverse=True)
         eps = np.float32(f.eps / self.width)
-        base = np.float32(-self.start / self.width)    # bin coordinate of rho = 0
-        low, high = _low_high(self.point_bins, f.corners[idx], d)
-        low += base
-        high += base
-        ok = high - low <= 2 * eps
-        gain = np.abs(f.normal[idx].astype(np.float32) @ d.T)
-        gain *= f.area[idx, None].astype(np.float32)
-        gain *= ok
-        miss = gain * np.float32(self.penalty)
-        row = np.arange(len(d)) * (self.bins + 1)     # flat index of each direction's bin 0
-        outer = np.float32(self.first_outer)
-        bounds = (np.maximum(np.ceil(high - 2 * eps), outer),        # outer band, rho >= 0
-                  np.ceil(high - eps),                               # first bin in the range
-                  np.floor(low + eps) + 1,                           # one past its last bin
-                  np.minimum(np.floor(low + 2 * eps), outer - 1) + 1)    # band, rho < 0
-        flat = np.empty((4, *gain.shape), dtype=np.intp)
-        for out, k in zip(flat, bounds, strict=True):
-            np.add(k, row, out=out, casting="unsafe")    # exact: small whole numbers
-        m1 = miss * (flat[0] < flat[1])                  # outer band, rho >= 0, not empty
-        m2 = miss * (flat[3] > flat[2])                  # outer band, rho < 0, not empty
-        gain *= flat[1] < flat[2]                        # some bin centre is valid
-        weights = np.empty(flat.shape)    # float64 as bincount takes it; sums done in float32
-        np.negative(m1, out=weights[0])
-        np.add(gain, m1, out=weights[1])
-        np.negative(np.add(gain, m2, out=weights[2]), out=weights[2])    # -(gain + m2)
-        weights[3] = m2
-        return flat.ravel(), weights.ravel()
-
-
-def _low_high(points: np.ndarray, corners: np.ndarray,
-              d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Lowest and highest projection of each triangle (n, 3 corner indices) on each direction
-    (D, 3). Each distinct vertex is projected once (neighbouring faces share them), always
-    with the same elementwise products, so its value never depends on the chunk."""
-    used, where = np.unique(corners, return_inverse=True)
-    pts = points[used]
-    proj = pts[:, 0, None] * d[:, 0] + pts[:, 1, None] * d[:, 1] + pts[:, 2, None] * d[:, 2]
-    p0, p1, p2 = (proj[where.reshape(corners.shape)[:, i]] for i in range(3))
-    low = np.minimum(p0, p1)
-    np.minimum(low, p2, out=low)
-    high = np.maximum(p0, p1, out=p0)
-    np.maximum(high, p2, out=high)
-    return low, high
+        add_faces(self.diff, self.point_bins[used], where.reshape(-1, 3).astype(np.int64),
+                  f.normal[idx].astype(np.float32), f.area[idx].astype(np.float32),
+                  self.dirs32, eps, np.float32(2 * eps), np.float32(-self.start / self.width),
+                  np.float32(self.first_outer), np.float32(self.penalty), float(sign))
 
 
 class _Selector:

@@ -7,7 +7,8 @@ with coverage alpha, ``normal`` uint8 (L, H, W, 3)); param ``epsilon_world``.
 ``dmbbc``: the flat cloud's arrays prefixed ``bbc_`` (its params under param ``cloud``), and
 per box K ``bK_box_to_world`` float64 (4, 4), ``bK_color``, ``bK_normal``, ``bK_distance``
 uint8 and, for the shells, ``bK_displacement`` uint16; params ``variant``, ``boxes`` (the
-count), ``thickness``.
+count), ``thickness``. The distance textures are checked against the maps on reading
+(`distance.box_distance`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from dataclasses import replace
 from ...errors import FormatError, UsageError
 from ...io.rk import ArraySpec, Codec
 from .boxes import BillboardBox, BillboardBoxes
+from .distance import box_distance
 from .representation import BillboardCloud
 
 MAX_RECTANGLES = 4096
@@ -113,13 +115,26 @@ def _boxes_from_arrays(arrays: dict, params: dict) -> BillboardBoxes:
         boxes = [BillboardBox(arrays[f"b{k}_box_to_world"], arrays[f"b{k}_color"],
                               arrays[f"b{k}_normal"], arrays[f"b{k}_distance"],
                               arrays.get(f"b{k}_displacement")) for k in range(count)]
-        return BillboardBoxes(params.pop("variant", None), boxes, cloud,
-                              thickness=params.pop("thickness", None),
-                              source_bounds=arrays.get("source_bounds"), params=params)
+        rep = BillboardBoxes(params.pop("variant", None), boxes, cloud,
+                             thickness=params.pop("thickness", None),
+                             source_bounds=arrays.get("source_bounds"), params=params)
     except KeyError as exc:
         raise FormatError(f"dmbbc box array {exc} is missing") from None
     except (UsageError, TypeError, ValueError) as exc:
         raise FormatError(f"invalid displacement-mapped billboard cloud: {exc}") from None
+    _check_distances(rep)
+    return rep
+
+
+def _check_distances(rep: BillboardBoxes) -> None:
+    """Refuse distance textures that promise more room than the boxes' own maps leave: the
+    sphere march would jump over surfaces (a smaller distance only costs steps)."""
+    for k, box in enumerate(rep.boxes):
+        unsafe = int((box.distance > box_distance(box, rep.variant, rep.thickness)).sum())
+        if unsafe:
+            raise FormatError(f"dmbbc box {k}: its distance texture exceeds the distance to "
+                              f"its occupied cells in {unsafe:,} of its {box.distance.size:,} "
+                              "voxels (a damaged or forged file)")
 
 
 CODECS = (

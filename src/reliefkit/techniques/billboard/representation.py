@@ -32,6 +32,8 @@ class BillboardCloud:
     epsilon : world distance every face lies within of its rectangle's plane.
     source_bounds : (2, 3) float64 world box of the mesh it was baked from, or None.
     params : the bake's parameters and the generator's report (JSON).
+    generation_seconds : how long a fresh bake's plane search took, for its report; not
+        stored (a file depends only on its inputs), None once loaded.
     """
 
     corners: np.ndarray
@@ -43,6 +45,7 @@ class BillboardCloud:
     epsilon: float
     source_bounds: np.ndarray | None = None
     params: dict = field(default_factory=dict)
+    generation_seconds: float | None = None
 
     def __post_init__(self) -> None:
         self.corners, self.u_axes, self.v_axes = (
@@ -127,8 +130,9 @@ class BillboardCloud:
         faces = gen.get("faces_per_plane", [])
         lines = [f"billboard cloud: {self.count} planes (faces per plane: "
                  f"{', '.join(map(str, faces))}), {gen.get('skipped', 0)} faces skipped, "
-                 f"{100 * self.empty_texel_fraction():.1f}% of the rectangles' texels empty, "
-                 f"planes found in {gen.get('seconds', 0):.2f} s"]
+                 f"{100 * self.empty_texel_fraction():.1f}% of the rectangles' texels empty"
+                 + ("" if self.generation_seconds is None
+                    else f", planes found in {self.generation_seconds:.2f} s")]
         if gen.get("skipped"):
             lines.append(f"warning: {gen['skipped']} faces have no plane: "
                          f"{gen.get('skipped_reason')}")
