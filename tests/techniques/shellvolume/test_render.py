@@ -279,6 +279,29 @@ def test_shadows_darken_what_the_roof_hides(gl):
     assert not darker[floor & (x > 0.4)].any() and not darker[roof].any()
 
 
+@pytest.mark.parametrize("elevation,azimuth", [(10.0, 35.0), (30.0, 35.0), (60.0, 0.0),
+                                               (20.0, 60.0)])
+def test_shadows_leave_a_lit_flat_surface_lit(gl, elevation, azimuth):
+    """A solid slab (the lower half of the shell) under a light from above: nothing lies
+    between its flat top and the light, so no pixel of it may be darker with --shadows
+    than without (shadow acne: isolated dark pixels where a sample tests itself)."""
+    from reliefkit.scene.light import DirectionalLight
+
+    alpha = np.zeros((8, 16, 16))
+    alpha[:4] = 1.0
+    rep = TexturedShell(grid_mesh(8), 0.2, texture_from((0.8, 0.8, 0.8), alpha))
+    cam = slab_camera(20.0, size=(96, 96), ortho=True)
+    el, az = np.radians(elevation), np.radians(azimuth)
+    light = DirectionalLight(direction=(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az),
+                                        np.sin(el)), ambient=0.2)
+    lit = render(rep, cam, ctx=gl, light=light, samples=16)
+    shadowed = render(rep, cam, ctx=gl, light=light, samples=16, shadows=True)
+    top = lit.color[..., 3] > 0.99
+    assert top.all()
+    darker = shadowed.color[..., :3] < lit.color[..., :3] - 0.01
+    assert not darker.any(), f"{int(darker.any(axis=-1).sum())} dark pixels"
+
+
 def test_animation_moves_and_repeats(gl, cloudy_sphere):
     cam = sphere_camera()
     still = render(cloudy_sphere, cam, ctx=gl, samples=4)

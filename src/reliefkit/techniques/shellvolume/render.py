@@ -40,6 +40,7 @@ TET_TEXELS, TET_ROW_TEXELS = 16, 2048  # shaders/include/tets.glsl
 MAX_LEVELS = 4                          # shaders/include/volume.glsl
 SEARCH_BINS = 16
 SHADOW_SIZE = 1024
+SHADOW_DEPTH_BIAS = 2.0 ** -16  # window depth: the shadow map's rounding, not its texels
 _COLOR_UNITS, _NORMAL_UNITS = range(0, 4), range(4, 8)
 _TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT = 8, 9, 10, 11
 EXITS = ("fragment", "vertex")
@@ -97,10 +98,23 @@ def tet_texels(shell, origin, tile) -> np.ndarray:
     block[:, 8:11, :3] = rows[..., :3]
     block[:, 8:11, 3] = rows[..., 3] + rows[..., :3] @ origin
     block[:, 11:15, :3] = shell.normals[shell.tets]
+    block[:, 15, 0] = ray_reach(shell)
     per_row = TET_ROW_TEXELS // TET_TEXELS
     padded = np.zeros((-(-count // per_row) * per_row, TET_TEXELS, 4), np.float32)
     padded[:count] = block
     return padded.reshape(-1, TET_ROW_TEXELS, 4)
+
+
+def ray_reach(shell) -> np.ndarray:
+    """(T,) the longest segment a ray can have in each tetrahedron or in one it may come
+    from (a face neighbour): the longest edge among them. The shadow test steps back by it
+    over the sample count (shaders/shell.glsl, light_visibility)."""
+    corners = shell.positions[shell.tets]
+    pairs = [(i, j) for i in range(4) for j in range(i + 1, 4)]
+    own = np.max([np.linalg.norm(corners[:, i] - corners[:, j], axis=-1)
+                  for i, j in pairs], axis=0)
+    beside = np.where(shell.neighbors >= 0, own[np.maximum(shell.neighbors, 0)], 0.0)
+    return np.maximum(own, beside.max(axis=1))
 
 
 def level_count(shape) -> int:
@@ -298,8 +312,8 @@ class TexturedShellDrawable(GLObjects):
         from ...core.transforms import translation
 
         light_matrix = np.asarray(cam.proj) @ np.asarray(cam.view) @ translation(self.origin)
-        return {"u_light_matrix": light_matrix,
-                "u_shadow_bias": 2.0 / SHADOW_SIZE}
+        return {"u_light_matrix": light_matrix, "u_shadow_bias": SHADOW_DEPTH_BIAS,
+                "u_shadow_texel": 2.0 * cam.ortho_height / cam.size[0]}
 
     def _opaque_depth(self, outer, made) -> dict:
         """A copy of the opaque pass's depth to sample (the attached one cannot be)."""

@@ -96,7 +96,8 @@ uniform highp sampler2D u_peel_depth;  // .xy: gl_FragCoord.z and tetrahedron pe
 #if defined SHADOWS
 uniform highp sampler2D u_shadow_map;
 uniform mat4 u_light_matrix;        // shell-local point -> the light's clip space
-uniform float u_shadow_bias;
+uniform float u_shadow_bias;       // window depth: the depth buffer's rounding
+uniform float u_shadow_texel;      // a shadow-map texel's width, world units
 #endif
 in vec3 v_local;
 flat in int v_tet;
@@ -145,23 +146,31 @@ vec3 animated(vec3 s) {
 }
 
 #if defined SHADOWS
-// 1 where the light reaches shell-local point p, 0 behind the first dense voxel it meets.
-float light_visibility(vec3 p) {
-    vec4 q = u_light_matrix * vec4(p, 1.0);
+// 1 where the light reaches the surface a sample at shell-local p stands for, 0 behind the
+// first dense voxel the light meets. That surface lies between the sample before (`back`
+// along the ray) and this one, and the shadow map's nearest texel holds the depth of a light
+// ray up to half a texel diagonal beside p, on a surface sloped by the angle to the light:
+// tested at the sample before, lifted off the surface along its normal `n` by one texel,
+// neither error darkens a lit surface (no shadow acne).
+float light_visibility(vec3 p, vec3 dir, float back, vec3 n) {
+    vec3 receiver = p - dir * back + n * u_shadow_texel;
+    vec4 q = u_light_matrix * vec4(receiver, 1.0);
     vec3 c = q.xyz / q.w * 0.5 + 0.5;
     if (any(lessThan(c.xy, vec2(0.0))) || any(greaterThan(c.xy, vec2(1.0)))) return 1.0;
     return c.z - u_shadow_bias <= textureLod(u_shadow_map, c.xy, 0.0).r ? 1.0 : 0.0;
 }
 #endif
 
-// Colour of a sample at shell-local p (unlit: the stored colour).
-vec3 sample_color(VolumeSample v, vec3 p, vec3 dir) {
+// Colour of a sample at shell-local p, the sample before `back` behind it along `dir`
+// (unlit: the stored colour).
+vec3 sample_color(VolumeSample v, vec3 p, vec3 dir, float back) {
 #if defined LIT
+    vec3 n = shading_normal(v_tet, v.normal, v.size, p);
     float lit = 1.0;
 #if defined SHADOWS
-    lit = light_visibility(p);
+    lit = light_visibility(p, dir, back, n);
 #endif
-    return shade_phong(v.rgba.rgb, shading_normal(v_tet, v.normal, v.size, p), -dir, lit);
+    return shade_phong(v.rgba.rgb, n, -dir, lit);
 #else
     return v.rgba.rgb;
 #endif
@@ -218,7 +227,9 @@ void main() {
 #else
         vec3 p = mix(v_local, p_out, lambda);
         float a = sample_opacity(v.rgba.a, dt);
-        color += (1.0 - opacity) * (a * sample_color(v, p, dir) + v.glow * v.rgba.rgb * dt);
+        // the sample before: in this segment, or the last one of the tetrahedron before
+        float back = k > 0 ? dt : 0.5 * (dt + tet_ray_reach(v_tet) / float(n));
+        color += (1.0 - opacity) * (a * sample_color(v, p, dir, back) + v.glow * v.rgba.rgb * dt);
         opacity += (1.0 - opacity) * a;
 #if defined OPAQUE
         if (opacity >= 0.5) {
