@@ -119,3 +119,37 @@ def test_corrupt_file_is_refused(fur_rk, tmp_path):
                 data = data[:-8]
             dst.writestr(item, data)
     assert_one_line_error(run_cli("render", broken, "-o", tmp_path / "b.png"))
+
+
+def test_npy_texture_through_a_symlink_but_not_a_fifo(tmp_path):
+    """A symlink to a regular .npy is that file; a FIFO is refused at once (never read)."""
+    import os
+
+    rgba = np.zeros((4, 8, 8, 4), np.float32)
+    rgba[0] = (0.2, 0.8, 0.2, 1.0)
+    np.save(tmp_path / "moss.npy", rgba)
+    os.symlink(tmp_path / "moss.npy", tmp_path / "link.npy")
+    out = run_cli("bake", "demo:plane", "--as", "shell-volume", "--texture",
+                  tmp_path / "link.npy", "-o", tmp_path / "moss.rk")
+    assert out.returncode == 0, out.stderr
+    assert np.array_equal(load(tmp_path / "moss.rk").texture.rgba, rgba)
+    if hasattr(os, "mkfifo"):
+        os.mkfifo(tmp_path / "pipe.npy")
+        assert_one_line_error(run_cli("bake", "demo:plane", "--as", "shell-volume",
+                                      "--texture", tmp_path / "pipe.npy", "-o",
+                                      tmp_path / "x.rk"), "not a regular file")
+
+
+def test_a_texture_without_voxels_is_refused(fur_rk, tmp_path):
+    """A forged file whose texture has depth 0: one line, not a division by zero."""
+    from reliefkit.io import rk
+
+    rep = load(fur_rk)
+    codec = rk._codec_for_object(rep)  # noqa: SLF001 - forging needs the codec's arrays
+    arrays, params = codec.to_arrays(rep)
+    arrays = {k: v for k, v in arrays.items() if v is not None}
+    arrays["texture_rgba"] = np.zeros((0, 16, 16, 4), np.float32)
+    arrays["texture_normal"] = np.zeros((0, 16, 16, 3), np.float32)
+    forged = rk.write_rk(tmp_path / "empty.rk", "shell-volume", arrays, params)
+    assert_one_line_error(run_cli("render", forged, "--size", "32x32", "-o",
+                                  tmp_path / "e.png"), "at least 1")
