@@ -153,3 +153,33 @@ def test_a_texture_without_voxels_is_refused(fur_rk, tmp_path):
     forged = rk.write_rk(tmp_path / "empty.rk", "shell-volume", arrays, params)
     assert_one_line_error(run_cli("render", forged, "--size", "32x32", "-o",
                                   tmp_path / "e.png"), "at least 1")
+
+
+def test_a_texture_that_would_take_minutes_is_refused_with_the_estimate(tmp_path):
+    """256^3 voxels of fur took minutes and GBs; refused at once, with the estimate."""
+    out = run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture-size",
+                  "256,256,256", "-o", tmp_path / "x.rk")
+    assert_one_line_error(out, "16,777,216 voxels", "minutes", "GiB", "128,128,128")
+    assert not (tmp_path / "x.rk").exists()
+
+
+def test_a_shell_no_gpu_is_sure_to_hold_is_refused_before_it_is_built():
+    """A grid of 700,928 triangles (2.1M tetrahedra, over OpenGL 4.3's 16384 texture rows of
+    128): refused by the bake and by the representation, before the shell is built."""
+    from reliefkit.errors import UsageError
+    from reliefkit.scene.mesh import RenderMesh
+    from reliefkit.techniques.shellvolume.bakers import ShellVolumeParams, bake_shell
+    from reliefkit.techniques.shellvolume.textures import make_absorption
+
+    n = 593
+    x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n), indexing="ij")
+    at = np.arange(n * n).reshape(n, n)
+    a, b, c, d = at[:-1, :-1].ravel(), at[1:, :-1].ravel(), at[1:, 1:].ravel(), at[:-1, 1:].ravel()
+    faces = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    positions = np.column_stack([x.ravel(), y.ravel(), np.zeros(n * n)])
+    grid = RenderMesh(positions, faces, np.tile([0.0, 0.0, 1.0], (n * n, 1)),
+                      np.ones((n * n, 4)), positions[:, :2])
+    with pytest.raises(UsageError, match="at most 699,050 triangles"):
+        bake_shell(grid, ShellVolumeParams(texture="absorption", thickness=0.01))
+    with pytest.raises(UsageError, match="700,928 triangles"):
+        TexturedShell(grid, 0.01, make_absorption(size=(4, 4, 4)))

@@ -32,11 +32,11 @@ from ...gl.textures import read_depth, read_rgba, texture2d, texture3d
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
-from .representation import TexturedShell
+from .representation import TET_TEXELS, TETS_PER_ROW, TexturedShell
 from .textures import density_floor, density_normals, marched_volume
 
 PROGRAM = "shellvolume:shell.glsl"
-TET_TEXELS, TET_ROW_TEXELS = 16, 2048  # shaders/include/tets.glsl
+TET_ROW_TEXELS = TET_TEXELS * TETS_PER_ROW  # 2048, shaders/include/tets.glsl
 MAX_LEVELS = 4                          # shaders/include/volume.glsl
 SEARCH_BINS = 16
 SHADOW_SIZE = 1024
@@ -99,8 +99,7 @@ def tet_texels(shell, origin, tile) -> np.ndarray:
     block[:, 8:11, 3] = rows[..., 3] + rows[..., :3] @ origin
     block[:, 11:15, :3] = shell.normals[shell.tets]
     block[:, 15, 0] = ray_reach(shell)
-    per_row = TET_ROW_TEXELS // TET_TEXELS
-    padded = np.zeros((-(-count // per_row) * per_row, TET_TEXELS, 4), np.float32)
+    padded = np.zeros((-(-count // TETS_PER_ROW) * TETS_PER_ROW, TET_TEXELS, 4), np.float32)
     padded[:count] = block
     return padded.reshape(-1, TET_ROW_TEXELS, 4)
 

@@ -16,6 +16,14 @@ from ...errors import UsageError
 from .shell import ShellVolume, build_shell
 from .textures import VolumeTexture
 
+#: The renderer keeps each tetrahedron in TET_TEXELS texels of a 2D float texture,
+#: TETS_PER_ROW per row (render.tet_texels), and OpenGL 4.3 guarantees 2D textures of
+#: GL43_TEXTURE_ROWS rows: a shell of more tetrahedra (three per triangle) cannot be drawn
+#: on every GPU, so it is refused before it is built (a 1M-triangle bake took 44 s and 4.1 GB
+#: to be refused by the render).
+TET_TEXELS, TETS_PER_ROW, GL43_TEXTURE_ROWS = 16, 128, 16384
+MAX_TETRAHEDRA = TETS_PER_ROW * GL43_TEXTURE_ROWS
+
 #: Deformation of an animated base (`TexturedShell.shell_at`): vertices move along their
 #: normals by this fraction of the shell's thickness, as a wave over the surface.
 WAVE_AMPLITUDE = 0.6
@@ -40,6 +48,7 @@ class TexturedShell:
         if not isinstance(self.texture, VolumeTexture):
             raise UsageError(f"a textured shell needs a VolumeTexture, got "
                              f"{type(self.texture).__name__}")
+        check_tetrahedron_count(len(self.base.indices))
         self.thickness = np.broadcast_to(np.asarray(self.thickness, np.float64),
                                          (len(self.base.positions),)).copy()
         self.shell = build_shell(self.base, self.thickness)
@@ -96,3 +105,13 @@ class TexturedShell:
                          f"{thinned} of {s['base_vertices']} vertices, where "
                          f"{self.params.get('thickness', 0):.3g} would fold it over itself")
         return lines
+
+
+def check_tetrahedron_count(triangles: int) -> None:
+    """Refuse a base of ``triangles`` whose shell (three tetrahedra each) the renderer could
+    not hold on every GPU (`MAX_TETRAHEDRA`), before anything is built."""
+    if 3 * triangles > MAX_TETRAHEDRA:
+        raise UsageError(f"a shell over {triangles:,} triangles has {3 * triangles:,} "
+                         f"tetrahedra, more than the {MAX_TETRAHEDRA:,} a GPU is guaranteed to "
+                         f"hold (at most {MAX_TETRAHEDRA // 3:,} triangles); simplify the mesh "
+                         "(for example with Blender's Decimate modifier)")
