@@ -302,6 +302,27 @@ def test_shadows_leave_a_lit_flat_surface_lit(gl, elevation, azimuth):
     assert not darker.any(), f"{int(darker.any(axis=-1).sum())} dark pixels"
 
 
+def test_a_shell_looks_the_same_at_any_scale(gl):
+    """The cloudy sphere scaled by 1e-20 (squares of its coordinates flush to zero in float32)
+    gives the unit sphere's picture, lit and shadowed (it drew nothing)."""
+    from reliefkit.scene.light import DirectionalLight
+
+    base = sphere_mesh(2)
+    tex = textures.make_clouds(size=(16, 16, 8)).tiled((2, 1))
+    light = DirectionalLight.from_angles(-60.0, 30.0)
+    frames = []
+    for scale in (1.0, 1e-20):
+        tiny = RenderMesh(base.world_positions * scale, base.indices, base.normals,
+                          base.colors, base.uvs)
+        cam = Camera.orbit((0.0, 0.0, 0.0), 30.0, 25.0, 4.0 * scale, fov_deg=35.0,
+                           size=(48, 48), near=0.5 * scale, far=10.0 * scale)
+        rep = TexturedShell(tiny, 0.25 * scale, tex.over_length(0.25 * scale))
+        frames.append(render(rep, cam, ctx=gl, light=light, samples=8, shadows=True))
+    unit, tiny = (premultiplied(f.color) for f in frames)
+    assert frames[0].stats["covered"] > 500
+    assert np.abs(unit - tiny).max() < 0.02
+
+
 def test_animation_moves_and_repeats(gl, cloudy_sphere):
     cam = sphere_camera()
     still = render(cloudy_sphere, cam, ctx=gl, samples=4)

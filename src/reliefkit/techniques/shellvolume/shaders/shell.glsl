@@ -109,7 +109,7 @@ in vec3 v_exit;
 vec3 eye_local() { return u_eye - u_model_offset; }
 
 vec3 ray_direction() {
-    return u_orthographic ? -u_view_dir : normalize(v_local - eye_local());
+    return u_orthographic ? -u_view_dir : unit_or(v_local - eye_local(), -u_view_dir);
 }
 
 // Distance from the entry point to where the ray leaves the tetrahedron.
@@ -117,7 +117,7 @@ float exit_distance(vec3 dir) {
 #if defined EXIT_VERTEX
     if (u_orthographic) return max(min(min(v_exit.x, v_exit.y), v_exit.z), 0.0);
     float mu = max(max(v_exit.x, v_exit.y), v_exit.z);
-    return mu > 0.0 ? max(1.0 / mu - 1.0, 0.0) * length(v_local - eye_local()) : 0.0;
+    return mu > 0.0 ? max(1.0 / mu - 1.0, 0.0) * scale_free_length(v_local - eye_local()) : 0.0;
 #else
     float t = 1e30;
     for (int f = 0; f < 4; ++f) {
