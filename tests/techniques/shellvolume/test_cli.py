@@ -183,3 +183,29 @@ def test_a_shell_no_gpu_is_sure_to_hold_is_refused_before_it_is_built():
         bake_shell(grid, ShellVolumeParams(texture="absorption", thickness=0.01))
     with pytest.raises(UsageError, match="700,928 triangles"):
         TexturedShell(grid, 0.01, make_absorption(size=(4, 4, 4)))
+
+
+def test_render_warns_when_the_order_breaks_cycles(tmp_path):
+    """Two spheres passing through each other: the render says how many cycles its sort
+    broke and names the exact --sort peel, on one warning line."""
+    from shell_scenes import sphere_mesh
+
+    sphere = sphere_mesh(2)
+    lines = []
+    for shift in (0.0, 0.8):
+        lines += [f"v {x + shift:.6f} {y:.6f} {z:.6f}" for x, y, z in sphere.world_positions]
+        lines += [f"vt {u:.6f} {v:.6f}" for u, v in sphere.uvs]
+    count = len(sphere.positions)
+    for k in range(2):
+        lines += ["f " + " ".join(f"{i + 1 + k * count}/{i + 1 + k * count}" for i in tri)
+                  for tri in sphere.indices]
+    (tmp_path / "two.obj").write_text("\n".join(lines) + "\n")
+    out = run_cli("bake", tmp_path / "two.obj", "--as", "shell-volume", "--texture", "clouds",
+                  "--texture-size", "16,16,8", "--thickness", "0.2", "-o", tmp_path / "two.rk")
+    assert out.returncode == 0, out.stderr
+    out = run_cli("render", tmp_path / "two.rk", "--size", "48x48", "--samples", "2", "-o",
+                  tmp_path / "two.png")
+    assert out.returncode == 0, out.stderr
+    warned = [line for line in out.stderr.splitlines() if "cycles" in line]
+    assert len(warned) == 1 and warned[0].startswith("warning: the visibility order broke")
+    assert "--sort peel" in warned[0]

@@ -323,6 +323,31 @@ def test_a_shell_looks_the_same_at_any_scale(gl):
     assert np.abs(unit - tiny).max() < 0.02
 
 
+def crossing_spheres():
+    """Two spheres passing through each other: where their shells cross, tetrahedra overlap
+    and no visibility order exists."""
+    one, two = sphere_mesh(2), sphere_mesh(2)
+    offset = len(one.positions)
+    positions = np.concatenate([one.world_positions, two.world_positions + (0.8, 0.0, 0.0)])
+    mesh = RenderMesh(positions, np.concatenate([one.indices, two.indices + offset]),
+                      np.concatenate([one.normals, two.normals]),
+                      np.ones((len(positions), 4)), np.concatenate([one.uvs, two.uvs]))
+    return TexturedShell(mesh, 0.2, textures.make_clouds(size=(16, 16, 8)).over_length(0.2))
+
+
+def test_a_sort_that_breaks_cycles_says_so(gl, cloudy_sphere):
+    """The frame carries a warning with the count and the exact alternative; a shell whose
+    order is exact carries none."""
+    cam = sphere_camera(az=10.0)
+    frame = render(crossing_spheres(), cam, ctx=gl, samples=4)
+    assert frame.stats["cycles"] > 0
+    assert len(frame.warnings) == 1
+    assert f"{frame.stats['cycles']:,} cycles" in frame.warnings[0]
+    assert "--sort peel" in frame.warnings[0]
+    clean = render(cloudy_sphere, cam, ctx=gl, samples=4)
+    assert clean.stats["cycles"] == 0 and clean.warnings == []
+
+
 def test_animation_moves_and_repeats(gl, cloudy_sphere):
     cam = sphere_camera()
     still = render(cloudy_sphere, cam, ctx=gl, samples=4)

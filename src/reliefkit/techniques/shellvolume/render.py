@@ -421,6 +421,18 @@ class TexturedShellDrawable(GLObjects):
         frame.stats.update({"tetrahedra": len(self.shell.tets),
                             "samples": self.options.samples, "unlit": self.options.unlit,
                             "mip": self.options.mip, **self.stats})
+        if self.stats.get("cycles"):
+            frame.warnings.append(cycles_warning(self.stats["cycles"]))
+
+
+def cycles_warning(cycles: int) -> str:
+    """What a sort that broke ``cycles`` cycles tells the user: no order of the tetrahedra
+    exists where they overlap (parts of the mesh pass through each other, or the shell is
+    too thick there), so some pixels are composited out of order; peeling is exact."""
+    return (f"the visibility order broke {cycles:,} cycles (tetrahedra that overlap, where "
+            "parts of the mesh pass through each other or the shell is too thick): some "
+            "pixels are composited out of order; --sort peel is exact (one pass per depth "
+            "layer, slower)")
 
 
 def _needed_optical_depth(front: np.ndarray) -> np.ndarray:
