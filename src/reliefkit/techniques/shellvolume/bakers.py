@@ -6,13 +6,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
 from ...core.params import param
 from ...errors import UsageError
 from .representation import TexturedShell, check_tetrahedron_count
 from .shell import fitted_thickness, unusable_triangles
 from .textures import TEXTURES, load_texture_npy, texture_from_mesh
 
-DEFAULT_THICKNESS = 0.05  # of the base's bounding-box diagonal, when --thickness is not given
 # A generated or voxelized texture costs about MADE_SECONDS_PER_MVOXEL per million voxels and
 # MADE_BYTES_PER_VOXEL at its peak (fur, the slowest, at 128^3: 42 s and 0.7 GB on 2026-12-06
 # on this 2-core machine); above MADE_MAX_VOXELS a bake would run for minutes, so it is
@@ -28,10 +28,12 @@ class ShellVolumeParams:
                          "(D, H, W, 4) float RGBA, or a mesh (FILE or demo:NAME) voxelized "
                          "into one")
     thickness: float | None = param(None, "shell thickness in the mesh's own units (none: "
-                                    f"{DEFAULT_THICKNESS:g} of its bounding-box diagonal)",
+                                    f"{LAYER_PER_EDGE:g} of its median edge length)",
                                     kind="float", lo=1e-12)
-    tile: tuple = param((1.0, 1.0), "how many times the texture repeats over the uvs, U,V",
-                        kind="floats", count=2, lo=1, hi=4096)
+    tile: tuple | None = param(None, "how many times the texture repeats over the uvs, U,V "
+                               f"(none: as often as makes a tile about {TILE_PER_LAYER:g} "
+                               "thicknesses long on the surface)",
+                               kind="floats", count=2, lo=1, hi=4096)
     texture_size: tuple = param((32.0, 32.0, 16.0), "W,H,D voxels of a generated or "
                                 "voxelized texture (at most 128^3 in all)", kind="floats",
                                 count=3, lo=2, hi=256)
@@ -77,15 +79,13 @@ def check_made_size(size) -> None:
 
 
 def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
-    for t in p.tile:
-        if t != int(t):
-            raise UsageError(f"--tile takes whole numbers, got {p.tile[0]:g},{p.tile[1]:g}")
+    if p.tile is not None and any(t != int(t) for t in p.tile):
+        raise UsageError(f"--tile takes whole numbers, got {p.tile[0]:g},{p.tile[1]:g}")
     check_tetrahedron_count(len(source.indices))
-    lo, hi = source.bounds
-    thickness = p.thickness if p.thickness is not None else \
-        DEFAULT_THICKNESS * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
-    texture = make_texture(p.texture, p.texture_size, thickness, progress).tiled(
-        (int(p.tile[0]), int(p.tile[1])))
+    thickness = p.thickness if p.thickness is not None else layer_thickness(source)
+    tile = uv_tiling(source, TILE_PER_LAYER * thickness) if p.tile is None else \
+        (int(p.tile[0]), int(p.tile[1]))
+    texture = make_texture(p.texture, p.texture_size, thickness, progress).tiled(tile)
     base, dropped = usable_part(source)
     fitted = fitted_thickness(base, thickness)
     thinned = int((fitted < thickness).sum())
