@@ -348,6 +348,49 @@ def test_a_sort_that_breaks_cycles_says_so(gl, cloudy_sphere):
     assert clean.stats["cycles"] == 0 and clean.warnings == []
 
 
+def two_material_grid():
+    """The grid (uvs over [0, 1]^2) with a red factor on the triangles of x < 0 and a 2x2
+    blue-and-yellow texture on the others."""
+    from reliefkit.scene.mesh import Material
+
+    mesh = grid_mesh(4)
+    centres = mesh.world_positions[mesh.indices].mean(axis=1)
+    texture = np.array([[[0, 0, 255, 255], [255, 255, 0, 255]],
+                        [[255, 255, 0, 255], [0, 0, 255, 255]]], np.uint8)
+    materials = [Material("red", (1.0, 0.2, 0.2, 1.0)), Material("tiles", texture=texture)]
+    return RenderMesh(mesh.world_positions, mesh.indices, mesh.normals, mesh.colors, mesh.uvs,
+                      materials=materials, material=(centres[:, 0] > 0).astype(np.uint16))
+
+
+def test_the_surface_material_tints_the_volume(gl, tmp_path):
+    """A uniform medium over two materials: over the red factor its colour is the medium's
+    times the factor exactly; everywhere the GPU matches the CPU reference, which samples
+    the same atlas; the atlas survives a round trip through the .rk file."""
+    from reliefkit.bake import bake
+
+    rep = bake(two_material_grid(), "shell-volume", texture="absorption", thickness=0.4,
+               tile=(2.0, 2.0), texture_size=(4.0, 4.0, 4.0))
+    assert rep.surface is not None and rep.surface.rgba8.shape[0] == 2
+    cam = Camera(eye=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0),
+                 size=(48, 48), near=0.5, far=10.0, ortho_height=1.0)
+    frame = render(rep, cam, ctx=gl, unlit=True, mip=False, samples=8)
+    o, _ = cam.pixel_rays()
+    red = (o[..., 0] < -0.2) & (np.abs(o[..., 1]) < 0.8) & (o[..., 0] > -0.8)
+    medium = np.array([0.1, 0.7, 0.2])  # textures.make_absorption's colour
+    assert red.sum() > 200
+    np.testing.assert_allclose(frame.color[..., :3][red], np.broadcast_to(
+        medium * (1.0, 0.2, 0.2), (int(red.sum()), 3)), atol=2e-3)
+    ref = reference_render(rep.shell, rep.texture, cam, samples=8, surface=rep.surface,
+                           layers=rep.surface_layers())
+    rmse, off = against_reference(frame, ref)
+    assert rmse <= RMSE_BOUND and off <= 0.005
+    save(tmp_path / "tinted.rk", rep)
+    back = load(tmp_path / "tinted.rk")
+    assert np.array_equal(back.surface.rgba8, rep.surface.rgba8)
+    assert back.surface.box == rep.surface.box
+    assert np.array_equal(back.base.material, rep.base.material)
+
+
 def test_animation_moves_and_repeats(gl, cloudy_sphere):
     cam = sphere_camera()
     still = render(cloudy_sphere, cam, ctx=gl, samples=4)

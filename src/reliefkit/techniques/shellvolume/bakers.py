@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
+from ...bake.uv_atlas import MAX_MATERIALS, has_material, material_atlas
 from ...core.params import param
 from ...errors import UsageError
 from .representation import TexturedShell, check_tetrahedron_count
@@ -89,9 +90,13 @@ def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
     base, dropped = usable_part(source)
     fitted = fitted_thickness(base, thickness)
     thinned = int((fitted < thickness).sum())
+    kept = has_material(base) and len(base.materials) <= MAX_MATERIALS
     return TexturedShell(base, fitted, texture,
                          {"source": source.name, "thickness": thickness,
-                          "dropped_triangles": dropped, "thinned_vertices": thinned})
+                          "dropped_triangles": dropped, "thinned_vertices": thinned,
+                          "materials_left_out": 0 if kept or not has_material(base)
+                          else len(base.materials)},
+                         surface=material_atlas(base) if kept else None)
 
 
 def usable_part(mesh):
@@ -110,4 +115,5 @@ def usable_part(mesh):
 
     kept = np.asarray(mesh.indices)[~bad]
     return RenderMesh(mesh.world_positions, kept, mesh.normals, mesh.colors, mesh.uvs,
-                      name=mesh.name), int(bad.sum())
+                      name=mesh.name, materials=mesh.materials,
+                      material=np.asarray(mesh.material)[~bad]), int(bad.sum())

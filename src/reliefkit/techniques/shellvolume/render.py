@@ -28,7 +28,7 @@ from ...gl.context import check_gl_error
 from ...gl.objects import GLObjects
 from ...gl.shaders import program
 from ...gl.targets import use_transparent_blending
-from ...gl.textures import read_depth, read_rgba, texture2d, texture3d
+from ...gl.textures import read_depth, read_rgba, texture2d, texture3d, texture_array
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
@@ -42,7 +42,7 @@ SEARCH_BINS = 16
 SHADOW_SIZE = 1024
 SHADOW_DEPTH_BIAS = 2.0 ** -16  # window depth: the shadow map's rounding, not its texels
 _COLOR_UNITS, _NORMAL_UNITS = range(0, 4), range(4, 8)
-_TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT = 8, 9, 10, 11
+_TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT, _SURFACE_UNIT = 8, 9, 10, 11, 13
 EXITS = ("fragment", "vertex")
 SORTS = (*METHODS, "peel")  # peel: depth peeling, the baseline the paper measured against
 MAX_PEELS = 1024
@@ -80,9 +80,10 @@ class ShellRenderOptions:
                                "AOVs (extra passes; off: AOVs only from opaque objects)")
 
 
-def tet_texels(shell, origin, tile) -> np.ndarray:
+def tet_texels(shell, origin, tile, layers=None) -> np.ndarray:
     """(rows, TET_ROW_TEXELS, 4) float32: shaders/include/tets.glsl's block per tetrahedron,
-    relative to ``origin`` (float64), the tiling folded into the texture map."""
+    relative to ``origin`` (float64), the tiling folded into the texture map; ``layers``
+    (T,): the surface material layer of each tetrahedron (0 when None)."""
     origin = np.asarray(origin, np.float64)
     count = len(shell.tets)
     block = np.zeros((count, TET_TEXELS, 4), np.float64)
@@ -99,6 +100,8 @@ def tet_texels(shell, origin, tile) -> np.ndarray:
     block[:, 8:11, 3] = rows[..., 3] + rows[..., :3] @ origin
     block[:, 11:15, :3] = shell.normals[shell.tets]
     block[:, 15, 0] = ray_reach(shell)
+    if layers is not None:
+        block[:, 15, 1] = layers
     padded = np.zeros((-(-count // TETS_PER_ROW) * TETS_PER_ROW, TET_TEXELS, 4), np.float32)
     padded[:count] = block
     return padded.reshape(-1, TET_ROW_TEXELS, 4)
@@ -183,7 +186,10 @@ class TexturedShellDrawable(GLObjects):
                 tex.repeat_z = False  # w is clamped: the shell ends at its base and top
                 pair.append(tex)
             self.level_textures.append(pair)
-        texels = tet_texels(shell, self.origin, rep.texture.tile)
+        if rep.surface is not None:
+            self.surface = self.keep(texture_array(ctx, rep.surface.rgba8, srgb=True,
+                                                   what="shell surface materials"))
+        texels = tet_texels(shell, self.origin, rep.texture.tile, rep.surface_layers())
         self.tets = self.keep(texture2d(ctx, texels, what="shell tetrahedra",
                                         filter="nearest"))
         count = len(shell.tets)
@@ -222,6 +228,8 @@ class TexturedShellDrawable(GLObjects):
         units |= {f"u_normal{k}": _NORMAL_UNITS[min(k, len(self.levels) - 1)]
                   for k in range(MAX_LEVELS)}
         animated = self.options.time is not None
+        surface = self.rep.surface
+        box = surface.box if surface is not None else (0.0, 0.0, 1.0, 1.0)
         return (camera_uniforms(camera) | model_offset(camera, self.origin) | light.uniforms()
                 | units | {"u_tets": _TETS_UNIT, "u_levels": len(self.levels),
                            "u_level_size": sizes, "u_mip": self.options.mip,
@@ -230,13 +238,19 @@ class TexturedShellDrawable(GLObjects):
                            "u_time": float(self.options.time or 0.0),
                            "u_sway": 0.04 if animated else 0.0,
                            "u_opaque_depth": _DEPTH_UNIT, "u_search": _SEARCH_UNIT,
-                           "u_shadow_map": _SHADOW_UNIT})
+                           "u_shadow_map": _SHADOW_UNIT, "u_surface": _SURFACE_UNIT,
+                           "u_tinted": surface is not None,
+                           "u_surface_box": (box[0], box[1], 1.0 / (box[2] - box[0]),
+                                             1.0 / (box[3] - box[1])),
+                           "u_tile": tuple(float(t) for t in self.rep.texture.tile)})
 
     def _bind(self) -> None:
         for k, (colour, normal) in enumerate(self.level_textures):
             colour.use(_COLOR_UNITS[k])
             normal.use(_NORMAL_UNITS[k])
         self.tets.use(_TETS_UNIT)
+        if self.rep.surface is not None:
+            self.surface.use(_SURFACE_UNIT)
 
     def _draw(self, name: str, uniforms: dict) -> None:
         set_uniforms(self.programs[name], uniforms)

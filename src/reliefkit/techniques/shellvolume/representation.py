@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas
 from ...errors import UsageError
 from .shell import ShellVolume, build_shell
 from .textures import VolumeTexture
@@ -34,6 +35,10 @@ class TexturedShell:
     """A shell of thickness ``thickness`` (per base vertex, world units) over ``base`` (a
     RenderMesh with uvs), filled with ``texture`` tiled ``texture.tile`` times over the uvs.
 
+    ``surface``: the base's own materials in its uv space (`reliefkit.bake.uv_atlas`), one
+    layer per material of ``base.material``; the volume's colours are multiplied by it (the
+    surface tints what grows on it). None: the texture's colours as they are.
+
     ``shell`` is built at construction (`build_shell`), so a bad base or thickness is refused
     here, with the reason.
     """
@@ -42,6 +47,7 @@ class TexturedShell:
     thickness: np.ndarray
     texture: VolumeTexture
     params: dict = field(default_factory=dict)
+    surface: MaterialAtlas | None = None
     shell: ShellVolume = field(init=False)
 
     def __post_init__(self) -> None:
@@ -51,6 +57,10 @@ class TexturedShell:
         check_tetrahedron_count(len(self.base.indices))
         self.thickness = np.broadcast_to(np.asarray(self.thickness, np.float64),
                                          (len(self.base.positions),)).copy()
+        if self.surface is not None and len(self.surface.rgba8) <= int(
+                np.max(self.base.material, initial=0)):
+            raise UsageError(f"a shell's surface has {len(self.surface.rgba8)} material "
+                             f"layers, its base uses {int(np.max(self.base.material)) + 1}")
         self.shell = build_shell(self.base, self.thickness)
 
     @property
@@ -68,6 +78,13 @@ class TexturedShell:
         """Whether the texture is opaque (every voxel empty or a solid): drawn depth-tested,
         without sorting (§4, the tree of Color plate E)."""
         return self.texture.opaque
+
+    def surface_layers(self) -> np.ndarray | None:
+        """(T,) int64 the `surface` layer of each tetrahedron (its base triangle's material:
+        three tetrahedra per triangle, in the triangles' order); None without a surface."""
+        if self.surface is None:
+            return None
+        return np.repeat(np.asarray(self.base.material, np.int64), 3)
 
     def shell_at(self, time: float | None) -> ShellVolume:
         """The shell at animation ``time`` (None: at rest): the base deformed by a wave along
@@ -95,8 +112,8 @@ class TexturedShell:
                  f"{s['thickness'][0]:.4g}..{s['thickness'][1]:.4g}; texture "
                  f"'{self.texture.name}' {w}x{h}x{d} ({kind}), tiled "
                  f"{self.texture.tile[0]}x{self.texture.tile[1]}"]
-        dropped, thinned = (self.params.get(k, 0) for k in ("dropped_triangles",
-                                                             "thinned_vertices"))
+        dropped, thinned, left_out = (self.params.get(k, 0) for k in (
+            "dropped_triangles", "thinned_vertices", "materials_left_out"))
         if dropped:
             lines.append(f"warning: {dropped} triangles were left out of the shell (no area "
                          "in space or in uv, or a vertex normal along or behind the triangle)")
@@ -104,6 +121,11 @@ class TexturedShell:
             lines.append(f"warning: the shell is thinner (down to {s['thickness'][0]:.3g}) at "
                          f"{thinned} of {s['base_vertices']} vertices, where "
                          f"{self.params.get('thickness', 0):.3g} would fold it over itself")
+        if self.surface is not None:
+            lines.append(f"the surface's {len(self.surface.rgba8)} material(s) tint the volume")
+        if left_out:
+            lines.append(f"warning: the surface's {left_out} materials are left out (at most "
+                         f"{MAX_MATERIALS} tint a shell); the volume keeps its own colours")
         return lines
 
 
