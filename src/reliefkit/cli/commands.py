@@ -280,6 +280,9 @@ def cmd_compare(args) -> int:
     paths = write_comparison(result, Path(args.out), title)
     print(metrics_markdown(result, title))
     print("wrote " + ", ".join(str(p) for p in paths.values()))
+    for name, frame in result["frames"].items():  # what each variant's drawables said
+        for line in frame.warnings:
+            print(f"warning: {name}: {line}", file=sys.stderr)
     return 0
 
 

@@ -209,3 +209,11 @@ def test_render_warns_when_the_order_breaks_cycles(tmp_path):
     warned = [line for line in out.stderr.splitlines() if "cycles" in line]
     assert len(warned) == 1 and warned[0].startswith("warning: the visibility order broke")
     assert "--sort peel" in warned[0]
+    out = run_cli("compare", tmp_path / "two.obj", "--as", "shell-volume", "--texture",
+                  "clouds", "--texture-size", "16,16,8", "--thickness", "0.2", "--size",
+                  "48x48", "--out", tmp_path / "cmp")
+    assert out.returncode == 0, out.stderr
+    warned = [line for line in out.stderr.splitlines() if "cycles" in line]
+    assert warned and all(line.startswith("warning: ") and "--sort peel" in line
+                          for line in warned)
+    assert any(line.startswith("warning: sxmpvo: ") for line in warned)
