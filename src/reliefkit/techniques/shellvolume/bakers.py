@@ -90,12 +90,13 @@ def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
     base, dropped = usable_part(source)
     fitted = fitted_thickness(base, thickness)
     thinned = int((fitted < thickness).sum())
-    kept = has_material(base) and len(base.materials) <= MAX_MATERIALS
+    tinted = has_material(base)  # the surface's own look, kept under the volume's colours
+    kept = tinted and len(base.materials) <= MAX_MATERIALS
     return TexturedShell(base, fitted, texture,
                          {"source": source.name, "thickness": thickness,
                           "dropped_triangles": dropped, "thinned_vertices": thinned,
-                          "materials_left_out": 0 if kept or not has_material(base)
-                          else len(base.materials)},
+                          "materials_left_out": len(base.materials) if tinted and not kept
+                          else 0},
                          surface=material_atlas(base) if kept else None)
 
 

@@ -148,7 +148,7 @@ float opaque_distance(vec3 dir) {
 vec3 surface_tint(vec3 s) {
     if (!u_tinted) return vec3(1.0);
     vec2 uv = (s.xy / u_tile - u_surface_box.xy) * u_surface_box.zw;
-    return textureLod(u_surface, vec3(uv, tet_texel(v_tet, 15).y), 0.0).rgb;
+    return textureLod(u_surface, vec3(uv, tet_surface_layer(v_tet)), 0.0).rgb;
 }
 
 // The texture moving over time: strands sway, more at the top of the shell.

@@ -4,7 +4,8 @@
 // inside <= 0), 8-10 the rows of the object-to-texture map with the tiling folded in
 // (s = row . (p, 1) gives the lookup coordinate along u, v, w), 11-14 the shell's smooth
 // normal at vertex f, 15.x the longest segment a ray can have in the tetrahedron or in a face
-// neighbour it may come from (render.py, ray_reach).
+// neighbour it may come from (render.py, ray_reach), 15.y its layer of the base surface's
+// material atlas (TexturedShell.surface_layers).
 // Everything is relative to the shell's origin (u_model_offset places it, camera.glsl).
 #include "scale_free.glsl"
 #define TET_TEXELS 16
@@ -19,6 +20,7 @@ vec4 tet_texel(int tet, int k) {
 vec3 tet_vertex(int tet, int corner) { return tet_texel(tet, corner).xyz; }
 vec4 tet_plane(int tet, int face) { return tet_texel(tet, 4 + face); }
 float tet_ray_reach(int tet) { return tet_texel(tet, 15).x; }
+float tet_surface_layer(int tet) { return tet_texel(tet, 15).y; }
 
 // Texture coordinates (u U, v V, w) of shell-local point p in tetrahedron `tet`.
 vec3 tet_texture_coords(int tet, vec3 p) {
