@@ -110,6 +110,22 @@ def _warn_nothing_visible(what: str) -> None:
           "bounds and its materials' opacity)", file=sys.stderr)
 
 
+def _print_frame_warnings(per_frame: list, noun: str = "") -> None:
+    """What the drawables said of the pictures (`Frame.warnings`), one ``warning:`` line
+    each: of a single picture all; of a sequence (``noun`` "view" or "frame") the first
+    picture's, and how many others have some."""
+    warned = [(k, lines) for k, lines in enumerate(per_frame) if lines]
+    if not warned:
+        return
+    first, lines = warned[0]
+    for line in lines:
+        print(f"warning: {noun} {first + 1}: {line}" if noun else f"warning: {line}",
+              file=sys.stderr)
+    if len(warned) > 1:
+        print(f"warning: {len(warned) - 1} more of the {len(per_frame)} {noun}s have "
+              "warnings like this", file=sys.stderr)
+
+
 def cmd_render(args) -> int:
     from ..render import render, render_options
     from ..scene.views import check_fov, framing_bounds, orbit_bounds, parse_size, parse_view
@@ -138,6 +154,7 @@ def cmd_render(args) -> int:
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
     if frame.stats["covered"] == 0:
         _warn_nothing_visible("the render covers")
+    _print_frame_warnings([frame.warnings])
     if args.aovs:
         frame.save_aovs(args.aovs)
         print(f"wrote {args.aovs}")
@@ -187,12 +204,13 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
     from ..scene.views import turntable
 
     cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
-    frames, empty = [], []
+    frames, empty, warned = [], [], []
     with progress_bar("turntable", len(cameras)) as advance:
         for k, camera in enumerate(cameras):
             frame = draw(camera)
             if frame.stats["covered"] == 0:
                 empty.append(str(k + 1))
+            warned.append(frame.warnings)
             frames.append(frame.rgba8(background or TILE_BACKGROUND))
             advance(k + 1)
     save_gif(frames, args.output)
@@ -201,6 +219,7 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
         many = len(empty) > 1
         _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
                               f"cover{'' if many else 's'}")
+    _print_frame_warnings(warned, "view")
     return 0
 
 
@@ -216,14 +235,16 @@ def _render_animation(args, obj, camera, draw, background) -> int:
                          "(no --time option); use --turntable for views around it")
     if given_options(args).get(ANIMATION_TIME) is not None:
         raise UsageError("--animate sets the time of each frame itself: leave out --time")
-    frames = []
+    frames, warned = [], []
     with progress_bar("animate", args.animate) as advance:
         for k in range(args.animate):
-            frames.append(draw(camera, **{ANIMATION_TIME: k / args.animate}).rgba8(
-                background or TILE_BACKGROUND))
+            frame = draw(camera, **{ANIMATION_TIME: k / args.animate})
+            warned.append(frame.warnings)
+            frames.append(frame.rgba8(background or TILE_BACKGROUND))
             advance(k + 1)
     save_gif(frames, args.output)
     print(f"wrote {args.output} ({len(frames)} frames)")
+    _print_frame_warnings(warned, "frame")
     return 0
 
 
@@ -259,6 +280,9 @@ def cmd_compare(args) -> int:
     paths = write_comparison(result, Path(args.out), title)
     print(metrics_markdown(result, title))
     print("wrote " + ", ".join(str(p) for p in paths.values()))
+    for name, frame in result["frames"].items():  # what each variant's drawables said
+        for line in frame.warnings:
+            print(f"warning: {name}: {line}", file=sys.stderr)
     return 0
 
 

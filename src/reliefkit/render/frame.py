@@ -29,6 +29,8 @@ class Frame:
         the render was instrumented (``count_iterations=True``); technique-specific ones.
     extra : arrays that are no AOV (``iterations``: per-pixel loop counts, NaN where no
         fragment ran).
+    warnings : human-readable lines a drawable wants the user to see about this picture (a
+        known inexactness and its remedy); the CLI prints each as ``warning: ...``.
     """
 
     color: np.ndarray
@@ -41,6 +43,7 @@ class Frame:
     viewport: np.ndarray
     stats: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
 
     @property
     def size(self) -> tuple[int, int]:

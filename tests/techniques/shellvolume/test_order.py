@@ -315,3 +315,21 @@ def test_topological_order_matches_the_reference_with_cycles():
         order, broken = topological_order(n, src, dst, depth)
         ref, ref_broken, _ = reference_order(n, src, dst, depth)
         assert np.array_equal(order, ref) and broken == ref_broken and broken > 0
+
+
+def test_the_checker_counts_the_same_at_any_scale():
+    """The torus scaled by 1e-12 (every segment shorter than an absolute 1e-9) and its
+    camera likewise: the same rays, pairs and violations of the centroid order."""
+    counts = []
+    for scale in (1.0, 1e-12):
+        mesh = torus_mesh()
+        small = RenderMesh(mesh.world_positions * scale, mesh.indices, mesh.normals,
+                           mesh.colors, mesh.uvs)
+        shell = build_shell(small, 0.1 * scale)
+        camera = Camera.orbit((0, 0, 0), 30.0, 20.0, 4.5 * scale, size=(48, 48),
+                              near=0.5 * scale, far=10.0 * scale)
+        order = visibility_order(shell, camera, method="centroid").order
+        check = ordering_violations(shell, camera, order)
+        counts.append((check.rays, check.pairs, check.violations))
+    assert counts[0][1] > 100 and counts[0][2] > 0
+    assert counts[1] == counts[0]

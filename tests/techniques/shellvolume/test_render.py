@@ -279,6 +279,118 @@ def test_shadows_darken_what_the_roof_hides(gl):
     assert not darker[floor & (x > 0.4)].any() and not darker[roof].any()
 
 
+@pytest.mark.parametrize("elevation,azimuth", [(10.0, 35.0), (30.0, 35.0), (60.0, 0.0),
+                                               (20.0, 60.0)])
+def test_shadows_leave_a_lit_flat_surface_lit(gl, elevation, azimuth):
+    """A solid slab (the lower half of the shell) under a light from above: nothing lies
+    between its flat top and the light, so no pixel of it may be darker with --shadows
+    than without (shadow acne: isolated dark pixels where a sample tests itself)."""
+    from reliefkit.scene.light import DirectionalLight
+
+    alpha = np.zeros((8, 16, 16))
+    alpha[:4] = 1.0
+    rep = TexturedShell(grid_mesh(8), 0.2, texture_from((0.8, 0.8, 0.8), alpha))
+    cam = slab_camera(20.0, size=(96, 96), ortho=True)
+    el, az = np.radians(elevation), np.radians(azimuth)
+    light = DirectionalLight(direction=(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az),
+                                        np.sin(el)), ambient=0.2)
+    lit = render(rep, cam, ctx=gl, light=light, samples=16)
+    shadowed = render(rep, cam, ctx=gl, light=light, samples=16, shadows=True)
+    top = lit.color[..., 3] > 0.99
+    assert top.all()
+    darker = shadowed.color[..., :3] < lit.color[..., :3] - 0.01
+    assert not darker.any(), f"{int(darker.any(axis=-1).sum())} dark pixels"
+
+
+def test_a_shell_looks_the_same_at_any_scale(gl):
+    """The cloudy sphere scaled by 1e-20 (squares of its coordinates flush to zero in float32)
+    gives the unit sphere's picture, lit and shadowed (it drew nothing)."""
+    from reliefkit.scene.light import DirectionalLight
+
+    base = sphere_mesh(2)
+    tex = textures.make_clouds(size=(16, 16, 8)).tiled((2, 1))
+    light = DirectionalLight.from_angles(-60.0, 30.0)
+    frames = []
+    for scale in (1.0, 1e-20):
+        tiny = RenderMesh(base.world_positions * scale, base.indices, base.normals,
+                          base.colors, base.uvs)
+        cam = Camera.orbit((0.0, 0.0, 0.0), 30.0, 25.0, 4.0 * scale, fov_deg=35.0,
+                           size=(48, 48), near=0.5 * scale, far=10.0 * scale)
+        rep = TexturedShell(tiny, 0.25 * scale, tex.over_length(0.25 * scale))
+        frames.append(render(rep, cam, ctx=gl, light=light, samples=8, shadows=True))
+    unit, tiny = (premultiplied(f.color) for f in frames)
+    assert frames[0].stats["covered"] > 500
+    assert np.abs(unit - tiny).max() < 0.02
+
+
+def crossing_spheres():
+    """Two spheres passing through each other: where their shells cross, tetrahedra overlap
+    and no visibility order exists."""
+    one, two = sphere_mesh(2), sphere_mesh(2)
+    offset = len(one.positions)
+    positions = np.concatenate([one.world_positions, two.world_positions + (0.8, 0.0, 0.0)])
+    mesh = RenderMesh(positions, np.concatenate([one.indices, two.indices + offset]),
+                      np.concatenate([one.normals, two.normals]),
+                      np.ones((len(positions), 4)), np.concatenate([one.uvs, two.uvs]))
+    return TexturedShell(mesh, 0.2, textures.make_clouds(size=(16, 16, 8)).over_length(0.2))
+
+
+def test_a_sort_that_breaks_cycles_says_so(gl, cloudy_sphere):
+    """The frame carries a warning with the count and the exact alternative; a shell whose
+    order is exact carries none."""
+    cam = sphere_camera(az=10.0)
+    frame = render(crossing_spheres(), cam, ctx=gl, samples=4)
+    assert frame.stats["cycles"] > 0
+    assert len(frame.warnings) == 1
+    assert f"{frame.stats['cycles']:,} cycles" in frame.warnings[0]
+    assert "--sort peel" in frame.warnings[0]
+    clean = render(cloudy_sphere, cam, ctx=gl, samples=4)
+    assert clean.stats["cycles"] == 0 and clean.warnings == []
+
+
+def two_material_grid():
+    """The grid (uvs over [0, 1]^2) with a red factor on the triangles of x < 0 and a 2x2
+    blue-and-yellow texture on the others."""
+    from reliefkit.scene.mesh import Material
+
+    mesh = grid_mesh(4)
+    centres = mesh.world_positions[mesh.indices].mean(axis=1)
+    texture = np.array([[[0, 0, 255, 255], [255, 255, 0, 255]],
+                        [[255, 255, 0, 255], [0, 0, 255, 255]]], np.uint8)
+    materials = [Material("red", (1.0, 0.2, 0.2, 1.0)), Material("tiles", texture=texture)]
+    return RenderMesh(mesh.world_positions, mesh.indices, mesh.normals, mesh.colors, mesh.uvs,
+                      materials=materials, material=(centres[:, 0] > 0).astype(np.uint16))
+
+
+def test_the_surface_material_tints_the_volume(gl, tmp_path):
+    """A uniform medium over two materials: over the red factor its colour is the medium's
+    times the factor exactly; everywhere the GPU matches the CPU reference, which samples
+    the same atlas; the atlas survives a round trip through the .rk file."""
+    from reliefkit.bake import bake
+
+    rep = bake(two_material_grid(), "shell-volume", texture="absorption", thickness=0.4,
+               tile=(2.0, 2.0), texture_size=(4.0, 4.0, 4.0))
+    assert rep.surface is not None and rep.surface.rgba8.shape[0] == 2
+    cam = Camera(eye=(0.0, 0.0, 3.0), target=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0),
+                 size=(48, 48), near=0.5, far=10.0, ortho_height=1.0)
+    frame = render(rep, cam, ctx=gl, unlit=True, mip=False, samples=8)
+    o, _ = cam.pixel_rays()
+    red = (o[..., 0] < -0.2) & (np.abs(o[..., 1]) < 0.8) & (o[..., 0] > -0.8)
+    medium = np.array([0.1, 0.7, 0.2])  # textures.make_absorption's colour
+    assert red.sum() > 200
+    np.testing.assert_allclose(frame.color[..., :3][red], np.broadcast_to(
+        medium * (1.0, 0.2, 0.2), (int(red.sum()), 3)), atol=2e-3)
+    ref = reference_render(rep.shell, rep.texture, cam, samples=8, surface=rep.surface,
+                           layers=rep.surface_layers())
+    rmse, off = against_reference(frame, ref)
+    assert rmse <= RMSE_BOUND and off <= 0.005
+    save(tmp_path / "tinted.rk", rep)
+    back = load(tmp_path / "tinted.rk")
+    assert np.array_equal(back.surface.rgba8, rep.surface.rgba8)
+    assert back.surface.box == rep.surface.box
+    assert np.array_equal(back.base.material, rep.base.material)
+
+
 def test_animation_moves_and_repeats(gl, cloudy_sphere):
     cam = sphere_camera()
     still = render(cloudy_sphere, cam, ctx=gl, samples=4)

@@ -49,7 +49,8 @@ def _against_reference(frame, rep, camera):
         out["order_violations"] = ordering_violations(rep.shell, camera, order.order).violations
     if not frame.stats.get("unlit") or frame.stats.get("mip"):
         return out, None
-    ref = reference_render(rep.shell, rep.texture, camera, samples=frame.stats["samples"])
+    ref = reference_render(rep.shell, rep.texture, camera, samples=frame.stats["samples"],
+                           surface=rep.surface, layers=rep.surface_layers())
 
     def premultiplied(c):
         return np.concatenate([c[..., :3] * c[..., 3:], c[..., 3:]], axis=-1)

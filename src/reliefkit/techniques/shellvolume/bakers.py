@@ -6,13 +6,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
+from ...bake.uv_atlas import MAX_MATERIALS, has_material, material_atlas
 from ...core.params import param
 from ...errors import UsageError
-from .representation import TexturedShell
+from .representation import TexturedShell, check_tetrahedron_count
 from .shell import fitted_thickness, unusable_triangles
 from .textures import TEXTURES, load_texture_npy, texture_from_mesh
 
-DEFAULT_THICKNESS = 0.05  # of the base's bounding-box diagonal, when --thickness is not given
+# A generated or voxelized texture costs about MADE_SECONDS_PER_MVOXEL per million voxels and
+# MADE_BYTES_PER_VOXEL at its peak (fur, the slowest, at 128^3: 42 s and 0.7 GB on 2026-12-06
+# on this 2-core machine); above MADE_MAX_VOXELS a bake would run for minutes, so it is
+# refused with the estimate before anything is allocated.
+MADE_SECONDS_PER_MVOXEL = 20.0
+MADE_BYTES_PER_VOXEL = 350
+MADE_MAX_VOXELS = 128**3
 
 
 @dataclass(frozen=True)
@@ -21,18 +29,23 @@ class ShellVolumeParams:
                          "(D, H, W, 4) float RGBA, or a mesh (FILE or demo:NAME) voxelized "
                          "into one")
     thickness: float | None = param(None, "shell thickness in the mesh's own units (none: "
-                                    f"{DEFAULT_THICKNESS:g} of its bounding-box diagonal)",
+                                    f"{LAYER_PER_EDGE:g} of its median edge length)",
                                     kind="float", lo=1e-12)
-    tile: tuple = param((1.0, 1.0), "how many times the texture repeats over the uvs, U,V",
-                        kind="floats", count=2, lo=1, hi=4096)
+    tile: tuple | None = param(None, "how many times the texture repeats over the uvs, U,V "
+                               f"(none: as often as makes a tile about {TILE_PER_LAYER:g} "
+                               "thicknesses long on the surface)",
+                               kind="floats", count=2, lo=1, hi=4096)
     texture_size: tuple = param((32.0, 32.0, 16.0), "W,H,D voxels of a generated or "
-                                "voxelized texture", kind="floats", count=3, lo=2, hi=256)
+                                "voxelized texture (at most 128^3 in all)", kind="floats",
+                                count=3, lo=2, hi=256)
 
 
 def make_texture(spec: str, size, thickness: float, progress=None):
     """The texture ``spec`` names (see `ShellVolumeParams.texture`) at ``size`` (W, H, D);
     a generated one's alpha converted for a shell of ``thickness``."""
     size = tuple(int(round(s)) for s in size)
+    if not spec.lower().endswith(".npy"):
+        check_made_size(size)
     if spec in TEXTURES:
         return TEXTURES[spec](size=size).over_length(thickness)
     if spec.lower().endswith(".npy"):
@@ -52,22 +65,40 @@ def make_texture(spec: str, size, thickness: float, progress=None):
     return texture_from_mesh(mesh, size, progress=progress)
 
 
+def check_made_size(size) -> None:
+    """Refuse a generated or voxelized texture of ``size`` (W, H, D) whose making would take
+    minutes (estimate in the message)."""
+    voxels = size[0] * size[1] * size[2]
+    if voxels <= MADE_MAX_VOXELS:
+        return
+    minutes = MADE_SECONDS_PER_MVOXEL * voxels / 1e6 / 60
+    gib = MADE_BYTES_PER_VOXEL * voxels / 2**30
+    raise UsageError(f"--texture-size {size[0]},{size[1]},{size[2]} is {voxels:,} voxels: making "
+                     f"that texture would take about {minutes:.0f} minutes and {gib:.1f} GiB "
+                     f"here (the limit is {MADE_MAX_VOXELS:,} voxels, e.g. 128,128,128); use a "
+                     "smaller size, or a .npy volume made elsewhere")
+
+
 def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
-    for t in p.tile:
-        if t != int(t):
-            raise UsageError(f"--tile takes whole numbers, got {p.tile[0]:g},{p.tile[1]:g}")
-    lo, hi = source.bounds
-    thickness = p.thickness if p.thickness is not None else \
-        DEFAULT_THICKNESS * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
-    texture = make_texture(p.texture, p.texture_size, thickness, progress).tiled(
-        (int(p.tile[0]), int(p.tile[1])))
+    if p.tile is not None and any(t != int(t) for t in p.tile):
+        raise UsageError(f"--tile takes whole numbers, got {p.tile[0]:g},{p.tile[1]:g}")
+    check_tetrahedron_count(len(source.indices))
+    thickness = p.thickness if p.thickness is not None else layer_thickness(source)
+    tile = uv_tiling(source, TILE_PER_LAYER * thickness) if p.tile is None else \
+        (int(p.tile[0]), int(p.tile[1]))
+    texture = make_texture(p.texture, p.texture_size, thickness, progress).tiled(tile)
     base, dropped = usable_part(source)
     fitted = fitted_thickness(base, thickness)
     thinned = int((fitted < thickness).sum())
+    tinted = has_material(base)  # the surface's own look, kept under the volume's colours
+    kept = tinted and len(base.materials) <= MAX_MATERIALS
     return TexturedShell(base, fitted, texture,
                          {"source": source.name, "thickness": thickness,
-                          "dropped_triangles": dropped, "thinned_vertices": thinned},
-                         source_bounds=source.bounds)
+                          "dropped_triangles": dropped, "thinned_vertices": thinned,
+                          "materials_left_out": len(base.materials) if tinted and not kept
+                          else 0},
+                         source_bounds=source.bounds,
+                         surface=material_atlas(base) if kept else None)
 
 
 def usable_part(mesh):
@@ -86,4 +117,5 @@ def usable_part(mesh):
 
     kept = np.asarray(mesh.indices)[~bad]
     return RenderMesh(mesh.world_positions, kept, mesh.normals, mesh.colors, mesh.uvs,
-                      name=mesh.name), int(bad.sum())
+                      name=mesh.name, materials=mesh.materials,
+                      material=np.asarray(mesh.material)[~bad]), int(bad.sum())

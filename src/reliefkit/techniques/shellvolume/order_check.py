@@ -2,8 +2,9 @@
 benchmarks.
 
 One ray per pixel (`Camera.pixel_rays`: from the near plane through the pixel centre). On
-each ray, the tetrahedra it crosses (a positive length, more than `TOL`) are sorted by the
-exact float64 distance at which the ray enters them (ties by tetrahedron index). Each pair
+each ray, the tetrahedra it crosses (a length more than `TOL` of the shell's size) are
+sorted by the exact float64 distance at which the ray enters them (ties by tetrahedron
+index). Each pair
 of consecutive tetrahedra on that list is one constraint: the nearer one must come first
 in the order. A constraint whose two tetrahedra come the other way round in the order is a
 violation.
@@ -28,7 +29,8 @@ from ...errors import UsageError
 from ...scene.camera import pixel_segments
 from .binning import bin_by_tile, screen_boxes
 
-#: A ray crosses a tetrahedron when its length inside is more than this (world units).
+#: A ray crosses a tetrahedron when its length inside is more than this times the shell's
+#: size (relative: a shell of any scale is checked alike).
 TOL = 1e-9
 
 #: Side of the square screen tiles tetrahedra are binned into, in pixels.
@@ -84,9 +86,15 @@ def ordering_violations(shell, camera, order, size=None) -> OrderCheck:
     violations, pairs, rays, bad_rays = _check(
         np.ascontiguousarray(shell.planes, dtype=np.float64), np.ascontiguousarray(near),
         np.ascontiguousarray(dirs), starts, items, np.stack([lo_c, hi_c, lo_r, hi_r], axis=1),
-        rank, TILE, tiles_x, TOL)
+        rank, TILE, tiles_x, TOL * _size(shell))
     return OrderCheck(int(violations), int(pairs), int(rays), int(bad_rays),
                       time.perf_counter() - start)
+
+
+def _size(shell) -> float:
+    """The diagonal of the shell's bounding box (1 for a point)."""
+    p = np.asarray(shell.positions, np.float64)
+    return float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) or 1.0
 
 
 @njit(cache=True)

@@ -61,6 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from ...colorspace import srgb_decode
 from ...errors import UsageError
 from ...scene.camera import pixel_segments
 from .binning import bin_by_tile, screen_boxes
@@ -115,7 +116,7 @@ class ReferenceImage:
 
 
 def reference_render(shell, texture, camera, *, step=None, samples=None, level=None,
-                     rgba=None) -> ReferenceImage:
+                     rgba=None, surface=None, layers=None) -> ReferenceImage:
     """Render `shell` filled with `texture` as seen by `camera` (see the module docstring).
 
     step: dense sampling, n = max(1, ceil(L / step)) samples per segment (default
@@ -124,6 +125,9 @@ def reference_render(shell, texture, camera, *, step=None, samples=None, level=N
         `filtering.mip_pyramid(texture, level + 1, mean thickness)` to read.
     rgba: an explicit (D, H, W, 4) array (e.g. a mip level) read instead of texture.rgba
         (not with level); ``texture.tile`` still applies.
+    surface, layers: the base's material atlas (`TexturedShell.surface`) and each
+        tetrahedron's layer in it (`TexturedShell.surface_layers`): colours are multiplied by
+        its bilinear (clamped) colour at the sample's base uv, as the renderer does.
     """
     start = time.perf_counter()
     if step is not None and samples is not None:
@@ -148,6 +152,11 @@ def reference_render(shell, texture, camera, *, step=None, samples=None, level=N
     lo_c, hi_c, lo_r, hi_r = screen_boxes(shell, camera, width, height)
     starts, items = bin_by_tile(lo_c, hi_c, lo_r, hi_r, ntx, nty, TILE)
 
+    if surface is None:  # one white texel: a factor of 1
+        tint, layers, box = np.ones((1, 1, 1, 3)), np.zeros(len(shell.tets), np.int64), \
+            (0.0, 0.0, 1.0, 1.0)
+    else:
+        tint, box = srgb_decode(surface.rgba8[..., :3] / 255.0), surface.box
     color = np.zeros((height, width, 4), np.float32)
     position = np.full((height, width, 3), np.nan)
     crossings = np.zeros((height, width), np.int32)
@@ -155,7 +164,9 @@ def reference_render(shell, texture, camera, *, step=None, samples=None, level=N
             np.ascontiguousarray(shell.planes, dtype=np.float64),
             np.ascontiguousarray(shell.object_to_texture, dtype=np.float64),
             starts, items, ntx, volume, tile_u, tile_v, n_samples, h, eps,
-            density_floor(mean_thickness), color, position, crossings)
+            density_floor(mean_thickness), np.ascontiguousarray(tint),
+            np.asarray(layers, np.int64), np.asarray(box, np.float64), color, position,
+            crossings)
     return ReferenceImage(color, position, crossings, time.perf_counter() - start)
 
 
@@ -264,9 +275,21 @@ def _fetch(vol, su, sv, sw, out):
         out[ch] = (1.0 - fw) * c0 + fw * c1
 
 
+@njit(cache=True, error_model="numpy")
+def _tint(tint, layer, box, u, v, out):
+    """Multiply out[:3] by the bilinear (clamped) colour of layer ``layer`` of ``tint``
+    (M, H, W, 3) at base uv (u, v) over the rectangle ``box`` (u0, v0, u1, v1)."""
+    x0, x1, fx = _clamp_axis((u - box[0]) / (box[2] - box[0]), tint.shape[2])
+    y0, y1, fy = _clamp_axis((v - box[1]) / (box[3] - box[1]), tint.shape[1])
+    for ch in range(3):
+        c0 = (1.0 - fx) * tint[layer, y0, x0, ch] + fx * tint[layer, y0, x1, ch]
+        c1 = (1.0 - fx) * tint[layer, y1, x0, ch] + fx * tint[layer, y1, x1, ch]
+        out[ch] *= (1.0 - fy) * c0 + fy * c1
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def _render(origins, dirs, t_far, planes, m, starts, items, ntx, vol, tile_u, tile_v,
-            n_samples, h, eps, floor, color, position, crossings):
+            n_samples, h, eps, floor, tint, layers, box, color, position, crossings):
     height, width = t_far.shape
     for k in prange(starts.shape[0] - 1):
         ty, tx = k // ntx, k % ntx
@@ -317,6 +340,7 @@ def _render(origins, dirs, t_far, planes, m, starts, items, ntx, vol, tile_u, ti
                         texel[0] /= weight
                         texel[1] /= weight
                         texel[2] /= weight
+                        _tint(tint, layers[t], box, u, v, texel)
                         weight = (1.0 - acc_a) * a
                         acc_r += weight * texel[0]
                         acc_g += weight * texel[1]

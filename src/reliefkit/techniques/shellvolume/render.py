@@ -28,20 +28,21 @@ from ...gl.context import check_gl_error
 from ...gl.objects import GLObjects
 from ...gl.shaders import program
 from ...gl.targets import use_transparent_blending
-from ...gl.textures import read_depth, read_rgba, texture2d, texture3d
+from ...gl.textures import read_depth, read_rgba, texture2d, texture3d, texture_array
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
-from .representation import TexturedShell
+from .representation import TET_TEXELS, TETS_PER_ROW, TexturedShell
 from .textures import density_floor, density_normals, marched_volume
 
 PROGRAM = "shellvolume:shell.glsl"
-TET_TEXELS, TET_ROW_TEXELS = 16, 2048  # shaders/include/tets.glsl
+TET_ROW_TEXELS = TET_TEXELS * TETS_PER_ROW  # 2048, shaders/include/tets.glsl
 MAX_LEVELS = 4                          # shaders/include/volume.glsl
 SEARCH_BINS = 16
 SHADOW_SIZE = 1024
+SHADOW_DEPTH_BIAS = 2.0 ** -16  # window depth: the shadow map's rounding, not its texels
 _COLOR_UNITS, _NORMAL_UNITS = range(0, 4), range(4, 8)
-_TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT = 8, 9, 10, 11
+_TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT, _SURFACE_UNIT = 8, 9, 10, 11, 13
 EXITS = ("fragment", "vertex")
 SORTS = (*METHODS, "peel")  # peel: depth peeling, the baseline the paper measured against
 MAX_PEELS = 1024
@@ -79,9 +80,10 @@ class ShellRenderOptions:
                                "AOVs (extra passes; off: AOVs only from opaque objects)")
 
 
-def tet_texels(shell, origin, tile) -> np.ndarray:
+def tet_texels(shell, origin, tile, layers=None) -> np.ndarray:
     """(rows, TET_ROW_TEXELS, 4) float32: shaders/include/tets.glsl's block per tetrahedron,
-    relative to ``origin`` (float64), the tiling folded into the texture map."""
+    relative to ``origin`` (float64), the tiling folded into the texture map; ``layers``
+    (T,): the surface material layer of each tetrahedron (0 when None)."""
     origin = np.asarray(origin, np.float64)
     count = len(shell.tets)
     block = np.zeros((count, TET_TEXELS, 4), np.float64)
@@ -97,10 +99,24 @@ def tet_texels(shell, origin, tile) -> np.ndarray:
     block[:, 8:11, :3] = rows[..., :3]
     block[:, 8:11, 3] = rows[..., 3] + rows[..., :3] @ origin
     block[:, 11:15, :3] = shell.normals[shell.tets]
-    per_row = TET_ROW_TEXELS // TET_TEXELS
-    padded = np.zeros((-(-count // per_row) * per_row, TET_TEXELS, 4), np.float32)
+    block[:, 15, 0] = ray_reach(shell)
+    if layers is not None:
+        block[:, 15, 1] = layers
+    padded = np.zeros((-(-count // TETS_PER_ROW) * TETS_PER_ROW, TET_TEXELS, 4), np.float32)
     padded[:count] = block
     return padded.reshape(-1, TET_ROW_TEXELS, 4)
+
+
+def ray_reach(shell) -> np.ndarray:
+    """(T,) the longest segment a ray can have in each tetrahedron or in one it may come
+    from (a face neighbour): the longest edge among them. The shadow test steps back by it
+    over the sample count (shaders/shell.glsl, light_visibility)."""
+    corners = shell.positions[shell.tets]
+    pairs = [(i, j) for i in range(4) for j in range(i + 1, 4)]
+    own = np.max([np.linalg.norm(corners[:, i] - corners[:, j], axis=-1)
+                  for i, j in pairs], axis=0)
+    beside = np.where(shell.neighbors >= 0, own[np.maximum(shell.neighbors, 0)], 0.0)
+    return np.maximum(own, beside.max(axis=1))
 
 
 def level_count(shape) -> int:
@@ -170,7 +186,10 @@ class TexturedShellDrawable(GLObjects):
                 tex.repeat_z = False  # w is clamped: the shell ends at its base and top
                 pair.append(tex)
             self.level_textures.append(pair)
-        texels = tet_texels(shell, self.origin, rep.texture.tile)
+        if rep.surface is not None:
+            self.surface = self.keep(texture_array(ctx, rep.surface.rgba8, srgb=True,
+                                                   what="shell surface materials"))
+        texels = tet_texels(shell, self.origin, rep.texture.tile, rep.surface_layers())
         self.tets = self.keep(texture2d(ctx, texels, what="shell tetrahedra",
                                         filter="nearest"))
         count = len(shell.tets)
@@ -209,6 +228,8 @@ class TexturedShellDrawable(GLObjects):
         units |= {f"u_normal{k}": _NORMAL_UNITS[min(k, len(self.levels) - 1)]
                   for k in range(MAX_LEVELS)}
         animated = self.options.time is not None
+        surface = self.rep.surface
+        box = surface.box if surface is not None else (0.0, 0.0, 1.0, 1.0)
         return (camera_uniforms(camera) | model_offset(camera, self.origin) | light.uniforms()
                 | units | {"u_tets": _TETS_UNIT, "u_levels": len(self.levels),
                            "u_level_size": sizes, "u_mip": self.options.mip,
@@ -217,13 +238,19 @@ class TexturedShellDrawable(GLObjects):
                            "u_time": float(self.options.time or 0.0),
                            "u_sway": 0.04 if animated else 0.0,
                            "u_opaque_depth": _DEPTH_UNIT, "u_search": _SEARCH_UNIT,
-                           "u_shadow_map": _SHADOW_UNIT})
+                           "u_shadow_map": _SHADOW_UNIT, "u_surface": _SURFACE_UNIT,
+                           "u_tinted": surface is not None,
+                           "u_surface_box": (box[0], box[1], 1.0 / (box[2] - box[0]),
+                                             1.0 / (box[3] - box[1])),
+                           "u_tile": tuple(float(t) for t in self.rep.texture.tile)})
 
     def _bind(self) -> None:
         for k, (colour, normal) in enumerate(self.level_textures):
             colour.use(_COLOR_UNITS[k])
             normal.use(_NORMAL_UNITS[k])
         self.tets.use(_TETS_UNIT)
+        if self.rep.surface is not None:
+            self.surface.use(_SURFACE_UNIT)
 
     def _draw(self, name: str, uniforms: dict) -> None:
         set_uniforms(self.programs[name], uniforms)
@@ -298,8 +325,8 @@ class TexturedShellDrawable(GLObjects):
         from ...core.transforms import translation
 
         light_matrix = np.asarray(cam.proj) @ np.asarray(cam.view) @ translation(self.origin)
-        return {"u_light_matrix": light_matrix,
-                "u_shadow_bias": 2.0 / SHADOW_SIZE}
+        return {"u_light_matrix": light_matrix, "u_shadow_bias": SHADOW_DEPTH_BIAS,
+                "u_shadow_texel": 2.0 * cam.ortho_height / cam.size[0]}
 
     def _opaque_depth(self, outer, made) -> dict:
         """A copy of the opaque pass's depth to sample (the attached one cannot be)."""
@@ -408,6 +435,18 @@ class TexturedShellDrawable(GLObjects):
         frame.stats.update({"tetrahedra": len(self.shell.tets),
                             "samples": self.options.samples, "unlit": self.options.unlit,
                             "mip": self.options.mip, **self.stats})
+        if self.stats.get("cycles"):
+            frame.warnings.append(cycles_warning(self.stats["cycles"]))
+
+
+def cycles_warning(cycles: int) -> str:
+    """What a sort that broke ``cycles`` cycles tells the user: no order of the tetrahedra
+    exists where they overlap (parts of the mesh pass through each other, or the shell is
+    too thick there), so some pixels are composited out of order; peeling is exact."""
+    return (f"the visibility order broke {cycles:,} cycles (tetrahedra that overlap, where "
+            "parts of the mesh pass through each other or the shell is too thick): some "
+            "pixels are composited out of order; --sort peel is exact (one pass per depth "
+            "layer, slower)")
 
 
 def _needed_optical_depth(front: np.ndarray) -> np.ndarray:

@@ -56,6 +56,9 @@ class VolumeTexture:
         if self.rgba.ndim != 4 or self.rgba.shape[3] != 4 or self.rgba.dtype != np.float32:
             got = f"{self.rgba.dtype} {self.rgba.shape}"
             raise UsageError(f"texture rgba must be float32 (D, H, W, 4), got {got}")
+        if min(self.rgba.shape[:3]) < 1:
+            raise UsageError(f"texture has {self.rgba.shape[:3]} (D, H, W) voxels; every "
+                             "size must be at least 1")
         if self.normal.shape != self.rgba.shape[:3] + (3,) or self.normal.dtype != np.float32:
             got = f"{self.normal.dtype} {self.normal.shape}"
             raise UsageError(f"texture normal must be float32 (D, H, W, 3), got {got}")
@@ -394,7 +397,8 @@ def load_texture_npy(path, name: str | None = None) -> VolumeTexture:
     that matches. Values must be finite, colour >= 0, alpha in [0, 1].
     """
     path = Path(path)
-    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    # a symlink is followed (fstat checks what it points to); O_NONBLOCK: a FIFO never blocks
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0)
     try:
         fd = os.open(path, flags)
     except OSError as exc:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
 from ...core.params import param
 from ...errors import UsageError
 from .displacement import DisplacementMap
@@ -30,11 +31,10 @@ from .displacement_textures import (
     terrain_colors,
 )
 
-#: Without --displacement-scale: a heightmap's square rises by this much of its diagonal ...
+#: Without --displacement-scale: a heightmap's square rises by this much of its diagonal (a
+#: mesh base by `reliefkit.bake.detail.layer_thickness`: a skin following its detail, as
+#: thick as a shell volume's default)
 DEFAULT_SCALE = 0.1
-#: ... and a mesh base by this much of its bounding-box diagonal (a skin like fur or bumps,
-#: as thick as a shell volume's default)
-DEFAULT_MESH_SCALE = 0.05
 SQUARE = 2.0         # side of a heightmap's polygon
 
 
@@ -42,8 +42,8 @@ SQUARE = 2.0         # side of a heightmap's polygon
 class DisplacementParams:
     displacement_scale: float | None = param(
         None, "world length of height 1 along the normals (none: the box height for a "
-        f"projected mesh, {DEFAULT_MESH_SCALE:g} of a mesh base's bounding-box diagonal, "
-        f"{DEFAULT_SCALE:g} of a heightmap square's)",
+        f"projected mesh, {LAYER_PER_EDGE:g} of a mesh base's median edge length, "
+        f"{DEFAULT_SCALE:g} of a heightmap square's diagonal)",
         kind="float", lo=1e-12)
     res: int = param(256, "displacement texture resolution (texels per side)", lo=2,
                      hi=8192)
@@ -51,8 +51,11 @@ class DisplacementParams:
         None, "the displacement texture on a mesh base (" + ", ".join(TEXTURES) + ", or a "
         "heightmap .png/.npy); none: project the mesh from above onto one polygon",
         kind="str")
-    tile: tuple = param((1.0, 1.0), "how many times the texture repeats over the uvs, U,V",
-                        kind="floats", count=2, lo=1, hi=4096)
+    tile: tuple | None = param(None, "how many times the texture repeats over the uvs, U,V "
+                               "(none: a procedural texture on a mesh base as often as makes "
+                               f"a tile about {TILE_PER_LAYER:g} scales long on the surface, "
+                               "a file once)",
+                               kind="floats", count=2, lo=1, hi=4096)
 
 
 def square_base(name: str = "square"):
@@ -158,7 +161,7 @@ def _rgba_texture(spec: str):
 
 
 def bake_displacement(source, p: DisplacementParams, progress=None) -> DisplacementMap:
-    tile = tuple(float(t) for t in p.tile)
+    tile = (1.0, 1.0) if p.tile is None else tuple(float(t) for t in p.tile)
     if isinstance(source, np.ndarray):
         height = normalised_heights(source)
         base = square_base("heightmap")
@@ -178,7 +181,9 @@ def bake_displacement(source, p: DisplacementParams, progress=None) -> Displacem
     else:
         color, height = _file_texture(p.displacement)
         wrap = tile != (1.0, 1.0)
-    scale = _scale(p, DEFAULT_MESH_SCALE * _diagonal(source.bounds))
+    scale = _scale(p, layer_thickness(source))
+    if p.tile is None and wrap:  # a periodic texture repeats at the mesh's own scale
+        tile = tuple(float(t) for t in uv_tiling(source, TILE_PER_LAYER * scale))
     base = _usable(source)
     return DisplacementMap(base, color, height, scale, tile, wrap,
                            params={"source": source.name, "texture": p.displacement},

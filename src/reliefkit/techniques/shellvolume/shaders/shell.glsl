@@ -84,6 +84,10 @@ uniform bool u_clip_opaque;         // stop segments at the opaque pass's surfac
 uniform highp sampler2D u_opaque_depth;
 uniform float u_time;               // animation time (the texture sways with it)
 uniform float u_sway;               // sway amplitude in texture tiles (0: still)
+uniform mediump sampler2DArray u_surface;  // the base's materials in uv space, per layer
+uniform bool u_tinted;              // whether there is one
+uniform vec4 u_surface_box;         // its uv rectangle: u0, v0, 1 / (u1 - u0), 1 / (v1 - v0)
+uniform vec2 u_tile;                // the texture's repetitions over the uvs
 #if defined AOV_BINS || defined AOV_FINAL
 uniform highp sampler2D u_search;   // per pixel, see render.py (half_opacity_search)
 #endif
@@ -96,7 +100,8 @@ uniform highp sampler2D u_peel_depth;  // .xy: gl_FragCoord.z and tetrahedron pe
 #if defined SHADOWS
 uniform highp sampler2D u_shadow_map;
 uniform mat4 u_light_matrix;        // shell-local point -> the light's clip space
-uniform float u_shadow_bias;
+uniform float u_shadow_bias;       // window depth: the depth buffer's rounding
+uniform float u_shadow_texel;      // a shadow-map texel's width, world units
 #endif
 in vec3 v_local;
 flat in int v_tet;
@@ -108,7 +113,7 @@ in vec3 v_exit;
 vec3 eye_local() { return u_eye - u_model_offset; }
 
 vec3 ray_direction() {
-    return u_orthographic ? -u_view_dir : normalize(v_local - eye_local());
+    return u_orthographic ? -u_view_dir : unit_or(v_local - eye_local(), -u_view_dir);
 }
 
 // Distance from the entry point to where the ray leaves the tetrahedron.
@@ -116,7 +121,7 @@ float exit_distance(vec3 dir) {
 #if defined EXIT_VERTEX
     if (u_orthographic) return max(min(min(v_exit.x, v_exit.y), v_exit.z), 0.0);
     float mu = max(max(v_exit.x, v_exit.y), v_exit.z);
-    return mu > 0.0 ? max(1.0 / mu - 1.0, 0.0) * length(v_local - eye_local()) : 0.0;
+    return mu > 0.0 ? max(1.0 / mu - 1.0, 0.0) * scale_free_length(v_local - eye_local()) : 0.0;
 #else
     float t = 1e30;
     for (int f = 0; f < 4; ++f) {
@@ -137,6 +142,15 @@ float opaque_distance(vec3 dir) {
     return max(dot(p - v_local, dir), 0.0);
 }
 
+// The colour of the base surface's own material under lookup coordinate s (the tiling
+// undone: the base's uv), from the tetrahedron's material layer (render.py, uv_atlas.py);
+// white without one. The volume's colours are multiplied by it.
+vec3 surface_tint(vec3 s) {
+    if (!u_tinted) return vec3(1.0);
+    vec2 uv = (s.xy / u_tile - u_surface_box.xy) * u_surface_box.zw;
+    return textureLod(u_surface, vec3(uv, tet_surface_layer(v_tet)), 0.0).rgb;
+}
+
 // The texture moving over time: strands sway, more at the top of the shell.
 vec3 animated(vec3 s) {
     float w = clamp(s.z, 0.0, 1.0);
@@ -145,23 +159,31 @@ vec3 animated(vec3 s) {
 }
 
 #if defined SHADOWS
-// 1 where the light reaches shell-local point p, 0 behind the first dense voxel it meets.
-float light_visibility(vec3 p) {
-    vec4 q = u_light_matrix * vec4(p, 1.0);
+// 1 where the light reaches the surface a sample at shell-local p stands for, 0 behind the
+// first dense voxel the light meets. That surface lies between the sample before (`back`
+// along the ray) and this one, and the shadow map's nearest texel holds the depth of a light
+// ray up to half a texel diagonal beside p, on a surface sloped by the angle to the light:
+// tested at the sample before, lifted off the surface along its normal `n` by one texel,
+// neither error darkens a lit surface (no shadow acne).
+float light_visibility(vec3 p, vec3 dir, float back, vec3 n) {
+    vec3 receiver = p - dir * back + n * u_shadow_texel;
+    vec4 q = u_light_matrix * vec4(receiver, 1.0);
     vec3 c = q.xyz / q.w * 0.5 + 0.5;
     if (any(lessThan(c.xy, vec2(0.0))) || any(greaterThan(c.xy, vec2(1.0)))) return 1.0;
     return c.z - u_shadow_bias <= textureLod(u_shadow_map, c.xy, 0.0).r ? 1.0 : 0.0;
 }
 #endif
 
-// Colour of a sample at shell-local p (unlit: the stored colour).
-vec3 sample_color(VolumeSample v, vec3 p, vec3 dir) {
+// Colour of a sample at shell-local p, the sample before `back` behind it along `dir`
+// (unlit: the stored colour).
+vec3 sample_color(VolumeSample v, vec3 p, vec3 dir, float back) {
 #if defined LIT
+    vec3 n = shading_normal(v_tet, v.normal, v.size, p);
     float lit = 1.0;
 #if defined SHADOWS
-    lit = light_visibility(p);
+    lit = light_visibility(p, dir, back, n);
 #endif
-    return shade_phong(v.rgba.rgb, shading_normal(v_tet, v.normal, v.size, p), -dir, lit);
+    return shade_phong(v.rgba.rgb, n, -dir, lit);
 #else
     return v.rgba.rgb;
 #endif
@@ -197,8 +219,9 @@ void main() {
     float opacity = 0.0, optical_depth = 0.0;
     for (int k = 0; k < n; ++k) {
         float lambda = (float(k) + 0.5) / float(n);
-        vec3 s = animated(mix(s_in, s_out, lambda));
-        VolumeSample v = volume_sample(s, lod);
+        vec3 s_at = mix(s_in, s_out, lambda);
+        VolumeSample v = volume_sample(animated(s_at), lod);
+        v.rgba.rgb *= surface_tint(s_at);
 #if defined SHADOW_MAP
         if (sample_opacity(v.rgba.a, u_shadow_length) >= 0.5) {
             gl_FragDepth = window_depth(mix(v_local, p_out, lambda) + u_model_offset);
@@ -218,7 +241,9 @@ void main() {
 #else
         vec3 p = mix(v_local, p_out, lambda);
         float a = sample_opacity(v.rgba.a, dt);
-        color += (1.0 - opacity) * (a * sample_color(v, p, dir) + v.glow * v.rgba.rgb * dt);
+        // the sample before: in this segment, or the last one of the tetrahedron before
+        float back = k > 0 ? dt : 0.5 * (dt + tet_ray_reach(v_tet) / float(n));
+        color += (1.0 - opacity) * (a * sample_color(v, p, dir, back) + v.glow * v.rgba.rgb * dt);
         opacity += (1.0 - opacity) * a;
 #if defined OPAQUE
         if (opacity >= 0.5) {

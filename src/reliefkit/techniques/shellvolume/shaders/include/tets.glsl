@@ -3,8 +3,11 @@
 // value there, < 0), 4-7 the face planes (face f opposite vertex f, outward unit normal,
 // inside <= 0), 8-10 the rows of the object-to-texture map with the tiling folded in
 // (s = row . (p, 1) gives the lookup coordinate along u, v, w), 11-14 the shell's smooth
-// normal at vertex f.
+// normal at vertex f, 15.x the longest segment a ray can have in the tetrahedron or in a face
+// neighbour it may come from (render.py, ray_reach), 15.y its layer of the base surface's
+// material atlas (TexturedShell.surface_layers).
 // Everything is relative to the shell's origin (u_model_offset places it, camera.glsl).
+#include "scale_free.glsl"
 #define TET_TEXELS 16
 #define TET_ROW_TEXELS 2048
 uniform highp sampler2D u_tets;
@@ -16,6 +19,8 @@ vec4 tet_texel(int tet, int k) {
 
 vec3 tet_vertex(int tet, int corner) { return tet_texel(tet, corner).xyz; }
 vec4 tet_plane(int tet, int face) { return tet_texel(tet, 4 + face); }
+float tet_ray_reach(int tet) { return tet_texel(tet, 15).x; }
+float tet_surface_layer(int tet) { return tet_texel(tet, 15).y; }
 
 // Texture coordinates (u U, v V, w) of shell-local point p in tetrahedron `tet`.
 vec3 tet_texture_coords(int tet, vec3 p) {
@@ -29,8 +34,7 @@ vec3 tet_normal(int tet, vec3 n_vox, vec3 size) {
     vec3 g = n_vox * size;
     vec3 n = g.x * tet_texel(tet, 8).xyz + g.y * tet_texel(tet, 9).xyz
              + g.z * tet_texel(tet, 10).xyz;
-    float len = length(n);
-    return len > 0.0 ? n / len : vec3(0.0, 1.0, 0.0);
+    return unit_or(n, vec3(0.0, 1.0, 0.0));
 }
 
 // The shell's normal at p, interpolated from its vertices (the paper's interpolated frame,
@@ -42,8 +46,7 @@ vec3 tet_smooth_normal(int tet, vec3 p) {
         float weight = (dot(plane.xyz, p) + plane.w) / tet_texel(tet, f).w;
         n += clamp(weight, 0.0, 1.0) * tet_texel(tet, 11 + f).xyz;
     }
-    float len = length(n);
-    return len > 0.0 ? n / len : vec3(0.0, 1.0, 0.0);
+    return unit_or(n, vec3(0.0, 1.0, 0.0));
 }
 
 // A texture-space normal at p in world space: mapped by the tetrahedron's own affine map
@@ -53,8 +56,7 @@ vec3 shading_normal(int tet, vec3 n_vox, vec3 size, vec3 p) {
     vec3 n = tet_normal(tet, n_vox, size);
     vec3 flat_w = tet_normal(tet, vec3(0.0, 0.0, 1.0), size);
     vec3 bent = n + (tet_smooth_normal(tet, p) - flat_w) * dot(n, flat_w);
-    float len = length(bent);
-    return len > 0.0 ? bent / len : n;
+    return unit_or(bent, n);
 }
 
 // Corner k (0..2) of face f, counter-clockwise seen from outside (a tetrahedron of positive
