@@ -220,6 +220,20 @@ def test_safety_options_with_no_safety_are_refused_in_one_line(tmp_path, capsys,
     assert len(err.splitlines()) == 1 and named in err and "--no-safety" in err
 
 
+@pytest.mark.parametrize("box", ["3,1,3", "2,0.5,2"])
+def test_box_with_a_mesh_is_refused_in_one_line(tmp_path, capsys, box):
+    """--box sizes a heightmap's box; a mesh's relief keeps the mesh's size, so the flag
+    was silently ignored (a byte-identical file), the heightmap default included."""
+    from reliefkit import cli
+
+    out = tmp_path / "b.rk"
+    code = cli.main(["bake", "demo:blob", "--as", "relief", "--depth-res", "16",
+                     "--no-safety", "--box", box, "-o", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and not out.exists()
+    assert len(err.splitlines()) == 1 and err.startswith("error:") and "--box" in err
+
+
 def test_a_frustum_takes_octant_radii_and_robust_keeps_the_reference_hits(gl):
     """Rays are straight in a frustum's texel space, so the radii per direction octant hold
     there as in an orthographic box: robust with every ray jumping meets the exact reference."""

@@ -21,6 +21,7 @@ HEIGHT_MARGIN = 0.01     # the box bottom lies this fraction of the height below
 # terrain get radius 0 (every non-planar patch bends down along some direction); 1% of the
 # box height keeps radii growing with resolution at a bounded silhouette error.
 DEFAULT_TOLERANCE = 0.01
+HEIGHTMAP_BOX = (2.0, 0.5, 2.0)  # world size (x, height, z) of a heightmap's box by default
 
 
 def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, tuple[int, int]]:
@@ -143,7 +144,7 @@ def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = 
                         octants=octants)
 
 
-def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bool = True,
+def relief_from_heights(heights, color=None, size=HEIGHTMAP_BOX, *, safety: bool = True,
                         tolerance: float = DEFAULT_TOLERANCE, progress=None,
                         octants: bool = False) -> ReliefTexture:
     """A relief texture straight from a height array (values scaled to [0, 1]).

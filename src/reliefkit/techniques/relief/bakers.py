@@ -8,7 +8,7 @@ import numpy as np
 
 from ...core.params import param
 from ...errors import UsageError
-from .bake import DEFAULT_TOLERANCE, bake_relief, relief_from_heights
+from .bake import DEFAULT_TOLERANCE, HEIGHTMAP_BOX, bake_relief, relief_from_heights
 from .frustum import bake_relief_cube, bake_relief_frustum
 
 AXES = ("x", "y", "z", "-x", "-y", "-z")
@@ -80,8 +80,10 @@ class ReliefParams:
     safety_tolerance: float = _tolerance()
     safety_octants: bool = _octants()
     axis: str = _axis()
-    box: tuple = param((2.0, 0.5, 2.0), "heightmaps: world size SX,SY,SZ of the box",
-                       kind="floats", count=3, lo=1e-9)
+    box: tuple | None = param(None, "heightmaps only: world size SX,SY,SZ of the box (none: "
+                              f"{','.join(f'{s:g}' for s in HEIGHTMAP_BOX)}); a mesh keeps "
+                              "its own size",
+                              kind="floats", count=3, lo=1e-9)
 
 
 @dataclass(frozen=True)
@@ -107,11 +109,15 @@ class ReliefCubeParams:
 
 def bake_orthographic(source, p: ReliefParams, progress=None):
     check_safety_options(p)
+    heightmap = isinstance(source, np.ndarray)
+    if not heightmap and p.box is not None:
+        raise UsageError("--box sets a heightmap's world size; a mesh's relief keeps the "
+                         "mesh's own size: drop --box (or scale the mesh)")
     if p.safety:
-        side = max(source.shape) if isinstance(source, np.ndarray) else p.depth_res
+        side = max(source.shape) if heightmap else p.depth_res
         check_safety_work(side, side)
-    if isinstance(source, np.ndarray):
-        return relief_from_heights(source, size=p.box, safety=p.safety,
+    if heightmap:
+        return relief_from_heights(source, size=p.box or HEIGHTMAP_BOX, safety=p.safety,
                                    tolerance=p.safety_tolerance, progress=progress,
                                    octants=p.safety_octants)
     return bake_relief(source, p.depth_res, p.color_res, p.axis, safety=p.safety,
