@@ -63,9 +63,10 @@ vec4 tangent_plane(vec3 hit, bool on_face) {
     return world_plane(hit, nb);
 }
 
-// A heightfield hit on a surface steeper than this (the cosine of 75 degrees from the box's
-// h lines) is on a wall: a step between texels of different heights.
-const float WALL_COS = 0.2588;
+// A heightfield hit on a surface steeper than 75 degrees from the box's h lines is on a
+// wall: a step between texels of different heights; below 60 degrees it is not. In between
+// the two normals are blended, so no hard switch draws a seam or a dot.
+const float WALL_COS = 0.2588, SLOPE_COS = 0.5;
 
 // The shading normal at a hit on the heightfield (`plane`: its tangent_plane). The bake saw
 // the topmost surface at texel centres, so a wall that the bilinear surface builds between a
@@ -78,7 +79,9 @@ vec3 heightfield_normal(vec3 hit, vec4 plane) {
     vec3 baked = normalize(textureLod(u_normal, hit.xy, 0.0).xyz);  // not mipmapped
     vec3 geometric = normalize(plane.xyz);
     vec3 level = normalize(world_plane(hit, vec3(0.0, 0.0, 1.0)).xyz);  // along the h lines
-    return abs(dot(geometric, level)) < WALL_COS ? geometric : baked;
+    if (dot(geometric, baked) < 0.0) geometric = -geometric;  // the same side, up the h lines
+    float wall = 1.0 - smoothstep(WALL_COS, SLOPE_COS, abs(dot(geometric, level)));
+    return normalize(mix(baked, geometric, wall));
 }
 
 // The colour's texture gradients at box point `hit`: where the rays of the next pixels right
