@@ -10,6 +10,7 @@ from ...core.params import param
 from ...errors import UsageError
 from .bake import DEFAULT_TOLERANCE, HEIGHTMAP_BOX, bake_relief, relief_from_heights
 from .frustum import bake_relief_cube, bake_relief_frustum
+from .render import ReliefRenderOptions
 
 AXES = ("x", "y", "z", "-x", "-y", "-z")
 # Safety radii cost about SAFETY_SECONDS_512 for a 512² field on a 2-core machine and grow
@@ -54,9 +55,9 @@ def _color_res():
 
 
 def _safety():
-    return param(None, "bake safety radii, which robust jumps by on fields with W + H > 256 "
-                 "(smaller ones it draws with the exact walk) (none: only where it jumps)",
-                 kind="bool")
+    return param(None, "bake safety radii, which robust jumps by on fields with W + H > "
+                 f"{ReliefRenderOptions().exact_field} (smaller ones it draws with the exact "
+                 "walk) (none: only where it jumps)", kind="bool")
 
 
 def _octants():
