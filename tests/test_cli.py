@@ -78,7 +78,8 @@ def test_info_gl_and_mesh(gl, box_obj):
 
 def test_bake_render_info_relief(gl, tmp_path):
     rk = tmp_path / "t.rk"
-    out = run_cli("bake", "demo:terrain", "--as", "relief", "--depth-res", "32", "-o", rk)
+    out = run_cli("bake", "demo:terrain", "--as", "relief", "--depth-res", "32", "--safety",
+                  "-o", rk)  # --safety: a 32² field gets no radii by default
     assert out.returncode == 0, out.stderr
     # sizes with units: 32 x 32 float32 heights are 4 KiB
     assert "height 4.0 KiB" in out.stdout and "on disk" in out.stdout, out.stdout

@@ -220,6 +220,51 @@ def test_safety_options_with_no_safety_are_refused_in_one_line(tmp_path, capsys,
     assert len(err.splitlines()) == 1 and named in err and "--no-safety" in err
 
 
+@pytest.mark.parametrize("box", ["3,1,3", "2,0.5,2"])
+def test_box_with_a_mesh_is_refused_in_one_line(tmp_path, capsys, box):
+    """--box sizes a heightmap's box; a mesh's relief keeps the mesh's size, so the flag
+    was silently ignored (a byte-identical file), the heightmap default included."""
+    from reliefkit import cli
+
+    out = tmp_path / "b.rk"
+    code = cli.main(["bake", "demo:blob", "--as", "relief", "--depth-res", "16",
+                     "--no-safety", "--box", box, "-o", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and not out.exists()
+    assert len(err.splitlines()) == 1 and err.startswith("error:") and "--box" in err
+
+
+@pytest.mark.parametrize("kind", ["relief", "relief-frustum", "relief-cube"])
+def test_default_bakes_leave_out_radii_that_the_default_render_never_reads(gl, kind):
+    """Robust draws fields with W + H <= 256 with the exact walk: a default bake of such a
+    field has no radii (a cube of 128² faces spent minutes on them) and renders the same
+    pixels as a bake with them; robust asked to jump on it names --safety."""
+    from reliefkit.bake import bake
+    from reliefkit.errors import UsageError
+
+    mesh = make_asset("blob")
+    lean, full = (bake(mesh, kind, depth_res=24, **extra) for extra in ({}, {"safety": True}))
+    parts = lambda rep: getattr(rep, "parts", [rep])  # noqa: E731
+    assert all(p.safety is None for p in parts(lean))
+    assert all(p.safety is not None for p in parts(full))
+    camera = orbit_bounds(mesh.bounds, 30, 25, 2.6, size=(64, 64))
+    plain, radii = render(lean, camera), render(full, camera)
+    assert plain.mask.mean() > 0.1 and np.array_equal(plain.color, radii.color)
+    with pytest.raises(UsageError, match="no safety radii.*--safety"):
+        render(lean, camera, method="robust", exact_field=0)
+
+
+def test_default_bakes_keep_radii_where_robust_jumps_or_octants_are_asked(gl):
+    """A 136² field (W + H > 256) is drawn jumping by its radii, so a default bake keeps
+    them; asking for octant radii asks for radii on a small field too."""
+    from reliefkit.bake import bake
+
+    u, v = np.meshgrid(np.linspace(0, 3, 136), np.linspace(0, 2, 136))
+    assert relief_from_heights(np.sin(u) * np.cos(v)).safety is not None
+    assert bake(make_asset("blob"), "relief-cube", depth_res=16,
+                safety_octants=True).parts[0].safety.shape == (8, 16, 16)
+
+
 def test_a_frustum_takes_octant_radii_and_robust_keeps_the_reference_hits(gl):
     """Rays are straight in a frustum's texel space, so the radii per direction octant hold
     there as in an orthographic box: robust with every ray jumping meets the exact reference."""
@@ -253,7 +298,7 @@ def test_robust_jumps_on_a_cube_meet_the_reference(gl, model):
     from reliefkit.techniques.relief.reference import wrong_hits
 
     mesh = make_asset(model)
-    rep = bake_relief_cube(mesh, depth_res=64)
+    rep = bake_relief_cube(mesh, depth_res=64, safety=True)  # 64² faces: radii on request
     for part in rep.parts:  # the surface spans the pyramid's depth, not a sliver at its top
         covered = part.height[part.height > 0]
         assert covered.size == 0 or np.ptp(covered) > 0.1 or covered.min() < 0.5

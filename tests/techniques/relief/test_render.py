@@ -202,6 +202,42 @@ def test_shadows_darken_the_lee_of_a_wall(gl):
     np.testing.assert_allclose(shaded.color[open_side], lit.color[open_side], atol=1e-5)
 
 
+def _box_on_the_ground():
+    """A 1 x 0.5 x 1 box standing on a 2 x 2 ground slab, flat-shaded."""
+    box = trimesh.creation.box((1.0, 0.5, 1.0))
+    box.apply_translation((0, 0.25, 0))
+    ground = trimesh.creation.box((2.0, 0.02, 2.0))
+    ground.apply_translation((0, -0.01, 0))
+    both = trimesh.util.concatenate([box, ground])
+    pos = both.vertices[both.faces].reshape(-1, 3).astype(np.float32)  # a vertex per corner
+    faces = np.arange(len(pos), dtype=np.uint32).reshape(-1, 3)
+    colors = np.tile([0.7, 0.7, 0.7, 1.0], (len(pos), 1)).astype(np.float32)
+    return RenderMesh(pos, faces, vertex_normals(pos, faces), colors, name="box")
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_wall_hits_have_wall_normals_at_every_pixel(gl, method):
+    """The bake sees a box's top and the ground, never its sides: the walls that the
+    heightfield builds between them have no normal of their own in the map, which gave
+    every wall pixel the top's normal (up), or a blend of it with a steep texel's (bright
+    dots). Every hit on a wall, away from the box's vertical edges, faces out of its face."""
+    from reliefkit.techniques.relief.bake import bake_relief
+
+    relief = bake_relief(_box_on_the_ground(), depth_res=48, safety=method == "robust")
+    texel = float(np.linalg.norm(relief.box_to_world[:3, 0])) / relief.height.shape[1]
+    camera = Camera.orbit((0, 0.25, 0), azimuth_deg=20, elevation_deg=15, distance=4.0,
+                          size=(96, 96))
+    frame = render(relief, camera, method=method, **OPTIONS.get(method, {}))
+    x, y, z = (frame.position[..., k] for k in range(3))
+    ax, az = np.abs(x), np.abs(z)
+    wall = (frame.mask & (y > 0.1) & (y < 0.4) & (np.maximum(ax, az) < 0.5 + 1.5 * texel)
+            & (np.minimum(ax, az) < 0.5 - 2 * texel))
+    outward = np.where((ax > az)[..., None], np.stack([np.sign(x), 0 * x, 0 * x], -1),
+                       np.stack([0 * z, 0 * z, np.sign(z)], -1))
+    facing = (frame.normal * outward).sum(-1)[wall]
+    assert wall.sum() > 200 and facing.min() > 0.95, (wall.sum(), facing.min())
+
+
 def _checker_relief(height, square=4):
     relief = make_relief(height)
     n = height.shape[0]

@@ -13,6 +13,7 @@ from ...colorspace import srgb_decode, to_rgba8
 from ...core.transforms import transform_points
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
+from .render import ReliefRenderOptions, robust_jumps
 from .representation import ReliefTexture
 
 BORDER_TEXELS = 1.5      # empty margin around the footprint (the border ring must be 0)
@@ -21,6 +22,7 @@ HEIGHT_MARGIN = 0.01     # the box bottom lies this fraction of the height below
 # terrain get radius 0 (every non-planar patch bends down along some direction); 1% of the
 # box height keeps radii growing with resolution at a bounded silhouette error.
 DEFAULT_TOLERANCE = 0.01
+HEIGHTMAP_BOX = (2.0, 0.5, 2.0)  # world size (x, height, z) of a heightmap's box by default
 
 
 def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, tuple[int, int]]:
@@ -79,6 +81,16 @@ def _color_size(depth_size, depth_res: int, color_res: int | None) -> tuple[int,
     return tuple(max(2, int(round(s * scale))) for s in depth_size)
 
 
+def wants_radii(safety: bool | None, size, octants: bool = False) -> bool:
+    """``safety`` as given, or by default (None) whether robust's default render jumps by
+    safety radii on a field of ``size`` (W, H), or ``octants`` asks for them. Smaller fields
+    are drawn with the exact walk, which never reads them: the radii of a cube's six 128²
+    faces took minutes for the same pixels."""
+    if safety is None:
+        return octants or robust_jumps(*size, ReliefRenderOptions())
+    return bool(safety)
+
+
 def far_tolerance(box_to_world: np.ndarray, tolerance: float) -> float:
     """The safety tolerance in h units that bounds, at a frustum's far end, the world depth
     that ``tolerance`` bounds in an orthographic box as deep (its fraction of the depth).
@@ -99,13 +111,14 @@ def far_tolerance(box_to_world: np.ndarray, tolerance: float) -> float:
 
 
 def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_size, *,
-                 safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
-                 params: dict | None = None, zero_border: bool = True,
+                 safety: bool | None = None, tolerance: float = DEFAULT_TOLERANCE,
+                 progress=None, params: dict | None = None, zero_border: bool = True,
                  clip_bounds=None, ctx=None, octants: bool = False) -> ReliefTexture:
     """Bake ``mesh`` through any box/frustum matrix at the given resolutions.
 
     ``zero_border`` empties the outer ring of texels so every ray enters above the surface
-    (§3, footnote 1); the six frusta of a cube share their sides and keep it.
+    (§3, footnote 1); the six frusta of a cube share their sides and keep it. ``safety``:
+    bake safety radii, or by default (None) where robust would jump (`wants_radii`).
     """
     for label, (w, h) in (("depth", depth_size), ("color", color_size)):
         if w > 8192 or h > 8192:
@@ -120,7 +133,7 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
                            normal=_orient_normals(normal, box_to_world),
                            box_to_world=box_to_world, clip_bounds=clip_bounds,
                            source_bounds=mesh.bounds, params=dict(params or {}))
-    if safety:
+    if wants_radii(safety, depth_size, octants):
         from .safety import safety_radii
 
         tolerance = far_tolerance(box_to_world, tolerance)  # a frustum's h is not uniform
@@ -131,8 +144,9 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
 
 
 def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = None,
-                axis: str = "y", *, safety: bool = True, tolerance: float = DEFAULT_TOLERANCE,
-                progress=None, ctx=None, octants: bool = False) -> ReliefTexture:
+                axis: str = "y", *, safety: bool | None = None,
+                tolerance: float = DEFAULT_TOLERANCE, progress=None, ctx=None,
+                octants: bool = False) -> ReliefTexture:
     """Orthographic relief texture of ``mesh`` seen from above along ``axis`` (§3)."""
     box_to_world, depth_size = ortho_box(mesh, axis, depth_res)
     color_size = _color_size(depth_size, depth_res, color_res)
@@ -143,9 +157,9 @@ def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = 
                         octants=octants)
 
 
-def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bool = True,
-                        tolerance: float = DEFAULT_TOLERANCE, progress=None,
-                        octants: bool = False) -> ReliefTexture:
+def relief_from_heights(heights, color=None, size=HEIGHTMAP_BOX, *,
+                        safety: bool | None = None, tolerance: float = DEFAULT_TOLERANCE,
+                        progress=None, octants: bool = False) -> ReliefTexture:
     """A relief texture straight from a height array (values scaled to [0, 1]).
 
     Orientation is that of a map seen from above: row 0 (an image's top row) is the far
@@ -170,7 +184,7 @@ def relief_from_heights(heights, color=None, size=(2.0, 0.5, 2.0), *, safety: bo
     normal = heightfield_normals(h, box_to_world)
     relief = ReliefTexture(height=h, color=color8, normal=normal, box_to_world=box_to_world,
                            params={"projection": "orthographic", "source": "heightmap"})
-    if safety:
+    if wants_radii(safety, relief.depth_resolution, octants):
         from .safety import safety_radii
 
         relief.safety = safety_radii(h, tolerance=tolerance, progress=progress,

@@ -8,8 +8,9 @@ import numpy as np
 
 from ...core.params import param
 from ...errors import UsageError
-from .bake import DEFAULT_TOLERANCE, bake_relief, relief_from_heights
+from .bake import DEFAULT_TOLERANCE, HEIGHTMAP_BOX, bake_relief, relief_from_heights
 from .frustum import bake_relief_cube, bake_relief_frustum
+from .render import ReliefRenderOptions
 
 AXES = ("x", "y", "z", "-x", "-y", "-z")
 # Safety radii cost about SAFETY_SECONDS_512 for a 512² field on a 2-core machine and grow
@@ -31,16 +32,17 @@ def check_safety_work(width: int, height: int, parts: int = 1) -> None:
                      "radii), or use a smaller --depth-res")
 
 
-def check_safety_options(p) -> None:
-    """Refuse safety-radii options given with ``--no-safety``: they would be silently ignored."""
-    if p.safety:
-        return
+def wanted_safety(p) -> bool | None:
+    """Whether to bake safety radii: ``--safety`` / ``--no-safety``, else (None) where robust
+    would jump (`bake.wants_radii`); ``--safety-octants`` or ``--safety-tolerance`` ask for
+    them. Refuses those two with ``--no-safety``: they would be silently ignored."""
     given = [flag for flag, on in (("--safety-octants", p.safety_octants),
                                    ("--safety-tolerance", p.safety_tolerance != DEFAULT_TOLERANCE))
              if on]
-    if given:
+    if given and p.safety is False:
         raise UsageError(f"{' and '.join(given)} shape safety radii, which --no-safety leaves "
                          "out: drop one or the other")
+    return True if given else p.safety
 
 
 def _depth_res(default: int):
@@ -53,7 +55,9 @@ def _color_res():
 
 
 def _safety():
-    return param(True, "bake safety radii (needed by the robust method)")
+    return param(None, "bake safety radii, which robust jumps by on fields with W + H > "
+                 f"{ReliefRenderOptions().exact_field} (smaller ones it draws with the exact "
+                 "walk) (none: only where it jumps)", kind="bool")
 
 
 def _octants():
@@ -76,19 +80,21 @@ def _axis():
 class ReliefParams:
     depth_res: int = _depth_res(256)
     color_res: int | None = _color_res()
-    safety: bool = _safety()
+    safety: bool | None = _safety()
     safety_tolerance: float = _tolerance()
     safety_octants: bool = _octants()
     axis: str = _axis()
-    box: tuple = param((2.0, 0.5, 2.0), "heightmaps: world size SX,SY,SZ of the box",
-                       kind="floats", count=3, lo=1e-9)
+    box: tuple | None = param(None, "heightmaps only: world size SX,SY,SZ of the box (none: "
+                              f"{','.join(f'{s:g}' for s in HEIGHTMAP_BOX)}); a mesh keeps "
+                              "its own size",
+                              kind="floats", count=3, lo=1e-9)
 
 
 @dataclass(frozen=True)
 class ReliefFrustumParams:
     depth_res: int = _depth_res(256)
     color_res: int | None = _color_res()
-    safety: bool = _safety()
+    safety: bool | None = _safety()
     safety_tolerance: float = _tolerance()
     safety_octants: bool = _octants()
     axis: str = _axis()
@@ -100,39 +106,43 @@ class ReliefFrustumParams:
 class ReliefCubeParams:
     depth_res: int = _depth_res(128)
     color_res: int | None = _color_res()
-    safety: bool = _safety()
+    safety: bool | None = _safety()
     safety_tolerance: float = _tolerance()
     safety_octants: bool = _octants()
 
 
 def bake_orthographic(source, p: ReliefParams, progress=None):
-    check_safety_options(p)
-    if p.safety:
-        side = max(source.shape) if isinstance(source, np.ndarray) else p.depth_res
+    safety = wanted_safety(p)
+    heightmap = isinstance(source, np.ndarray)
+    if not heightmap and p.box is not None:
+        raise UsageError("--box sets a heightmap's world size; a mesh's relief keeps the "
+                         "mesh's own size: drop --box (or scale the mesh)")
+    if safety is not False:
+        side = max(source.shape) if heightmap else p.depth_res
         check_safety_work(side, side)
-    if isinstance(source, np.ndarray):
-        return relief_from_heights(source, size=p.box, safety=p.safety,
+    if heightmap:
+        return relief_from_heights(source, size=p.box or HEIGHTMAP_BOX, safety=safety,
                                    tolerance=p.safety_tolerance, progress=progress,
                                    octants=p.safety_octants)
-    return bake_relief(source, p.depth_res, p.color_res, p.axis, safety=p.safety,
+    return bake_relief(source, p.depth_res, p.color_res, p.axis, safety=safety,
                        tolerance=p.safety_tolerance, progress=progress,
                        octants=p.safety_octants)
 
 
 def bake_frustum(source, p: ReliefFrustumParams, progress=None):
-    check_safety_options(p)
-    if p.safety:
+    safety = wanted_safety(p)
+    if safety is not False:
         check_safety_work(p.depth_res, p.depth_res)
     return bake_relief_frustum(source, depth_res=p.depth_res, color_res=p.color_res,
-                               axis=p.axis, spread_deg=p.spread, clip=p.clip, safety=p.safety,
+                               axis=p.axis, spread_deg=p.spread, clip=p.clip, safety=safety,
                                tolerance=p.safety_tolerance, progress=progress,
                                octants=p.safety_octants)
 
 
 def bake_cube(source, p: ReliefCubeParams, progress=None):
-    check_safety_options(p)
-    if p.safety:
+    safety = wanted_safety(p)
+    if safety is not False:
         check_safety_work(p.depth_res, p.depth_res, parts=6)
     return bake_relief_cube(source, depth_res=p.depth_res, color_res=p.color_res,
-                            safety=p.safety, tolerance=p.safety_tolerance, progress=progress,
+                            safety=safety, tolerance=p.safety_tolerance, progress=progress,
                             octants=p.safety_octants)

@@ -197,7 +197,8 @@ def correctness(cfg: BenchConfig, log) -> list[dict]:
               ("blob", " cube", bake_relief_cube))
     for name, kind, baker in bakers:
         mesh = make_asset(name)
-        relief = baker(mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance)
+        relief = baker(mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance,
+                       safety=True)  # robust_jump reads them at every size
         for az, el in cfg.correctness_views:
             camera = orbit_bounds(relief.bounds, az, el, 2.2, cfg.correctness_size)
             row = {"model": name + kind, "azimuth": az, "elevation": el}

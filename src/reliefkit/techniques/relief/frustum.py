@@ -70,8 +70,9 @@ def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 3
 
 def bake_relief_frustum(mesh: RenderMesh, frustum: np.ndarray | None = None, *,
                         depth_res: int = 256, color_res: int | None = None, axis: str = "y",
-                        spread_deg: float = 30.0, clip: bool = True, safety: bool = True,
-                        tolerance: float = DEFAULT_TOLERANCE, progress=None,
+                        spread_deg: float = 30.0, clip: bool = True,
+                        safety: bool | None = None, tolerance: float = DEFAULT_TOLERANCE,
+                        progress=None,
                         ctx=None, octants: bool = False) -> ReliefTexture:
     """Relief texture through a reverse frustum (a user's box_to_world, or a fitted one).
 
@@ -131,8 +132,8 @@ def cube_frusta(mesh: RenderMesh, margin: float = 0.02, near_fraction: float = 0
 
 
 def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int | None = None,
-                     safety: bool = True, tolerance: float = DEFAULT_TOLERANCE, progress=None,
-                     ctx=None, octants: bool = False) -> ReliefObject:
+                     safety: bool | None = None, tolerance: float = DEFAULT_TOLERANCE,
+                     progress=None, ctx=None, octants: bool = False) -> ReliefObject:
     """Six reverse-perspective heightfields splitting the bounding cube (§4.2, Fig. 10)."""
     size = (depth_res, depth_res)
     color_size = size if color_res is None else (color_res, color_res)

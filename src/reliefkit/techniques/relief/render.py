@@ -71,15 +71,22 @@ def relief_proxy(relief: ReliefTexture):
     return convex_proxy(planes, near=relief.center)
 
 
+def robust_jumps(width: int, height: int, options: ReliefRenderOptions) -> bool:
+    """Whether robust jumps by safety radii on a W x H field. Robust walks every ray shorter
+    than ``exact_below`` texels exactly, so when no ray of the field can be longer (W + H
+    bounds |dx| + |dy|) the exact walk's own program draws the same hits without the robust
+    code around it; so does a field so small (``exact_field``) that the exact walk is the
+    cheaper one (up to 128² on llvmpipe; docs/benchmarks.md). Such a field never reads its
+    radii."""
+    return not (width + height <= options.exact_field or width + height < options.exact_below)
+
+
 def drawn_method(relief: ReliefTexture, options: ReliefRenderOptions) -> str:
-    """The method whose program draws ``relief``: robust walks every ray shorter than
-    ``exact_below`` texels exactly, so when no ray of the field can be longer (W + H bounds
-    |dx| + |dy|) the exact walk's own program draws the same hits without the robust code
-    around it; so does a field so small (``exact_field``) that the exact walk is the cheaper
-    one (up to 128² on llvmpipe; docs/benchmarks.md)."""
-    w, h = relief.depth_resolution
-    small = w + h <= options.exact_field or w + h < options.exact_below
-    return "exact" if options.method == "robust" and small else options.method
+    """The method whose program draws ``relief``: robust's own, or the exact walk's where
+    robust would not jump (`robust_jumps`)."""
+    if options.method == "robust" and not robust_jumps(*relief.depth_resolution, options):
+        return "exact"
+    return options.method
 
 
 class ReliefDrawable:
@@ -99,8 +106,10 @@ class ReliefDrawable:
         w, h = relief.depth_resolution
         self.method = drawn_method(relief, opts)
         if self.method == "robust" and relief.safety is None:
-            raise UsageError("this relief texture has no safety radii: bake it with them or "
-                             "render with --method maxmip (exact, needs no radii)")
+            raise UsageError(f"this {w}x{h} relief texture has no safety radii, which robust "
+                             "jumps by here (bakes leave them out where robust's default "
+                             "draws the exact walk): bake it with --safety, or render with "
+                             "--method maxmip (exact, needs no radii)")
         self.prog = program(ctx, PROGRAM, {
             f"METHOD_{self.method.upper()}": True,
             "SAFETY_OCTANTS": self.method == "robust" and relief.safety.ndim == 3,

@@ -40,28 +40,58 @@ int box_face_axis(vec3 p) {
     return dist.x < dist.y ? (dist.x < dist.z ? 0 : 2) : (dist.y < dist.z ? 1 : 2);
 }
 
+// The world plane through box point `hit` whose box normal is nb: box_h = W x_h, so
+// (nb, -nb.hit) . box_h = (W^T plane) . x_h; its xyz is the world normal (unnormalized).
+vec4 world_plane(vec3 hit, vec3 nb) {
+    return transpose(u_world_to_box) * vec4(nb, -dot(nb, hit));
+}
+
 // World normal of the box face that box point p lies on (the side walls of the solid).
 vec3 box_face_normal(vec3 p) {
     int k = box_face_axis(p);
-    vec4 w = vec4(u_world_to_box[0][3], u_world_to_box[1][3], u_world_to_box[2][3], 0.0);
-    vec4 row = vec4(u_world_to_box[0][k], u_world_to_box[1][k], u_world_to_box[2][k], 0.0);
-    vec3 grad = (row - p[k] * w).xyz;   // gradient of box coordinate k in world space
-    return normalize(p[k] < 0.5 ? -grad : grad);
+    vec3 nb = vec3(0.0);
+    nb[k] = p[k] < 0.5 ? -1.0 : 1.0;  // out of the box
+    return normalize(world_plane(p, nb).xyz);
 }
 
-// The colour's texture gradients at box point `hit`: where the rays of the next pixels right
-// and up meet the surface's tangent plane there (ray differentials), in box (u, v). The plane
-// is the box face the ray entered by (`on_face`) or the bilinear surface's own, not the
-// shading normal's, which is smoothed across edges. Hardware derivatives would be taken from
-// the 2x2 quad's other fragments, whose rays end on other surfaces or were discarded after
-// their own march: blurred colours along every depth edge, and different colours from two
-// methods that find the same hits.
-void hit_gradients(vec2 ndc, vec3 hit, bool on_face, out vec2 dx, out vec2 dy) {
+// The world tangent plane of the surface at box point `hit`: the box face the ray entered by
+// (`on_face`) or the bilinear heightfield's own.
+vec4 tangent_plane(vec3 hit, bool on_face) {
     vec3 nb = vec3(0.0);
     if (on_face) nb[box_face_axis(hit)] = 1.0;
     else nb = vec3(-hf_slope(hit.xy * vec2(u_hf_size)) * vec2(u_hf_size), 1.0);
-    // the plane in world space: box_h = W x_h, so (nb, -nb.hit) . box_h = (W^T plane) . x_h
-    vec4 plane = transpose(u_world_to_box) * vec4(nb, -dot(nb, hit));
+    return world_plane(hit, nb);
+}
+
+// A heightfield hit on a surface steeper than 75 degrees from the box's h lines is on a
+// wall: a step between texels of different heights; below 60 degrees it is not. In between
+// the two normals are blended, so no hard switch draws a seam or a dot.
+const float WALL_COS = 0.2588, SLOPE_COS = 0.5;
+
+// The shading normal at a hit on the heightfield (`plane`: its tangent_plane). The bake saw
+// the topmost surface at texel centres, so a wall that the bilinear surface builds between a
+// high texel and a low one (a box's side, a roof's edge) has no normal of its own in the map:
+// the lookup there gives the top's or the floor's, or a blend of them with a steep texel's
+// (bright dots and stripes on walls). On a wall the heightfield's own normal is the surface's;
+// elsewhere the baked one keeps the mesh's smooth shading and detail, and where a real surface
+// is that steep the two agree.
+vec3 heightfield_normal(vec3 hit, vec4 plane) {
+    vec3 baked = normalize(textureLod(u_normal, hit.xy, 0.0).xyz);  // not mipmapped
+    vec3 geometric = normalize(plane.xyz);
+    vec3 level = normalize(world_plane(hit, vec3(0.0, 0.0, 1.0)).xyz);  // along the h lines
+    if (dot(geometric, baked) < 0.0) geometric = -geometric;  // the same side, up the h lines
+    float wall = 1.0 - smoothstep(WALL_COS, SLOPE_COS, abs(dot(geometric, level)));
+    return normalize(mix(baked, geometric, wall));
+}
+
+// The colour's texture gradients at box point `hit`: where the rays of the next pixels right
+// and up meet the surface's tangent plane there (`plane`, ray differentials), in box (u, v).
+// The plane is the box face's or the bilinear surface's, not the shading normal's, which is
+// smoothed across edges. Hardware derivatives would be taken from the 2x2 quad's other
+// fragments, whose rays end on other surfaces or were discarded after their own march:
+// blurred colours along every depth edge, and different colours from two methods that find
+// the same hits.
+void hit_gradients(vec2 ndc, vec3 hit, vec4 plane, out vec2 dx, out vec2 dy) {
     vec2 pixel = 2.0 / u_viewport;
     vec2 uv[2];
     for (int i = 0; i < 2; ++i) {
@@ -100,11 +130,15 @@ void main() {
     }
     vec3 hit_box = clamp(a + s_hit * d, 0.0, 1.0);
     vec3 hit = to_world(hit_box);
-    vec3 n = normalize(textureLod(u_normal, hit_box.xy, 0.0).xyz);  // not mipmapped
     bool at_entry = s_hit <= s0;  // on the face the ray entered by
+    bool on_face = at_entry && (entered_side || a.z <= 0.0);
+    vec4 plane = tangent_plane(hit_box, on_face);
+    vec3 n;
     if (at_entry && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
+    else if (on_face) n = normalize(textureLod(u_normal, hit_box.xy, 0.0).xyz);  // underside
+    else n = heightfield_normal(hit_box, plane);
     vec2 uv_dx, uv_dy;
-    hit_gradients(ndc, hit_box, at_entry && (entered_side || a.z <= 0.0), uv_dx, uv_dy);
+    hit_gradients(ndc, hit_box, plane, uv_dx, uv_dy);
     vec4 base = textureGrad(u_color, hit_box.xy, uv_dx, uv_dy);
     vec3 to_eye = towards_eye(hit);
     if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
