@@ -8,6 +8,7 @@ and the technique adds its own metrics (such as wrong hits against an exact refe
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -64,11 +65,19 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
         frames[variant.name] = plain
         errors[variant.name] = error_mask
         advance(k + 2, len(variants) + 1)
-    columns = tuple(c for m in tech.compare_metrics for c in m.columns) + CORE_COLUMNS
+    columns = _measured_columns(tech.compare_metrics, rows.values()) + CORE_COLUMNS
     sizes = {"mesh": sum(array_bytes(mesh).values()),
              "representation": sum(array_bytes(representation).values())}
     return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns,
             "bytes": sizes}
+
+
+def _measured_columns(compare_metrics, rows) -> tuple[str, ...]:
+    """The technique's metric columns in declared order, each once, that some row holds: a
+    technique of several parts declares columns for kinds other than the one compared."""
+    held = {key for row in rows for key in row}
+    declared = dict.fromkeys(c for metric in compare_metrics for c in metric.columns)
+    return tuple(c for c in declared if c in held)
 
 
 def comparison_sheet(result: dict, title: str):
@@ -105,12 +114,27 @@ def metrics_markdown(result: dict, heading: str) -> str:
              f", mesh {format_bytes(sizes['mesh'])}.", "",
              "| variant | " + " | ".join(cols) + " |",
              "|---" * (len(cols) + 1) + "|"]
-    for name, row in result["metrics"].items():
-        cells = [format_bytes(row[c]) if c == "bytes" else
-                 f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, ""))
-                 for c in cols]
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    rows = [[_cell(row.get(c), c) for c in cols] for row in result["metrics"].values()]
+    lines += [f"| {name} | " + " | ".join(cells) + " |"
+              for name, cells in zip(result["metrics"], rows, strict=True)]
+    if any("n/a" in cells for cells in rows):
+        lines += ["", "n/a: not measured for that variant."]
     return "\n".join(lines) + "\n"
+
+
+def _measured(value):
+    """None for a score with nothing to measure: missing, or NaN (the position error of a
+    frame without positions, such as depth peeling's); the reports show n/a, JSON null."""
+    return None if value is None or (isinstance(value, float) and math.isnan(value)) else value
+
+
+def _cell(value, column: str) -> str:
+    value = _measured(value)
+    if value is None:
+        return "n/a"
+    if column == "bytes":
+        return format_bytes(value)
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]:
@@ -124,6 +148,13 @@ def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]
     with atomic_path(paths["markdown"]) as tmp:
         tmp.write_text(metrics_markdown(result, title))
     with atomic_path(paths["json"]) as tmp:
-        tmp.write_text(json.dumps({"title": title, "bytes": result["bytes"],
-                                   "variants": result["metrics"]}, indent=2))
+        tmp.write_text(metrics_json(result, title))
     return paths
+
+
+def metrics_json(result: dict, title: str) -> str:
+    """``{"title", "bytes", "variants": {name: row}}``, a score not measured as null."""
+    variants = {name: {key: _measured(value) for key, value in row.items()}
+                for name, row in result["metrics"].items()}
+    return json.dumps({"title": title, "bytes": result["bytes"], "variants": variants},
+                      indent=2)
