@@ -107,6 +107,15 @@ def _add_view_args(p: _Parser) -> None:
                    "--view (default: %(default)s, a low sun from the side)")
 
 
+def _drawn_kinds(tech, spec) -> str:
+    """Who owns a drawable's options in --help: its technique, or where the technique's
+    drawables take different options (depth objects and displacement maps) the kinds this
+    one draws."""
+    if len({d.options for d in tech.drawables}) == 1:
+        return tech.name
+    return "/".join(c.kind for c in tech.codecs if issubclass(c.cls, spec.cls)) or tech.name
+
+
 def _command(sub, name: str, summary: str, description: str):
     """A subcommand parser whose --help ends with its examples."""
     epilog = "examples:\n" + "\n".join(f"  {line}" for line in _examples(name))
@@ -146,8 +155,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
                    help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
                         "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
-    add_options(p, [(t.name, spec.option_list) for t in techniques() for spec in t.drawables],
-                 "render options")
+    add_options(p, [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
+                    for spec in t.drawables], "render options")
     p.set_defaults(run=cmd_render)
 
     p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",

@@ -1,0 +1,31 @@
+"""What the command line says: help that names every owner and asset, a bake's summary line,
+an output name that points to the flag it needs."""
+
+import re
+
+from helpers import run_cli
+
+WIDE = {"COLUMNS": "400"}  # argparse wraps help at the terminal's width
+
+
+def flag_help(help_text: str, flag: str) -> str:
+    """The help of ``flag`` in ``--help`` output, its wrapped lines joined."""
+    lines = help_text.splitlines()
+    start = next(k for k, line in enumerate(lines) if line.strip().startswith(flag))
+    text = [lines[start].strip()[len(flag):]]
+    for line in lines[start + 1:]:
+        if not line.strip() or line.strip().startswith("-"):
+            break
+        text.append(line.strip())
+    return " ".join(" ".join(text).split())
+
+
+def test_render_help_names_each_owner_once():
+    """--unlit is declared by the shell volume, the depth objects and the displacement maps:
+    the two halves of the slicing technique are named apart, each owner once."""
+    out = run_cli("render", "--help", env=WIDE)
+    assert out.returncode == 0, out.stderr
+    text = flag_help(out.stdout, "--unlit, --no-unlit")
+    owners = re.findall(r"(?:^|; )([\w/-]+): ", text)
+    assert len(owners) == len(set(owners)) == 3, text
+    assert "depth-object/visual-hull" in owners and "displacement" in owners, owners
