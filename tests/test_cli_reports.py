@@ -29,3 +29,18 @@ def test_render_help_names_each_owner_once():
     owners = re.findall(r"(?:^|; )([\w/-]+): ", text)
     assert len(owners) == len(set(owners)) == 3, text
     assert "depth-object/visual-hull" in owners and "displacement" in owners, owners
+
+
+def test_top_level_help_lists_every_demo_asset():
+    """Every demo:NAME the help's own examples use is among the listed assets, and every
+    listed asset builds."""
+    from reliefkit.scene.assets import make_asset
+
+    out = run_cli("--help")
+    assert out.returncode == 0, out.stderr
+    text = " ".join(out.stdout.split())
+    listed = re.search(r"\(demo assets: ([^)]*)\)", text).group(1).split(", ")
+    used = set(re.findall(r"demo:([\w-]+)", text)) - {"NAME"}
+    assert used and used <= set(listed), used - set(listed)
+    for name in listed:
+        assert make_asset(name).triangle_count > 0, name

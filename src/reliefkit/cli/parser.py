@@ -42,16 +42,19 @@ def _examples(command: str | None = None) -> list[str]:
 
 
 def _epilog() -> str:
+    import textwrap
+
     from ..core.technique import bakers
+    from ..scene.assets import DEMO_NAMES
 
     heightmap_kinds = [name for name, (_, b) in bakers().items() if "heightmap" in b.sources]
-    lines = ["examples:", *(f"  {line}" for line in _examples()), "",
-             "inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME",
-             "(demo assets: terrain, blob, tree, vehicle)"]
+    inputs = ("inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME "
+              f"(demo assets: {', '.join(DEMO_NAMES)})")
     if heightmap_kinds:
-        lines[-1] += (f", or for `bake --as {'/'.join(heightmap_kinds)}` a heightmap")
-        lines.append("(8/16-bit greyscale .png or a 2D .npy array)")
-    return "\n".join(lines) + ".\n"
+        inputs += (f", or for `bake --as {'/'.join(heightmap_kinds)}` a heightmap (8/16-bit "
+                   "greyscale .png or a 2D .npy array)")
+    return "\n".join(["examples:", *(f"  {line}" for line in _examples()), "",
+                      textwrap.fill(inputs + ".", 88)]) + "\n"
 
 
 class _Parser(argparse.ArgumentParser):
