@@ -44,3 +44,26 @@ def test_top_level_help_lists_every_demo_asset():
     assert used and used <= set(listed), used - set(listed)
     for name in listed:
         assert make_asset(name).triangle_count > 0, name
+
+
+def test_bake_summarises_its_arrays(gl, tmp_path):
+    """A cube's 25 arrays are one short line: their count and total as the file holds them,
+    and only the three largest by name."""
+    import zipfile
+
+    import numpy as np
+
+    out = run_cli("bake", "demo:blob", "--as", "relief-cube", "--depth-res", "16",
+                  "--no-safety", "-o", tmp_path / "cube.rk")
+    assert out.returncode == 0, out.stderr
+    with zipfile.ZipFile(tmp_path / "cube.rk") as rk:
+        sizes = {}
+        for member in rk.namelist():
+            if member.endswith(".npy"):
+                with rk.open(member) as f:
+                    sizes[member[:-4]] = np.load(f, allow_pickle=False).nbytes
+    line = next(x for x in out.stdout.splitlines() if x.startswith("wrote "))
+    assert f": {len(sizes)} arrays, " in line, line
+    named = [name for name in sizes if re.search(rf"\b{name}\b", line)]
+    assert len(named) == 3, line
+    assert sorted(sizes[n] for n in named) == sorted(sizes.values())[-3:], line

@@ -74,13 +74,27 @@ def cmd_bake(args) -> int:
     rep = _bake_input(args)
     source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
     save(args.output, rep, source_hash=source_hash)
-    sizes = array_bytes(rep)
-    parts = ", ".join(f"{name} {format_bytes(n)}" for name, n in sizes.items())
-    print(f"wrote {args.output}: {format_bytes(sum(sizes.values()))} of arrays ({parts}), "
+    print(f"wrote {args.output}: {_arrays_summary(array_bytes(rep), args.output)}, "
           f"{format_bytes(Path(args.output).stat().st_size)} on disk")
     for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
         print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
+
+
+def _arrays_summary(sizes: dict[str, int], path: str, shown: int = 3) -> str:
+    """``N arrays, TOTAL (the largest ...)``: a cube's or a cloud's dozens of arrays in one
+    short line; `reliefkit info` lists every one."""
+    import shlex
+
+    from ..units import format_bytes
+
+    largest = sorted(sizes.items(), key=lambda item: -item[1])[:shown]
+    named = ", ".join(f"{name} {format_bytes(n)}" for name, n in largest)
+    total = f"{len(sizes)} array{'s' if len(sizes) != 1 else ''}, " \
+            f"{format_bytes(sum(sizes.values()))}"
+    if len(sizes) <= shown:
+        return f"{total} ({named})"
+    return f"{total} (the largest: {named}; `reliefkit info {shlex.quote(path)}` lists all)"
 
 
 def _background(text: str):
