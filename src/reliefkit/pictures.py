@@ -1,4 +1,5 @@
-"""Pictures for people: titled contact sheets, PNG and GIF writing (atomic)."""
+"""Pictures for people: titled contact sheets and their atomic writing (animations:
+`reliefkit.animation`)."""
 
 from __future__ import annotations
 
@@ -52,15 +53,6 @@ def save_image(image, path) -> None:
     """Write a PIL image (format from the suffix) atomically."""
     with atomic_path(path) as tmp:
         image.save(tmp, format=_format_of(path))
-
-
-def save_gif(frames: list[np.ndarray], path, fps: float = 15.0) -> None:
-    """Write RGBA uint8 frames as a looping animated GIF, atomically."""
-    import imageio.v3 as iio
-
-    rgb = [np.ascontiguousarray(f[..., :3]) for f in frames]
-    with atomic_path(path) as tmp:
-        iio.imwrite(tmp, rgb, extension=".gif", duration=1000.0 / fps, loop=0)
 
 
 def _format_of(path) -> str:

@@ -164,39 +164,47 @@ def cmd_render(args) -> int:
 def _check_render_outputs(args) -> None:
     """The output names fit what is written; per-frame outputs do not go with --turntable
     or --animate."""
+    from ..animation import is_animation_name
+
     suffix = Path(args.output).suffix.lower()
     if args.turntable is not None and args.animate is not None:
-        raise UsageError("--turntable and --animate both write a GIF: give one of them")
+        raise UsageError("--turntable and --animate both write an animation: give one of them")
     sequence = "--turntable" if args.turntable is not None else \
         "--animate" if args.animate is not None else None
     if sequence:
         count = args.turntable if args.turntable is not None else args.animate
         if not 1 <= count <= 1000:
             raise UsageError(f"{sequence} takes 1..1000 frames, got {count}")
-        if suffix != ".gif":
-            raise UsageError(f"{sequence} writes an animated .gif: name the output *.gif")
+        from ..animation import check_animation_output
+        from ..scene.views import parse_size
+
+        check_animation_output(args.output, parse_size(args.size))
         given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
                  if value]
         if given:
             raise UsageError(f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not "
                              f"apply to {sequence} (one frame's arrays and counters): render "
                              "a single --view for them")
-    elif suffix != ".png":
-        raise UsageError(f"output must be a .png file, got {args.output}")
+    elif suffix != ".png" or is_animation_name(args.output):
+        hint = (": an animation (.gif, .png/.apng, .webp, .mp4 or a PNG per frame) needs "
+                "--turntable N or --animate N" if is_animation_name(args.output) else "")
+        raise UsageError(f"output must be a .png file, got {args.output}{hint}")
     if args.stats and Path(args.stats).suffix.lower() != ".json":
         raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
     if args.aovs and Path(args.aovs).suffix.lower() != ".npz":
         raise UsageError(f"--aovs writes NumPy arrays: name the file *.npz, got {args.aovs}")
     from ..io.atomic import check_writable
 
-    for flag, value in (("-o", args.output), ("--aovs", args.aovs), ("--stats", args.stats)):
+    for flag, value in (("-o", None if sequence else args.output), ("--aovs", args.aovs),
+                        ("--stats", args.stats)):
         if value:
             check_writable(value, flag)
 
 
 def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
-    """``args.turntable`` views of ``draw(camera)`` into a GIF, warning about empty views."""
-    from ..pictures import TILE_BACKGROUND, save_gif
+    """``args.turntable`` views of ``draw(camera)`` into an animation, warning about empty
+    views."""
+    from ..animation import frame_background, save_animation
     from ..progress import progress_bar
     from ..scene.views import turntable
 
@@ -207,10 +215,9 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
             frame = draw(camera)
             if frame.stats["covered"] == 0:
                 empty.append(str(k + 1))
-            frames.append(frame.rgba8(background or TILE_BACKGROUND))
+            frames.append(frame.rgba8(frame_background(args.output, background)))
             advance(k + 1)
-    save_gif(frames, args.output)
-    print(f"wrote {args.output} ({len(frames)} views)")
+    print(f"wrote {save_animation(frames, args.output)} ({len(frames)} views)")
     if empty:
         many = len(empty) > 1
         _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
@@ -219,9 +226,9 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
 
 
 def _render_animation(args, obj, camera, draw, background) -> int:
-    """``args.animate`` frames of ``obj``'s animation (its ``time`` render option) into a GIF."""
+    """``args.animate`` frames of ``obj``'s animation (its ``time`` render option)."""
+    from ..animation import frame_background, save_animation
     from ..core.params import ANIMATION_TIME
-    from ..pictures import TILE_BACKGROUND, save_gif
     from ..progress import progress_bar
     from ..render import render_options
 
@@ -234,10 +241,9 @@ def _render_animation(args, obj, camera, draw, background) -> int:
     with progress_bar("animate", args.animate) as advance:
         for k in range(args.animate):
             frames.append(draw(camera, **{ANIMATION_TIME: k / args.animate}).rgba8(
-                background or TILE_BACKGROUND))
+                frame_background(args.output, background)))
             advance(k + 1)
-    save_gif(frames, args.output)
-    print(f"wrote {args.output} ({len(frames)} frames)")
+    print(f"wrote {save_animation(frames, args.output)} ({len(frames)} frames)")
     return 0
 
 

@@ -20,7 +20,11 @@ CORE_EXAMPLES = {
                "30,25)",
                "reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs "
                "side.npz",
-               "reliefkit render demo:tree --turntable 36 -o spin.gif"],
+               "reliefkit render demo:tree --turntable 36 -o spin.gif",
+               "reliefkit render demo:tree --turntable 36 -o spin.webp    with alpha (.png: "
+               "APNG)",
+               "reliefkit render demo:tree --turntable 36 --size 640x480 -o spin.mp4",
+               "reliefkit render demo:tree --turntable 36 -o frames/%04d.png"],
     "info": ["reliefkit info --gl                               the OpenGL renderer and its "
              "limits",
              "reliefkit info model.obj                          counts and bounds of a mesh "
@@ -136,21 +140,25 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     table = bakers()
 
-    p = _command(sub, "render", "render a mesh or an .rk representation to PNG / GIF",
+    p = _command(sub, "render", "render a mesh or an .rk representation to PNG, or an animation",
                  "Render a mesh (ground truth) or an .rk representation.")
     p.add_argument("input", help="mesh file, .rk file or demo:NAME")
     _add_view_args(p)
-    p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable or "
-                                                   "--animate)")
+    p.add_argument("-o", "--output", required=True,
+                   help="output .png; with --turntable or --animate, by its name: a .gif, an "
+                        "animated .png/.apng or .webp (with alpha), an .mp4, or one PNG per "
+                        "frame (frames/%%04d.png or a folder/)")
     p.add_argument("--aovs", metavar="OUT.npz",
                    help="also write color, mask, depth, position, normal, view, proj, viewport")
     p.add_argument("--stats", metavar="OUT.json",
                    help="also write the frame's counters: covered pixels, fragments and loop "
                         "iterations per pixel (mean, max) where the renderer counts them")
-    p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
+    p.add_argument("--turntable", type=int, metavar="N",
+                   help="N views around the object, as an animation (see -o)")
     p.add_argument("--animate", type=int, metavar="N",
-                   help="N frames of the input's animation, times 0, 1/N, ... (GIF; for "
-                        "inputs with a --time option, such as shell volumes)")
+                   help="N frames of the input's animation, times 0, 1/N, ... (an "
+                        "animation, see -o; for inputs with a --time option, such as shell "
+                        "volumes)")
     add_flag(p, "--background", dash_value=True, default="transparent",
               metavar="transparent|LEVEL",
               help="'transparent' or a grey level 0..1 to composite over (default: "
