@@ -133,6 +133,7 @@ def _command(sub, name: str, summary: str, description: str):
 def build_parser() -> argparse.ArgumentParser:
     from ..bench import suite_names, suites
     from ..core.technique import bakers, techniques
+    from ..render.registry import core_drawables
 
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
                      epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -166,7 +167,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
                    help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
                         "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
-    add_options(p, [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
+    add_options(p, [("mesh", spec.option_list) for spec in core_drawables()]
+                 + [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
                     for spec in t.drawables], "render options")
     p.set_defaults(run=cmd_render)
 
