@@ -17,6 +17,20 @@ def _check_not_empty(spec: str) -> None:
         raise FormatError(f"{spec}: the file is empty (0 bytes)")
 
 
+def _check_mesh_file(spec: str, flag: str) -> None:
+    """A mesh file (not demo:NAME, a heightmap or an .rk) that exists, refused up front."""
+    from ..errors import MeshError
+    from ..scene.loader import SUPPORTED_EXTENSIONS
+
+    if Path(spec).suffix.lower() not in SUPPORTED_EXTENSIONS:
+        raise UsageError(f"{flag} needs a mesh file ({' '.join(SUPPORTED_EXTENSIONS)}), got "
+                         f"{spec}")
+    if not Path(spec).is_file():
+        raise MeshError(f"{spec}: no such file" if not Path(spec).exists() else
+                        f"{spec}: is not a file")
+    _check_not_empty(spec)
+
+
 def _bake_source(spec: str, command: str = "bake"):
     """The mesh or heightmap ``bake`` and ``compare`` start from."""
     from ..scene.heightmap import is_heightmap, load_heightmap
@@ -299,7 +313,9 @@ def cmd_bench(args) -> int:
     from ..io.atomic import check_writable
 
     check_writable(args.out, "--out", folder=True)
-    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out))
+    if args.mesh is not None:
+        _check_mesh_file(args.mesh, "--mesh")
+    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out), mesh=args.mesh)
     print(report)
     print("wrote " + ", ".join(map(str, paths)))
     return 0

@@ -194,6 +194,9 @@ def build_parser() -> argparse.ArgumentParser:
                  + "; ".join(f"{n}: {s.summary}" for n, s in suites().items()) + ".")
     p.add_argument("name", choices=names, help="which benchmark")
     p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    p.add_argument("--mesh", metavar="FILE",
+                   help="run on this mesh file instead of the built-in assets (suites: "
+                        + ", ".join(n for n, s in suites().items() if s.takes_mesh) + ")")
     p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
     p.set_defaults(run=cmd_bench)
 
