@@ -51,3 +51,36 @@ def test_a_score_without_a_measure_is_na_and_null():
     parsed = json.loads(metrics_json(result, "shell"), parse_constant=refuse)
     assert parsed["variants"]["peeling"]["position_mean_rel"] is None
     assert parsed["variants"]["sorted"]["position_mean_rel"] == 0.01
+
+
+def test_a_shadowed_variant_is_scored_against_the_mesh_with_shadows(gl):
+    """The shell volume's "shadows" variant is held to the mesh rendered with --shadows,
+    every other variant to the plain mesh (one render per distinct set of options)."""
+    import numpy as np
+    import trimesh
+
+    from reliefkit.compare import mesh_references
+    from reliefkit.core.technique import technique
+    from reliefkit.render import render
+    from reliefkit.scene.light import DirectionalLight
+    from reliefkit.scene.mesh import RenderMesh, vertex_normals
+
+    cube = trimesh.creation.box(extents=(0.5, 0.5, 0.5))
+    cube.apply_translation((0.0, 0.75, 0.0))
+    plane = trimesh.creation.box(extents=(4.0, 0.02, 4.0))
+    both = trimesh.util.concatenate([cube, plane])
+    positions = np.asarray(both.vertices, np.float32)
+    mesh = RenderMesh(positions, both.faces, vertex_normals(positions, both.faces),
+                      np.ones((len(positions), 4)))
+    camera = orbit_bounds(mesh.bounds, 30.0, 50.0, None, (48, 48), 40.0)
+    light = DirectionalLight.from_angles(-60.0, 45.0)
+    variants = technique("shellvolume").compare_variants
+    references = mesh_references(mesh, camera, light, variants)
+    shadowed = render(mesh, camera, light=light, shadows=True).color
+    plain = render(mesh, camera, light=light).color
+    assert not np.array_equal(shadowed, plain)
+    for variant in variants:
+        expected = shadowed if variant.options.get("shadows") else plain
+        np.testing.assert_array_equal(references[variant.name].color, expected, variant.name)
+    assert any(v.options.get("shadows") for v in variants)
+    assert len({id(frame) for frame in references.values()}) == 2

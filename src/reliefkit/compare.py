@@ -28,7 +28,8 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
 
     Returns ``{"metrics": {variant: row}, "frames": {"mesh": Frame, variant: Frame},
     "errors": {variant: mask or None}, "columns": table columns, "bytes": {"mesh": n,
-    "representation": n}}`` (bytes as the .rk files store them, uncompressed).
+    "representation": n}, "references": {variant: the mesh's Frame it is scored against}}``
+    (bytes as the .rk files store them, uncompressed; see `mesh_references`).
     """
     from . import metrics
     from .core.technique import technique_of
@@ -42,10 +43,11 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
                          "compare variants")
     variants = [v for v in tech.compare_variants if v.available(representation)]
     advance = progress or (lambda done, total: None)
-    truth = render(mesh, camera, light=light)
+    references = mesh_references(mesh, camera, light, variants)
     advance(1, len(variants) + 1)
-    rows, frames, errors = {}, {"mesh": truth}, {}
+    rows, frames, errors = {}, {"mesh": references[None]}, {}
     for k, variant in enumerate(variants):
+        truth = references[variant.name]
         drawn = variant.derive(representation, mesh) if variant.derive else representation
         plain = render(drawn, camera, light=light, **variant.options)
         counted = render(drawn, camera, light=light, count_iterations=True, **variant.options)
@@ -69,7 +71,25 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     sizes = {"mesh": sum(array_bytes(mesh).values()),
              "representation": sum(array_bytes(representation).values())}
     return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns,
-            "bytes": sizes}
+            "bytes": sizes, "references": references}
+
+
+def mesh_references(mesh, camera, light, variants) -> dict:
+    """The mesh's frame each variant is scored against, by variant name (``None``: the
+    plain mesh): rendered with the variant's options that the mesh also takes (a variant
+    with ``shadows`` against the mesh's shadows), each distinct set once."""
+    from .render import render, render_options
+
+    takes = {opt.name for opt in render_options(mesh)}
+    drawn: dict[tuple, object] = {}
+
+    def reference(options: dict):
+        shared = tuple(sorted((k, v) for k, v in options.items() if k in takes))
+        if shared not in drawn:
+            drawn[shared] = render(mesh, camera, light=light, **dict(shared))
+        return drawn[shared]
+
+    return {None: reference({})} | {v.name: reference(v.options) for v in variants}
 
 
 def _measured_columns(compare_metrics, rows) -> tuple[str, ...]:
@@ -92,7 +112,8 @@ def comparison_sheet(result: dict, title: str):
     last = frames[list(result["errors"])[-1]]
     tiles.append(("coverage vs mesh", _rgba(metrics.error_image(last, truth, "mask"))))
     for name, mask in result["errors"].items():
-        err = metrics.error_image(frames[name], truth, "color", scale=0.25)
+        reference = result.get("references", {}).get(name, truth)
+        err = metrics.error_image(frames[name], reference, "color", scale=0.25)
         caption = f"{name}: error"
         if mask is not None:
             err[mask] = (1.0, 0.1, 0.1)
