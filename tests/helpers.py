@@ -99,3 +99,25 @@ def write_obj_quad(folder, mtl_text: str, material: str, positions, uvs, name: s
         + "".join(f"vt {u:g} {v:g}\n" for u, v in uvs)
         + f"usemtl {material}\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n")
     return folder / f"{name}.obj"
+
+
+def run_cli(*args, cwd=None, env=None):
+    """``reliefkit ARGS`` in a fresh interpreter (stdout, stderr and the exit status)."""
+    import os
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "reliefkit.cli", *map(str, args)],
+                          capture_output=True, text=True, timeout=300, cwd=cwd,
+                          env=None if env is None else {**os.environ, **env})
+
+
+def assert_one_line_error(result, *words, code=None):
+    """The command failed with one ``error:`` line on stderr that holds every word."""
+    assert result.returncode != 0
+    assert code is None or result.returncode == code, (result.returncode, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert "Traceback" not in result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]

@@ -111,7 +111,7 @@ def test_bake_render_info_relief(gl, tmp_path):
     (["render", "demo:tree", "--view", "1,2,3,4", "-o", "x.png"], ["--view"]),
     (["render", "demo:tree", "--size", "0x5", "-o", "x.png"], ["--size"]),
     (["render", "demo:tree", "-o", "x.jpg"], [".png"]),
-    (["render", "demo:tree", "--turntable", "3", "-o", "x.png"], [".gif"]),
+    (["render", "demo:tree", "--turntable", "3", "-o", "x.jpg"], [".gif", ".webp", ".mp4"]),
     (["info"], ["--gl"]),
     (["render"], ["required"]),
     (["bake", "demo:tree", "--as", "volume", "-o", "x.rk"], ["invalid choice"]),

@@ -8,6 +8,7 @@ and the technique adds its own metrics (such as wrong hits against an exact refe
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -27,9 +28,10 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
 
     Returns ``{"metrics": {variant: row}, "frames": {"mesh": Frame, variant: Frame},
     "errors": {variant: mask or None}, "columns": table columns, "bytes": {"mesh": n,
-    "representation": n}, "default": variant}`` (bytes as the .rk files store them,
-    uncompressed; ``default`` is the variant that draws the representation as a plain
-    render does, see `default_variant`).
+    "representation": n}, "default": variant, "references": {variant: the mesh's Frame it
+    is scored against}}`` (bytes as the .rk files store them, uncompressed; ``default`` is the
+    variant that draws the representation as a plain render does, see `default_variant`;
+    ``references``: see `mesh_references`).
     """
     from . import metrics
     from .core.technique import technique_of
@@ -43,10 +45,11 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
                          "compare variants")
     variants = [v for v in tech.compare_variants if v.available(representation)]
     advance = progress or (lambda done, total: None)
-    truth = render(mesh, camera, light=light)
+    references = mesh_references(mesh, camera, light, variants)
     advance(1, len(variants) + 1)
-    rows, frames, errors, itself = {}, {"mesh": truth}, {}, []
+    rows, frames, errors, itself = {}, {"mesh": references[None]}, {}, []
     for k, variant in enumerate(variants):
+        truth = references[variant.name]
         drawn = variant.derive(representation, mesh) if variant.derive else representation
         if drawn is representation:
             itself.append(variant)
@@ -68,11 +71,12 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
         frames[variant.name] = plain
         errors[variant.name] = error_mask
         advance(k + 2, len(variants) + 1)
-    columns = tuple(c for m in tech.compare_metrics for c in m.columns) + CORE_COLUMNS
+    columns = _measured_columns(tech.compare_metrics, rows.values()) + CORE_COLUMNS
     sizes = {"mesh": sum(array_bytes(mesh).values()),
              "representation": sum(array_bytes(representation).values())}
     return {"metrics": rows, "frames": frames, "errors": errors, "columns": columns,
-            "bytes": sizes, "default": default_variant(representation, itself or variants)}
+            "bytes": sizes, "default": default_variant(representation, itself or variants),
+            "references": references}
 
 
 def default_variant(representation, variants) -> str:
@@ -86,6 +90,32 @@ def default_variant(representation, variants) -> str:
         if all(defaults.get(name) == value for name, value in variant.options.items()):
             return variant.name
     return variants[0].name
+
+
+def mesh_references(mesh, camera, light, variants) -> dict:
+    """The mesh's frame each variant is scored against, by variant name (``None``: the
+    plain mesh): rendered with the variant's options that the mesh also takes (a variant
+    with ``shadows`` against the mesh's shadows), each distinct set once."""
+    from .render import render, render_options
+
+    takes = {opt.name for opt in render_options(mesh)}
+    drawn: dict[tuple, object] = {}
+
+    def reference(options: dict):
+        shared = tuple(sorted((k, v) for k, v in options.items() if k in takes))
+        if shared not in drawn:
+            drawn[shared] = render(mesh, camera, light=light, **dict(shared))
+        return drawn[shared]
+
+    return {None: reference({})} | {v.name: reference(v.options) for v in variants}
+
+
+def _measured_columns(compare_metrics, rows) -> tuple[str, ...]:
+    """The technique's metric columns in declared order, each once, that some row holds: a
+    technique of several parts declares columns for kinds other than the one compared."""
+    held = {key for row in rows for key in row}
+    declared = dict.fromkeys(c for metric in compare_metrics for c in metric.columns)
+    return tuple(c for c in declared if c in held)
 
 
 def comparison_sheet(result: dict, title: str):
@@ -108,7 +138,8 @@ def comparison_tiles(result: dict) -> list[tuple[str, np.ndarray]]:
     tiles.append((f"coverage vs mesh: {default}",
                   _rgba(metrics.error_image(frames[default], truth, "mask"))))
     for name, mask in result["errors"].items():
-        err = metrics.error_image(frames[name], truth, "color", scale=0.25)
+        reference = result.get("references", {}).get(name, truth)
+        err = metrics.error_image(frames[name], reference, "color", scale=0.25)
         caption = f"{name}: error"
         if mask is not None:
             err[mask] = (1.0, 0.1, 0.1)
@@ -130,12 +161,27 @@ def metrics_markdown(result: dict, heading: str) -> str:
              f", mesh {format_bytes(sizes['mesh'])}.", "",
              "| variant | " + " | ".join(cols) + " |",
              "|---" * (len(cols) + 1) + "|"]
-    for name, row in result["metrics"].items():
-        cells = [format_bytes(row[c]) if c == "bytes" else
-                 f"{row[c]:.4g}" if isinstance(row.get(c), float) else str(row.get(c, ""))
-                 for c in cols]
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    rows = [[_cell(row.get(c), c) for c in cols] for row in result["metrics"].values()]
+    lines += [f"| {name} | " + " | ".join(cells) + " |"
+              for name, cells in zip(result["metrics"], rows, strict=True)]
+    if any("n/a" in cells for cells in rows):
+        lines += ["", "n/a: not measured for that variant."]
     return "\n".join(lines) + "\n"
+
+
+def _measured(value):
+    """None for a score with nothing to measure: missing, or NaN (the position error of a
+    frame without positions, such as depth peeling's); the reports show n/a, JSON null."""
+    return None if value is None or (isinstance(value, float) and math.isnan(value)) else value
+
+
+def _cell(value, column: str) -> str:
+    value = _measured(value)
+    if value is None:
+        return "n/a"
+    if column == "bytes":
+        return format_bytes(value)
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]:
@@ -149,6 +195,13 @@ def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]
     with atomic_path(paths["markdown"]) as tmp:
         tmp.write_text(metrics_markdown(result, title))
     with atomic_path(paths["json"]) as tmp:
-        tmp.write_text(json.dumps({"title": title, "bytes": result["bytes"],
-                                   "variants": result["metrics"]}, indent=2))
+        tmp.write_text(metrics_json(result, title))
     return paths
+
+
+def metrics_json(result: dict, title: str) -> str:
+    """``{"title", "bytes", "variants": {name: row}}``, a score not measured as null."""
+    variants = {name: {key: _measured(value) for key, value in row.items()}
+                for name, row in result["metrics"].items()}
+    return json.dumps({"title": title, "bytes": result["bytes"], "variants": variants},
+                      indent=2)

@@ -1,4 +1,5 @@
-"""Pictures for people: titled contact sheets, PNG and GIF writing (atomic)."""
+"""Pictures for people: titled contact sheets and their atomic writing (animations:
+`reliefkit.animation`)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from .io.atomic import atomic_path
 TILE_BACKGROUND = (0.05, 0.055, 0.065)  # linear grey behind every rendered tile and frame
 SHEET_BACKGROUND = (32, 34, 38)         # sRGB bytes between the tiles of a sheet
 TITLE_COLOR = (235, 235, 235)
+CAPTION_SIZE, CAPTION_LINE = 14, 17  # caption font size and line height (pixels)
 
 
 def _font(size: int):
@@ -23,7 +25,12 @@ def _font(size: int):
 
 def contact_sheet(tiles: list[tuple[str, np.ndarray]], columns: int = 4, *,
                   title: str | None = None, pad: int = 8, caption_height: int = 22):
-    """Arrange (caption, RGBA uint8 image) tiles in a grid with captions; returns a PIL image."""
+    """Arrange (caption, RGBA uint8 image) tiles in a grid with captions; returns a PIL image.
+
+    Captions wrap to their tile's width (the caption band grows by a line for each extra
+    line the longest one needs), so none runs into its neighbour or off the sheet; the
+    title widens the sheet if it is wider than the tiles.
+    """
     from PIL import Image, ImageDraw
 
     if not tiles:
@@ -32,35 +39,49 @@ def contact_sheet(tiles: list[tuple[str, np.ndarray]], columns: int = 4, *,
     tile_w = max(img.shape[1] for _, img in tiles)
     columns = max(1, min(columns, len(tiles)))
     rows = -(-len(tiles) // columns)
+    font, title_font = _font(CAPTION_SIZE), _font(20)
+    captions = [wrap_text(caption, font, tile_w - 2) for caption, _ in tiles]
+    caption_height += (max(len(lines) for lines in captions) - 1) * CAPTION_LINE
     head = 34 if title else 0
     cell_w, cell_h = tile_w + pad, tile_h + caption_height + pad
-    sheet = Image.new("RGB", (columns * cell_w + pad, head + rows * cell_h + pad),
-                      SHEET_BACKGROUND)
+    width = max(columns * cell_w + pad, int(title_font.getlength(title)) + 2 * pad if title
+                else 0)
+    sheet = Image.new("RGB", (width, head + rows * cell_h + pad), SHEET_BACKGROUND)
     draw = ImageDraw.Draw(sheet)
     if title:
-        draw.text((pad, 8), title, fill=TITLE_COLOR, font=_font(20))
-    for k, (caption, img) in enumerate(tiles):
+        draw.text((pad, 8), title, fill=TITLE_COLOR, font=title_font)
+    for k, ((_, img), lines) in enumerate(zip(tiles, captions, strict=True)):
         x = pad + (k % columns) * cell_w
         y = head + pad + (k // columns) * cell_h
-        draw.text((x + 2, y + 3), caption, fill=TITLE_COLOR, font=_font(14))
+        for n, line in enumerate(lines):
+            draw.text((x + 2, y + 3 + n * CAPTION_LINE), line, fill=TITLE_COLOR, font=font)
         tile = Image.fromarray(img, "RGBA" if img.shape[2] == 4 else "RGB")
         sheet.paste(tile, (x, y + caption_height), tile if img.shape[2] == 4 else None)
     return sheet
+
+
+def wrap_text(text: str, font, width: float) -> list[str]:
+    """``text`` in lines of at most ``width`` pixels in ``font``: broken at spaces, and a
+    word wider than a line broken where it must be."""
+    lines: list[str] = []
+    for word in text.split():
+        joined = f"{lines[-1]} {word}" if lines else word
+        if lines and font.getlength(joined) <= width:
+            lines[-1] = joined
+            continue
+        while font.getlength(word) > width and len(word) > 1:
+            cut = max(k for k in range(1, len(word)) if font.getlength(word[:k]) <= width
+                      or k == 1)
+            lines.append(word[:cut])
+            word = word[cut:]
+        lines.append(word)
+    return lines or [""]
 
 
 def save_image(image, path) -> None:
     """Write a PIL image (format from the suffix) atomically."""
     with atomic_path(path) as tmp:
         image.save(tmp, format=_format_of(path))
-
-
-def save_gif(frames: list[np.ndarray], path, fps: float = 15.0) -> None:
-    """Write RGBA uint8 frames as a looping animated GIF, atomically."""
-    import imageio.v3 as iio
-
-    rgb = [np.ascontiguousarray(f[..., :3]) for f in frames]
-    with atomic_path(path) as tmp:
-        iio.imwrite(tmp, rgb, extension=".gif", duration=1000.0 / fps, loop=0)
 
 
 def _format_of(path) -> str:

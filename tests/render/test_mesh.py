@@ -309,3 +309,52 @@ def test_rotated_textured_boxes_are_lit_from_the_front(gl, tmp_path):
         to_eye = np.asarray(camera.eye) - frame.position[m]
         facing = (frame.normal[m] * to_eye).sum(axis=1)
         assert (facing > 0).all(), f"{(facing <= 0).mean():.0%} of the pixels face away"
+
+
+def _box_over_plane(half=0.25, height=0.75):
+    """A cube of side 2 * ``half`` centred ``height`` above a 4 x 4 plane at y = 0."""
+    cube = trimesh.creation.box(extents=(2 * half,) * 3)
+    cube.apply_translation((0.0, height, 0.0))
+    cube.unmerge_vertices()  # flat faces: a face turned from the light gets no diffuse light
+    plane = [[-2, 0, -2], [2, 0, -2], [2, 0, 2], [-2, 0, 2]]
+    positions = np.concatenate([cube.vertices, plane])
+    faces = np.concatenate([cube.faces, np.array([[0, 2, 1], [0, 3, 2]]) + len(cube.vertices)])
+    return _mesh(positions, faces, color=(0.8, 0.8, 0.8, 1.0))
+
+
+def _ray_hits_box(origins, direction, lo, hi):
+    """Whether rays from ``origins`` along ``direction`` hit the box [lo, hi] (slab test)."""
+    with np.errstate(divide="ignore"):
+        inv = 1.0 / np.asarray(direction, np.float64)
+    t0, t1 = (lo - origins) * inv, (hi - origins) * inv
+    near = np.minimum(t0, t1).max(axis=-1)
+    far = np.maximum(t0, t1).min(axis=-1)
+    return (far >= np.maximum(near, 0.0))
+
+
+@pytest.mark.parametrize("light_angles", [(-60.0, 45.0), (120.0, 30.0)])
+def test_mesh_shadows_fall_where_the_light_is_blocked(gl, light_angles):
+    """A cube over a plane: plane points whose ray to the light hits the cube (on the CPU)
+    are dark with --shadows and lit without; the rest keep their light. Points within
+    0.03 of the shadow's edge (the shadow map's filter) are not judged."""
+    from reliefkit.scene.light import DirectionalLight
+
+    half, height, margin = 0.25, 0.75, 0.03
+    mesh = _box_over_plane(half, height)
+    light = DirectionalLight.from_angles(*light_angles)
+    camera = Camera.orbit((0, 0, 0), 30, 60, 6.0, size=(96, 96))
+    plain = render(mesh, camera, light=light)
+    shaded = render(mesh, camera, light=light, shadows=True)
+    np.testing.assert_array_equal(plain.mask, shaded.mask)
+    on_plane = plain.mask & (np.abs(plain.position[..., 1]) < 1e-4)
+    points = plain.position[on_plane]
+    centre = np.array([0.0, height, 0.0])
+    towards = light.unit_direction
+    inside = _ray_hits_box(points, towards, centre - half + margin, centre + half - margin)
+    outside = ~_ray_hits_box(points, towards, centre - half - margin, centre + half + margin)
+    assert inside.sum() > 30 and outside.sum() > 1000
+    ratio = shaded.color[on_plane][:, :3].mean(-1) / plain.color[on_plane][:, :3].mean(-1)
+    assert (ratio[inside] < 0.6).all(), ratio[inside].max()
+    np.testing.assert_allclose(ratio[outside], 1.0, atol=1e-3)
+    cube = plain.mask & (plain.position[..., 1] > 0.01)  # lit faces never shadow themselves
+    np.testing.assert_allclose(shaded.color[cube], plain.color[cube], atol=1e-3)

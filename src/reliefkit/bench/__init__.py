@@ -11,9 +11,10 @@ from pathlib import Path
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
-              log=None) -> tuple[str, list[Path]]:
+              log=None, mesh: str | None = None) -> tuple[str, list[Path]]:
     """Run the suite ``name``; returns its markdown report and the files it wrote.
 
+    ``mesh`` (a mesh file) replaces the built-in assets of a suite that ``takes_mesh``.
     Without ``log`` the suite's step messages are its progress (`reliefkit.progress.activity`:
     ``bench NAME: ...`` lines on stderr, a spinner on a terminal).
     """
@@ -24,10 +25,17 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
     if name not in table:
         raise UsageError(f"unknown benchmark {name!r} (choose from {', '.join(table)})")
     suite = table[name]
+    kwargs = {}
+    if mesh is not None:
+        if not suite.takes_mesh:
+            takers = ", ".join(n for n, s in table.items() if s.takes_mesh) or "none"
+            raise UsageError(f"bench {name} runs on its own assets only: --mesh applies to "
+                             f"{takers}")
+        kwargs["mesh"] = str(mesh)
     if log is not None:
-        return suite.run(quick, Path(out), log)
+        return suite.run(quick, Path(out), log, **kwargs)
     with activity(f"bench {name}") as progress_log:
-        return suite.run(quick, Path(out), progress_log)
+        return suite.run(quick, Path(out), progress_log, **kwargs)
 
 
 def suites() -> dict:
@@ -36,7 +44,7 @@ def suites() -> dict:
     from . import loading
 
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
-                                  loading.run_suite)}
+                                  loading.run_suite, takes_mesh=True)}
     return core | {name: suite for name, (_, suite) in bench_suites().items()}
 
 

@@ -17,6 +17,20 @@ def _check_not_empty(spec: str) -> None:
         raise FormatError(f"{spec}: the file is empty (0 bytes)")
 
 
+def _check_mesh_file(spec: str, flag: str) -> None:
+    """A mesh file (not demo:NAME, a heightmap or an .rk) that exists, refused up front."""
+    from ..errors import MeshError
+    from ..scene.loader import SUPPORTED_EXTENSIONS
+
+    if Path(spec).suffix.lower() not in SUPPORTED_EXTENSIONS:
+        raise UsageError(f"{flag} needs a mesh file ({' '.join(SUPPORTED_EXTENSIONS)}), got "
+                         f"{spec}")
+    if not Path(spec).is_file():
+        raise MeshError(f"{spec}: no such file" if not Path(spec).exists() else
+                        f"{spec}: is not a file")
+    _check_not_empty(spec)
+
+
 def _bake_source(spec: str, command: str = "bake"):
     """The mesh or heightmap ``bake`` and ``compare`` start from."""
     from ..scene.heightmap import is_heightmap, load_heightmap
@@ -74,13 +88,27 @@ def cmd_bake(args) -> int:
     rep = _bake_input(args)
     source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
     save(args.output, rep, source_hash=source_hash)
-    sizes = array_bytes(rep)
-    parts = ", ".join(f"{name} {format_bytes(n)}" for name, n in sizes.items())
-    print(f"wrote {args.output}: {format_bytes(sum(sizes.values()))} of arrays ({parts}), "
+    print(f"wrote {args.output}: {_arrays_summary(array_bytes(rep), args.output)}, "
           f"{format_bytes(Path(args.output).stat().st_size)} on disk")
     for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
         print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
+
+
+def _arrays_summary(sizes: dict[str, int], path: str, shown: int = 3) -> str:
+    """``N arrays, TOTAL (the largest ...)``: a cube's or a cloud's dozens of arrays in one
+    short line; `reliefkit info` lists every one."""
+    import shlex
+
+    from ..units import format_bytes
+
+    largest = sorted(sizes.items(), key=lambda item: -item[1])[:shown]
+    named = ", ".join(f"{name} {format_bytes(n)}" for name, n in largest)
+    total = f"{len(sizes)} array{'s' if len(sizes) != 1 else ''}, " \
+            f"{format_bytes(sum(sizes.values()))}"
+    if len(sizes) <= shown:
+        return f"{total} ({named})"
+    return f"{total} (the largest: {named}; `reliefkit info {shlex.quote(path)}` lists all)"
 
 
 def _background(text: str):
@@ -167,39 +195,47 @@ def cmd_render(args) -> int:
 def _check_render_outputs(args) -> None:
     """The output names fit what is written; per-frame outputs do not go with --turntable
     or --animate."""
+    from ..animation import is_animation_name
+
     suffix = Path(args.output).suffix.lower()
     if args.turntable is not None and args.animate is not None:
-        raise UsageError("--turntable and --animate both write a GIF: give one of them")
+        raise UsageError("--turntable and --animate both write an animation: give one of them")
     sequence = "--turntable" if args.turntable is not None else \
         "--animate" if args.animate is not None else None
     if sequence:
         count = args.turntable if args.turntable is not None else args.animate
         if not 1 <= count <= 1000:
             raise UsageError(f"{sequence} takes 1..1000 frames, got {count}")
-        if suffix != ".gif":
-            raise UsageError(f"{sequence} writes an animated .gif: name the output *.gif")
+        from ..animation import check_animation_output
+        from ..scene.views import parse_size
+
+        check_animation_output(args.output, parse_size(args.size))
         given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
                  if value]
         if given:
             raise UsageError(f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not "
                              f"apply to {sequence} (one frame's arrays and counters): render "
                              "a single --view for them")
-    elif suffix != ".png":
-        raise UsageError(f"output must be a .png file, got {args.output}")
+    elif suffix != ".png" or is_animation_name(args.output):
+        hint = (": an animation (.gif, .png/.apng, .webp, .mp4 or a PNG per frame) needs "
+                "--turntable N or --animate N" if is_animation_name(args.output) else "")
+        raise UsageError(f"output must be a .png file, got {args.output}{hint}")
     if args.stats and Path(args.stats).suffix.lower() != ".json":
         raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
     if args.aovs and Path(args.aovs).suffix.lower() != ".npz":
         raise UsageError(f"--aovs writes NumPy arrays: name the file *.npz, got {args.aovs}")
     from ..io.atomic import check_writable
 
-    for flag, value in (("-o", args.output), ("--aovs", args.aovs), ("--stats", args.stats)):
+    for flag, value in (("-o", None if sequence else args.output), ("--aovs", args.aovs),
+                        ("--stats", args.stats)):
         if value:
             check_writable(value, flag)
 
 
 def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
-    """``args.turntable`` views of ``draw(camera)`` into a GIF, warning about empty views."""
-    from ..pictures import TILE_BACKGROUND, save_gif
+    """``args.turntable`` views of ``draw(camera)`` into an animation, warning about empty
+    views."""
+    from ..animation import frame_background, save_animation
     from ..progress import progress_bar
     from ..scene.views import turntable
 
@@ -211,10 +247,9 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
             if frame.stats["covered"] == 0:
                 empty.append(str(k + 1))
             warned.append(frame.warnings)
-            frames.append(frame.rgba8(background or TILE_BACKGROUND))
+            frames.append(frame.rgba8(frame_background(args.output, background)))
             advance(k + 1)
-    save_gif(frames, args.output)
-    print(f"wrote {args.output} ({len(frames)} views)")
+    print(f"wrote {save_animation(frames, args.output)} ({len(frames)} views)")
     if empty:
         many = len(empty) > 1
         _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
@@ -224,9 +259,9 @@ def _render_turntable(args, bounds, draw, elevation, distance, size, background)
 
 
 def _render_animation(args, obj, camera, draw, background) -> int:
-    """``args.animate`` frames of ``obj``'s animation (its ``time`` render option) into a GIF."""
+    """``args.animate`` frames of ``obj``'s animation (its ``time`` render option)."""
+    from ..animation import frame_background, save_animation
     from ..core.params import ANIMATION_TIME
-    from ..pictures import TILE_BACKGROUND, save_gif
     from ..progress import progress_bar
     from ..render import render_options
 
@@ -240,10 +275,9 @@ def _render_animation(args, obj, camera, draw, background) -> int:
         for k in range(args.animate):
             frame = draw(camera, **{ANIMATION_TIME: k / args.animate})
             warned.append(frame.warnings)
-            frames.append(frame.rgba8(background or TILE_BACKGROUND))
+            frames.append(frame.rgba8(frame_background(args.output, background)))
             advance(k + 1)
-    save_gif(frames, args.output)
-    print(f"wrote {args.output} ({len(frames)} frames)")
+    print(f"wrote {save_animation(frames, args.output)} ({len(frames)} frames)")
     _print_frame_warnings(warned, "frame")
     return 0
 
@@ -303,7 +337,9 @@ def cmd_bench(args) -> int:
     from ..io.atomic import check_writable
 
     check_writable(args.out, "--out", folder=True)
-    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out))
+    if args.mesh is not None:
+        _check_mesh_file(args.mesh, "--mesh")
+    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out), mesh=args.mesh)
     print(report)
     print("wrote " + ", ".join(map(str, paths)))
     return 0

@@ -20,7 +20,11 @@ CORE_EXAMPLES = {
                "30,25)",
                "reliefkit render car.glb --view 90,10,2 --size 800x600 -o side.png --aovs "
                "side.npz",
-               "reliefkit render demo:tree --turntable 36 -o spin.gif"],
+               "reliefkit render demo:tree --turntable 36 -o spin.gif",
+               "reliefkit render demo:tree --turntable 36 -o spin.webp    with alpha (.png: "
+               "APNG)",
+               "reliefkit render demo:tree --turntable 36 --size 640x480 -o spin.mp4",
+               "reliefkit render demo:tree --turntable 36 -o frames/%04d.png"],
     "info": ["reliefkit info --gl                               the OpenGL renderer and its "
              "limits",
              "reliefkit info model.obj                          counts and bounds of a mesh "
@@ -42,16 +46,19 @@ def _examples(command: str | None = None) -> list[str]:
 
 
 def _epilog() -> str:
+    import textwrap
+
     from ..core.technique import bakers
+    from ..scene.assets import DEMO_NAMES
 
     heightmap_kinds = [name for name, (_, b) in bakers().items() if "heightmap" in b.sources]
-    lines = ["examples:", *(f"  {line}" for line in _examples()), "",
-             "inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME",
-             "(demo assets: terrain, blob, tree, vehicle)"]
+    inputs = ("inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME "
+              f"(demo assets: {', '.join(DEMO_NAMES)})")
     if heightmap_kinds:
-        lines[-1] += (f", or for `bake --as {'/'.join(heightmap_kinds)}` a heightmap")
-        lines.append("(8/16-bit greyscale .png or a 2D .npy array)")
-    return "\n".join(lines) + ".\n"
+        inputs += (f", or for `bake --as {'/'.join(heightmap_kinds)}` a heightmap (8/16-bit "
+                   "greyscale .png or a 2D .npy array)")
+    return "\n".join(["examples:", *(f"  {line}" for line in _examples()), "",
+                      textwrap.fill(inputs + ".", 88)]) + "\n"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -107,6 +114,15 @@ def _add_view_args(p: _Parser) -> None:
                    "--view (default: %(default)s, a low sun from the side)")
 
 
+def _drawn_kinds(tech, spec) -> str:
+    """Who owns a drawable's options in --help: its technique, or where the technique's
+    drawables take different options (depth objects and displacement maps) the kinds this
+    one draws."""
+    if len({d.options for d in tech.drawables}) == 1:
+        return tech.name
+    return "/".join(c.kind for c in tech.codecs if issubclass(c.cls, spec.cls)) or tech.name
+
+
 def _command(sub, name: str, summary: str, description: str):
     """A subcommand parser whose --help ends with its examples."""
     epilog = "examples:\n" + "\n".join(f"  {line}" for line in _examples(name))
@@ -117,6 +133,7 @@ def _command(sub, name: str, summary: str, description: str):
 def build_parser() -> argparse.ArgumentParser:
     from ..bench import suite_names, suites
     from ..core.technique import bakers, techniques
+    from ..render.registry import core_drawables
 
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
                      epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -124,21 +141,25 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     table = bakers()
 
-    p = _command(sub, "render", "render a mesh or an .rk representation to PNG / GIF",
+    p = _command(sub, "render", "render a mesh or an .rk representation to PNG, or an animation",
                  "Render a mesh (ground truth) or an .rk representation.")
     p.add_argument("input", help="mesh file, .rk file or demo:NAME")
     _add_view_args(p)
-    p.add_argument("-o", "--output", required=True, help="output .png (or .gif with --turntable or "
-                                                   "--animate)")
+    p.add_argument("-o", "--output", required=True,
+                   help="output .png; with --turntable or --animate, by its name: a .gif, an "
+                        "animated .png/.apng or .webp (with alpha), an .mp4, or one PNG per "
+                        "frame (frames/%%04d.png or a folder/)")
     p.add_argument("--aovs", metavar="OUT.npz",
                    help="also write color, mask, depth, position, normal, view, proj, viewport")
     p.add_argument("--stats", metavar="OUT.json",
                    help="also write the frame's counters: covered pixels, fragments and loop "
                         "iterations per pixel (mean, max) where the renderer counts them")
-    p.add_argument("--turntable", type=int, metavar="N", help="N views around the object (GIF)")
+    p.add_argument("--turntable", type=int, metavar="N",
+                   help="N views around the object, as an animation (see -o)")
     p.add_argument("--animate", type=int, metavar="N",
-                   help="N frames of the input's animation, times 0, 1/N, ... (GIF; for "
-                        "inputs with a --time option, such as shell volumes)")
+                   help="N frames of the input's animation, times 0, 1/N, ... (an "
+                        "animation, see -o; for inputs with a --time option, such as shell "
+                        "volumes)")
     add_flag(p, "--background", dash_value=True, default="transparent",
               metavar="transparent|LEVEL",
               help="'transparent' or a grey level 0..1 to composite over (default: "
@@ -146,8 +167,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
                    help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
                         "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
-    add_options(p, [(t.name, spec.option_list) for t in techniques() for spec in t.drawables],
-                 "render options")
+    add_options(p, [("mesh", spec.option_list) for spec in core_drawables()]
+                 + [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
+                    for spec in t.drawables], "render options")
     p.set_defaults(run=cmd_render)
 
     p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",
@@ -172,6 +194,9 @@ def build_parser() -> argparse.ArgumentParser:
                  + "; ".join(f"{n}: {s.summary}" for n, s in suites().items()) + ".")
     p.add_argument("name", choices=names, help="which benchmark")
     p.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    p.add_argument("--mesh", metavar="FILE",
+                   help="run on this mesh file instead of the built-in assets (suites: "
+                        + ", ".join(n for n, s in suites().items() if s.takes_mesh) + ")")
     p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
     p.set_defaults(run=cmd_bench)
 

@@ -99,11 +99,16 @@ class CompareMetric:
 
 @dataclass(frozen=True)
 class BenchSuite:
-    """``reliefkit bench NAME``: ``run(quick, out, log) -> (markdown, written paths)``."""
+    """``reliefkit bench NAME``: ``run(quick, out, log) -> (markdown, written paths)``.
+
+    A suite with ``takes_mesh`` also runs on a user's mesh instead of its built-in assets
+    (``bench NAME --mesh FILE``): ``run(quick, out, log, mesh=FILE)``.
+    """
 
     name: str
     summary: str
     run: Callable
+    takes_mesh: bool = False
 
 
 @dataclass(frozen=True)

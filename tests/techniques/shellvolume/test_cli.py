@@ -54,11 +54,11 @@ def test_animate_writes_a_gif(fur_rk, tmp_path):
         assert gif.n_frames == 3
 
 
-def test_animate_needs_an_animated_input_and_a_gif(fur_rk, tmp_path):
+def test_animate_needs_an_animated_input_and_an_animation_name(fur_rk, tmp_path):
     assert_one_line_error(run_cli("render", "demo:blob", "--animate", "2", "-o",
                                   tmp_path / "a.gif"), "no animation")
     assert_one_line_error(run_cli("render", fur_rk, "--animate", "2", "-o",
-                                  tmp_path / "a.png"), ".gif")
+                                  tmp_path / "a.jpg"), ".gif", ".webp")
     assert_one_line_error(run_cli("render", fur_rk, "--animate", "2", "--time", "0.5", "-o",
                                   tmp_path / "a.gif"), "--time")
 

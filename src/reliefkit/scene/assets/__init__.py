@@ -34,6 +34,7 @@ from .vehicle import vehicle
 
 __all__ = [
     "ASSET_NAMES",
+    "DEMO_NAMES",
     "SHAPE_NAMES",
     "SURFACE_NAMES",
     "all_assets",
@@ -53,6 +54,9 @@ SHAPE_NAMES = ("cup",)
 #: The textured demo surfaces `make_asset` also knows (see :mod:`.surfaces`).
 SURFACE_NAMES = tuple(SURFACES)
 
+#: Every name `make_asset` builds, which `demo:NAME` accepts.
+DEMO_NAMES = ASSET_NAMES + SHAPE_NAMES + SURFACE_NAMES
+
 _FACTORIES: dict[str, Callable[[], RenderMesh]] = {
     "terrain": terrain,
     "blob": blob,
@@ -63,8 +67,8 @@ _FACTORIES: dict[str, Callable[[], RenderMesh]] = {
 
 
 def make_asset(name: str) -> RenderMesh:
-    """The demo asset or surface called `name` (one of `ASSET_NAMES` or `SURFACE_NAMES`)
-    with its default parameters.
+    """The demo asset, shape or surface called `name` (one of `DEMO_NAMES`) with its
+    default parameters.
 
     Raises
     ------

@@ -52,10 +52,10 @@ def _wrong_hits(frame, rep, camera):
              "wrong_pixels": wrong["wrong_pixels"]}, wrong["wrong"])
 
 
-def _bench(quick, out, log):
+def _bench(quick, out, log, mesh=None):
     from .bench import run_suite
 
-    return run_suite(quick, out, log)
+    return run_suite(quick, out, log, mesh=mesh)
 
 
 def _bench_sampling(quick, out, log):
@@ -115,7 +115,7 @@ TECHNIQUE = Technique(
     compare_metrics=(CompareMetric("wrong hits", _wrong_hits,
                                    ("wrong_hit_fraction", "wrong_pixels")),),
     bench_suites=(BenchSuite("relief", "Table 1, Fig. 12 and correctness of relief textures",
-                             _bench),
+                             _bench, takes_mesh=True),
                   BenchSuite("relief-sampling", "safety radii: sampling vs time vs the "
                              "checker's violating rays", _bench_sampling)),
     demo_tiles=_demo_tiles,

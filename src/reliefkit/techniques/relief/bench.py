@@ -9,7 +9,7 @@ from the instrumented shader variant and do not depend on the machine.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +35,11 @@ class BenchConfig:
     correctness_views: tuple = ((30, 45), (120, 20), (200, 10), (300, 5), (60, -30))
     correctness_size: tuple = (400, 300)
     tolerance: float = DEFAULT_TOLERANCE
+    tolerance_model: str = "terrain"
+    # the orthographic reliefs, then a reverse frustum and a cube of six (their projective
+    # h is where a tolerance in h units went wrong; relief.md)
+    correctness_models: tuple = (("terrain", ""), ("blob", ""), ("vehicle", ""),
+                                 ("vehicle", " frustum"), ("blob", " cube"))
 
     @classmethod
     def quick(cls) -> BenchConfig:
@@ -42,6 +47,25 @@ class BenchConfig:
                    repeats=1, tolerances=(0.0, 0.01, 0.05), tolerance_res=64,
                    correctness_res=64, correctness_views=((30, 45), (200, 10)),
                    correctness_size=(160, 120))
+
+    def on_mesh(self, mesh: str) -> BenchConfig:
+        """The same measurements of a mesh file (``bench relief --mesh FILE``) instead of
+        the demo assets: its relief, reverse frustum and cube."""
+        return replace(self, models=(mesh,), tolerance_model=mesh,
+                       correctness_models=((mesh, ""), (mesh, " frustum"), (mesh, " cube")))
+
+
+def load_model(name: str):
+    """A demo asset by name, or a mesh file (``--mesh``)."""
+    from ...scene.assets import DEMO_NAMES, make_asset
+    from ...scene.loader import load_mesh
+
+    return make_asset(name) if name in DEMO_NAMES else load_mesh(name)
+
+
+def model_label(name: str) -> str:
+    """A model's name in the tables: the demo asset's, or the mesh file's name."""
+    return Path(name).name
 
 
 def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
@@ -66,7 +90,6 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
     from ...bench.timing import time_render, time_renders
     from ...io.rk import array_bytes
     from ...render import render
-    from ...scene.assets import make_asset
     from .bake import bake_relief
     from .cone import relaxed_cone_ratios
     from .maxmip import max_pyramid
@@ -76,7 +99,7 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
     relaxed_cone_ratios(np.eye(8, dtype=np.float32))
     rows = []
     for name in cfg.models:
-        mesh = make_asset(name)
+        mesh = load_model(name)
         camera = fit_camera(mesh.bounds, cfg.size)
         mesh_ms = time_render(mesh, camera, repeats=cfg.repeats)["wall_ms"]
         for res in cfg.resolutions:
@@ -91,7 +114,7 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
             pyramid_gpu_ms = gpu_pyramid_ms(relief.height)
             start = time.perf_counter()
             relaxed_cone_ratios(relief.height)
-            row = {"model": name, "res": res, "mesh_ms": mesh_ms,
+            row = {"model": model_label(name), "res": res, "mesh_ms": mesh_ms,
                    "triangles": mesh.triangle_count, "safety_s": safety_s,
                    "pyramid_s": pyramid_s, "pyramid_gpu_ms": pyramid_gpu_ms,
                    "cone_s": time.perf_counter() - start,
@@ -113,7 +136,7 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
                 row[f"{key}_it_max"] = stats["iterations_max"]
                 row["fragments"] = stats["fragments"]
             rows.append(row)
-            log(f"table 1: {name} {res}^2: " + ", ".join(
+            log(f"table 1: {model_label(name)} {res}^2: " + ", ".join(
                 f"{m} {row[m + '_ms']:.0f} ms / {row[m + '_it_mean']:.1f} it" for m in METHODS))
     return rows
 
@@ -147,12 +170,11 @@ def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
     """Fig. 12: tolerance vs mean radius vs iterations vs silhouette (wrong-hit) error."""
     from ...bench.timing import time_render
     from ...render import render
-    from ...scene.assets import make_asset
     from .bake import bake_relief
     from .reference import wrong_hits
     from .safety import safety_radii
 
-    mesh = make_asset("terrain")
+    mesh = load_model(cfg.tolerance_model)
     relief = bake_relief(mesh, depth_res=cfg.tolerance_res, safety=False)
     camera = fit_camera(mesh.bounds, cfg.correctness_size, elevation=20.0)
     rows = []
@@ -183,7 +205,6 @@ def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
 def correctness(cfg: BenchConfig, log) -> list[dict]:
     """Wrong-hit fraction of each method against the exact reference, grazing views too."""
     from ...render import render
-    from ...scene.assets import make_asset
     from ...scene.views import orbit_bounds
     from .bake import bake_relief
     from .frustum import bake_relief_cube, bake_relief_frustum
@@ -192,13 +213,12 @@ def correctness(cfg: BenchConfig, log) -> list[dict]:
     rows = []
     # the orthographic reliefs, then a reverse frustum and a cube of six (their projective
     # h is where a tolerance in h units went wrong; relief.md)
-    bakers = (("terrain", "", bake_relief), ("blob", "", bake_relief),
-              ("vehicle", "", bake_relief), ("vehicle", " frustum", bake_relief_frustum),
-              ("blob", " cube", bake_relief_cube))
-    for name, kind, baker in bakers:
-        mesh = make_asset(name)
-        relief = baker(mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance,
-                       safety=True)  # robust_jump reads them at every size
+    bakers = {"": bake_relief, " frustum": bake_relief_frustum, " cube": bake_relief_cube}
+    for name, kind in cfg.correctness_models:
+        mesh = load_model(name)
+        relief = bakers[kind](mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance,
+                              safety=True)  # robust_jump reads them at every size
+        name = model_label(name)
         for az, el in cfg.correctness_views:
             camera = orbit_bounds(relief.bounds, az, el, 2.2, cfg.correctness_size)
             row = {"model": name + kind, "azimuth": az, "elevation": el}
@@ -407,8 +427,11 @@ def write(results: dict, out: Path) -> list[Path]:
     return paths
 
 
-def run_suite(quick: bool, out: Path, log) -> tuple[str, list[Path]]:
-    """The ``relief`` bench suite: run, write json/md/png into ``out``, return the markdown."""
+def run_suite(quick: bool, out: Path, log, mesh: str | None = None) -> tuple[str, list[Path]]:
+    """The ``relief`` bench suite: run, write json/md/png into ``out``, return the markdown;
+    with ``mesh`` on that mesh file instead of the demo assets."""
     cfg = BenchConfig.quick() if quick else BenchConfig()
+    if mesh is not None:
+        cfg = cfg.on_mesh(mesh)
     results = run(cfg, log=log)
     return markdown(results), write(results, out)

@@ -30,6 +30,7 @@ from ...gl.shaders import program
 from ...gl.targets import use_transparent_blending
 from ...gl.textures import read_depth, read_rgba, texture2d, texture3d, texture_array
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
+from ...render.shadows import light_camera
 from .filtering import mip_pyramid, naive_pyramid
 from .order import METHODS, visibility_order
 from .representation import TET_TEXELS, TETS_PER_ROW, TexturedShell
@@ -141,19 +142,6 @@ def texture_levels(texture, thickness: float) -> list[tuple[np.ndarray, np.ndarr
         marched = marched_volume(rgba, texture.length, thickness)
         out.append((marched, np.concatenate([normal, g[..., :1]], axis=-1).astype(np.float32)))
     return out
-
-
-def light_camera(bounds, light, size: int = SHADOW_SIZE):
-    """An orthographic camera looking along the light over ``bounds`` (its shadow map)."""
-    from ...scene.camera import Camera
-
-    lo, hi = np.asarray(bounds, np.float64)
-    centre, radius = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo)) or 1.0
-    towards = np.asarray(light.direction, np.float64)
-    towards = towards / np.linalg.norm(towards)
-    up = (1.0, 0.0, 0.0) if abs(towards[1]) > 0.99 else (0.0, 1.0, 0.0)
-    return Camera(eye=tuple(centre + 2.0 * radius * towards), target=tuple(centre), up=up,
-                  size=(size, size), near=0.5 * radius, far=3.5 * radius, ortho_height=radius)
 
 
 class TexturedShellDrawable(GLObjects):
