@@ -300,3 +300,56 @@ def test_python_warnings_become_one_warning_line(capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err[0] == "warning: a big texture" and len(err) == 2, err
     assert err[1].startswith("warning: Image size (200000000 pixels)"), err
+
+
+# ------------------------------------------------------------------ 7. signals at any moment
+
+SIGNAL_OUTCOMES = {"SIGINT": (130, "error: interrupted"),
+                   "SIGTERM": (143, "error: terminated (SIGTERM)")}
+
+
+@pytest.mark.parametrize("name", sorted(SIGNAL_OUTCOMES))
+@pytest.mark.parametrize("delay", [0.2, 0.7, 1.5, 3.0])
+def test_a_signal_at_any_moment_is_one_line_and_no_output(tmp_path, name, delay):
+    """Delays fall in the interpreter's imports (the first ~2 s), the parser's and the bake:
+    each ends in the documented line and exit status, with no file left."""
+    import signal
+    import time
+
+    out = tmp_path / "t.rk"
+    proc = subprocess.Popen([sys.executable, "-m", "reliefkit.cli", "bake", "demo:terrain",
+                             "--as", "relief", "--depth-res", "512", "-o", out],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    proc.send_signal(getattr(signal, name))
+    _, err = proc.communicate(timeout=300)
+    code, line = SIGNAL_OUTCOMES[name]
+    assert proc.returncode == code, err
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(line), err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_interrupt_swallowed_by_a_dependency_still_stops_the_command(tmp_path, capsys,
+                                                                        monkeypatch):
+    """trimesh imports optional modules under ``except BaseException``: a Ctrl-C raised
+    there is swallowed, yet the command must not go on to write its output."""
+    import contextlib
+    import importlib
+    import signal
+
+    bake_module = importlib.import_module("reliefkit.bake")
+    real_bake = bake_module.bake
+
+    def bake_under_a_guard(*args, **kwargs):
+        with contextlib.suppress(BaseException):  # what an import guard does
+            os.kill(os.getpid(), signal.SIGINT)
+        return real_bake(*args, **kwargs)
+
+    monkeypatch.setattr(bake_module, "bake", bake_under_a_guard)
+    out = tmp_path / "h.rk"
+    status = cli.main(["bake", "demo:blob", "--as", "relief", "--depth-res", "16",
+                       "--no-safety", "-o", str(out)])
+    assert status == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "error: interrupted"
+    assert list(tmp_path.iterdir()) == []

@@ -12,6 +12,8 @@ import contextlib
 import sys
 import time
 
+from .interrupts import raise_pending
+
 PLAIN_INTERVAL = 5.0  # seconds between two plain progress lines
 
 
@@ -23,17 +25,27 @@ def _is_terminal(stream) -> bool:
 @contextlib.contextmanager
 def progress_bar(description: str, total: int, *, enabled: bool = True, stream=None,
                  interval: float = PLAIN_INTERVAL):
-    """Yield ``advance(done, total=None)``, the callback long loops (and bakers) call."""
+    """Yield ``advance(done, total=None)``, the callback long loops (and bakers) call; each
+    call also stops the work if Ctrl-C or SIGTERM came and was swallowed (`interrupts`)."""
     stream = stream if stream is not None else sys.stderr
     if not enabled:
-        yield lambda done, total_=None: None
+        yield _checked(lambda done, total_=None: None)
     elif _is_terminal(stream):
         with _rich_bar(description, total, stream) as advance:
-            yield advance
+            yield _checked(advance)
     else:
         lines = _PlainLines(description, total, stream, interval)
-        yield lines.advance
+        yield _checked(lines.advance)
         lines.finish()
+
+
+def _checked(advance):
+    """``advance`` that first raises a pending interruption."""
+    def checked(done: int, total: int | None = None) -> None:
+        raise_pending()
+        advance(done, total)
+
+    return checked
 
 
 @contextlib.contextmanager

@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import UsageError
+from ..interrupts import raise_pending
 
 TEMP_NAME_BYTES = 40  # of the destination's name in the temporary file's (then 8 random + .tmp)
 TEMP_SUFFIX = ".tmp"
@@ -82,10 +83,10 @@ def atomic_path(path, *, error: type = UsageError):
     """Yield a temporary path beside ``path``; on success fsync it, move it into place and
     fsync the folder so the rename survives a crash.
 
-    On any exception (also KeyboardInterrupt and the CLI's SIGTERM) the temporary file is
-    removed and an existing ``path`` stays intact; an OSError (disk full, file too large, a
-    directory in the way) becomes ``error`` (a ReliefkitError subclass) with a one-line
-    message naming ``path``.
+    On any exception (also KeyboardInterrupt and the CLI's SIGTERM, even one a dependency
+    swallowed: `interrupts.raise_pending`) the temporary file is removed and an existing
+    ``path`` stays intact; an OSError (disk full, file too large, a directory in the way)
+    becomes ``error`` (a ReliefkitError subclass) with a one-line message naming ``path``.
     """
     dest = Path(path)
     folder = dest.parent if str(dest.parent) else Path(".")
@@ -100,6 +101,7 @@ def atomic_path(path, *, error: type = UsageError):
     os.close(fd)
     try:
         yield Path(tmp)
+        raise_pending()  # interrupted, though something swallowed it: commit nothing
         with open(tmp, "rb+") as handle:
             os.fsync(handle.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give outputs the usual mode
