@@ -124,7 +124,8 @@ def test_camera_framing_refuses_non_finite_bounds():
 @pytest.mark.parametrize("flag, name", [("--aovs", "missing/a.npz"), ("--aovs", "adir.npz"),
                                         ("--stats", "missing/s.json"),
                                         ("--stats", "adir.json"), ("-o", "missing/x.png"),
-                                        ("-o", "adir.png")])
+                                        ("-o", "adir.png"), ("-o", "x.png/"),
+                                        ("--aovs", "a.npz/"), ("--stats", "s.json/")])
 def test_a_bad_output_path_is_refused_before_rendering(tmp_path, flag, name):
     (tmp_path / "adir.npz").mkdir()
     (tmp_path / "adir.json").mkdir()
@@ -159,6 +160,12 @@ def test_a_read_only_folder_is_refused_before_rendering(tmp_path, monkeypatch, c
     status = cli.main(["bake", "demo:blob", "-o", str(locked / "b.rk")])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "not writable" in err[0]
+
+
+def test_a_bake_output_with_a_trailing_slash_is_refused(tmp_path):
+    result = run_cli("bake", "demo:blob", "--as", "relief", "-o", "b.rk/", cwd=tmp_path)
+    assert_one_line_error(result, "b.rk/", "names a folder", code=2)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_compare_out_that_is_a_file_is_refused_before_the_bake(tmp_path):

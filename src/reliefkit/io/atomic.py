@@ -48,7 +48,8 @@ def check_writable(path, flag: str | None = None, *, folder: bool = False,
                    error: type = UsageError) -> Path:
     """Refuse, before any work, an output that cannot be written: a missing or read-only
     folder, or a destination that is a directory (for ``folder=True``: a destination that
-    exists and is no directory, or whose nearest existing ancestor is not writable).
+    exists and is no directory, or whose nearest existing ancestor is not writable). A file
+    name ending in ``/`` is refused: pathlib would drop the slash and write ``x.png``.
 
     ``flag`` names the option in the message (``--aovs x/y.npz: the folder x does not
     exist``). Returns the path.
@@ -66,6 +67,9 @@ def check_writable(path, flag: str | None = None, *, folder: bool = False,
         if dest.exists():
             parent = dest
     else:
+        if str(path).endswith(tuple(filter(None, (os.sep, os.altsep)))):
+            raise error(f"{flag + ' ' if flag else ''}{path}: a trailing "
+                        f"'{str(path)[-1]}' names a folder; name a file")
         if dest.is_dir():
             raise error(f"{label}: is a directory; name a file")
         parent = dest.parent if str(dest.parent) else Path(".")
