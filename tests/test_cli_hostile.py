@@ -360,3 +360,23 @@ def test_an_interrupt_swallowed_by_a_dependency_still_stops_the_command(tmp_path
     assert status == 130
     assert capsys.readouterr().err.strip().splitlines()[-1] == "error: interrupted"
     assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ 8. exit statuses
+
+@pytest.mark.parametrize("args, code", [
+    (["render", "missing.obj", "-o", "x.png"], 1),
+    (["render", "demo:nope", "-o", "x.png"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "missing.npy", "-o",
+      "x.rk"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "missing.obj", "-o",
+      "x.rk"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "demo:nope", "-o",
+      "x.rk"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "furr", "-o", "x.rk"], 2),
+    (["render", "demo:blob", "--view", "1,2,3,4", "-o", "x.png"], 2),
+])
+def test_exit_statuses_follow_the_table(tmp_path, args, code):
+    """docs/cli.md: 1 for a missing input, whichever flag names it; 2 for a bad value."""
+    assert_one_line_error(run_cli(*args, cwd=tmp_path), code=code)
+    assert list(tmp_path.iterdir()) == []

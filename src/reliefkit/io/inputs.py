@@ -10,9 +10,13 @@ DEMO_PREFIX = "demo:"
 def load_input(spec: str):
     """``demo:NAME`` -> a procedural RenderMesh, ``*.rk`` -> its representation, else a mesh."""
     if spec.startswith(DEMO_PREFIX):
+        from ..errors import MeshError, UsageError
         from ..scene.assets import make_asset
 
-        return make_asset(spec[len(DEMO_PREFIX):])
+        try:
+            return make_asset(spec[len(DEMO_PREFIX):])
+        except UsageError as exc:  # an unknown name: a missing input (exit 1), not a bad flag
+            raise MeshError(f"{spec}: {exc}") from None
     if Path(spec).suffix.lower() == ".rk":
         from .rk import load
 
