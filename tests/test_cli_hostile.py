@@ -380,3 +380,36 @@ def test_exit_statuses_follow_the_table(tmp_path, args, code):
     """docs/cli.md: 1 for a missing input, whichever flag names it; 2 for a bad value."""
     assert_one_line_error(run_cli(*args, cwd=tmp_path), code=code)
     assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ 9. forged values out
+
+def _with_manifest(path, out, edit):
+    """A copy of the .rk ``path`` whose manifest text went through ``edit``."""
+    import zipfile
+
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(out, "w") as dst:
+        for info in src.infolist():
+            data = src.read(info)
+            if info.filename == "manifest.json":
+                data = edit(data.decode()).encode()
+            dst.writestr(info, data)
+    return out
+
+
+def test_info_json_is_strict_json_for_forged_non_finite_params(small_rk, tmp_path):
+    def add_params(text):
+        manifest = json.loads(text)
+        manifest["params"].update(forged_nan="@NaN", forged_inf=["@Infinity", 1.5])
+        return json.dumps(manifest).replace('"@NaN"', "NaN").replace('"@Infinity"',
+                                                                     "-Infinity")
+
+    forged = _with_manifest(small_rk, tmp_path / "nan.rk", add_params)
+    result = run_cli("info", "--json", forged)
+    assert result.returncode == 0, result.stderr
+
+    def refuse(constant):
+        raise ValueError(f"not JSON: {constant}")
+
+    params = json.loads(result.stdout, parse_constant=refuse)["file"]["params"]
+    assert params["forged_nan"] is None and params["forged_inf"] == [None, 1.5]

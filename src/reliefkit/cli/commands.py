@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -296,11 +297,23 @@ def cmd_info(args) -> int:
     if args.file:
         report["file"] = _describe_file(args.file)
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json.dumps(_finite_or_null(report), indent=2, allow_nan=False))
     else:
         for section in report.values():
             _print_section(section)
     return 0
+
+
+def _finite_or_null(value):
+    """``value`` with every NaN and infinity as None: strict JSON has no such numbers (a
+    forged file's params may hold them)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: _finite_or_null(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_or_null(item) for item in value]
+    return value
 
 
 def _print_section(section: dict) -> None:
