@@ -413,3 +413,68 @@ def test_info_json_is_strict_json_for_forged_non_finite_params(small_rk, tmp_pat
 
     params = json.loads(result.stdout, parse_constant=refuse)["file"]["params"]
     assert params["forged_nan"] is None and params["forged_inf"] == [None, 1.5]
+
+
+# ------------------------------------------------------------------ 10. sequences
+
+def test_a_gif_is_written_frame_by_frame(tmp_path):
+    """Each frame is encoded and released before the next is drawn (a 1,000-view turntable
+    at 2048x2048 needs one frame's memory), and decodes to exactly what was given."""
+    import weakref
+
+    from PIL import Image
+
+    from reliefkit.pictures import save_gif
+
+    rng = np.random.default_rng(1)
+    palette = rng.integers(0, 256, (200, 3), dtype=np.uint8)  # few colours: exact in a GIF
+    given, alive = [], []
+
+    def frame(k):
+        assert not any(ref() is not None for ref in alive), f"a frame before {k} is kept"
+        rgba = np.full((24, 32, 4), 255, np.uint8)
+        rgba[..., :3] = palette[rng.integers(0, 200, (24, 32))]
+        given.append(rgba[..., :3].copy())
+        alive.append(weakref.ref(rgba))
+        return rgba
+
+    def frames():
+        for k in range(5):
+            yield frame(k)
+
+    assert save_gif(frames(), tmp_path / "a.gif") == 5
+    with Image.open(tmp_path / "a.gif") as gif:
+        assert gif.n_frames == 5 and gif.info["loop"] == 0
+        for k, expected in enumerate(given):
+            gif.seek(k)
+            np.testing.assert_array_equal(np.asarray(gif.convert("RGB")), expected)
+
+
+@pytest.mark.parametrize("flag", ["--turntable", "--animate"])
+def test_sequence_lengths_follow_the_docs(tmp_path, flag):
+    result = run_cli("render", "demo:blob", flag, "3601", "-o", tmp_path / "s.gif")
+    assert_one_line_error(result, flag, "1..3600", code=2)
+
+
+@pytest.mark.parametrize("sequence", [["demo:blob", "--turntable", "6"],
+                                      ["demo:sphere:shell", "--animate", "6"]])
+def test_a_gif_over_the_file_size_limit_is_one_line(tmp_path, sequence):
+    resource = pytest.importorskip("resource")
+    if sequence[0] == "demo:sphere:shell":
+        shell = tmp_path / "s.rk"
+        baked = run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture-size",
+                        "8,8,4", "-o", shell)
+        assert baked.returncode == 0, baked.stderr
+        sequence = [shell, *sequence[1:]]
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8 * 1024, 8 * 1024))
+
+    out = tmp_path / "out"
+    out.mkdir()
+    result = run_cli("render", *sequence, "--size", "96x96", "-o", "x.gif", cwd=out,
+                     preexec_fn=limit, env={**os.environ, "MESA_SHADER_CACHE_DISABLE": "true"})
+    result.stderr = "".join(line for line in result.stderr.splitlines(keepends=True)
+                            if not line.startswith(("turntable: ", "animate: ")))  # progress
+    assert_one_line_error(result, "x.gif", "File too large", code=2)
+    assert os.listdir(out) == []

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 from .errors import UsageError
@@ -54,13 +56,34 @@ def save_image(image, path) -> None:
         image.save(tmp, format=_format_of(path))
 
 
-def save_gif(frames: list[np.ndarray], path, fps: float = 15.0) -> None:
-    """Write RGBA uint8 frames as a looping animated GIF, atomically."""
-    import imageio.v3 as iio
+def save_gif(frames: Iterable[np.ndarray], path, fps: float = 15.0) -> int:
+    """Write RGBA uint8 frames as a looping animated GIF, atomically; returns their count.
 
-    rgb = [np.ascontiguousarray(f[..., :3]) for f in frames]
-    with atomic_path(path) as tmp:
-        iio.imwrite(tmp, rgb, extension=".gif", duration=1000.0 / fps, loop=0)
+    Frames are encoded as they come (each with its own 256-colour palette) and dropped, so an
+    iterator of 3,600 views at 2048x2048 needs one frame's memory, not 45 GB.
+    """
+    from PIL import GifImagePlugin
+
+    count = 0
+    with atomic_path(path) as tmp, open(tmp, "wb") as out:
+        for image in map(_gif_frame, frames):  # holds no frame while the next is made
+            if count == 0:
+                header, _ = GifImagePlugin.getheader(image, info={"loop": 0})
+                out.write(b"".join(header))
+            out.writelines(GifImagePlugin.getdata(image, duration=1000.0 / fps,
+                                                  include_color_table=True))
+            count += 1
+        if count == 0:
+            raise UsageError(f"{path}: a GIF needs at least one frame")
+        out.write(b";")  # the GIF trailer
+    return count
+
+
+def _gif_frame(rgba: np.ndarray):
+    """One frame as a PIL image of at most 256 colours (median cut)."""
+    from PIL import Image
+
+    return Image.fromarray(np.ascontiguousarray(rgba[..., :3])).quantize(256)
 
 
 def _format_of(path) -> str:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import sys
@@ -9,6 +10,8 @@ from pathlib import Path
 
 from ..errors import FormatError, UsageError
 from .options import applicable, given_options
+
+MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
 
 
 def _check_not_empty(spec: str) -> None:
@@ -158,8 +161,8 @@ def _check_render_outputs(args) -> None:
         "--animate" if args.animate is not None else None
     if sequence:
         count = args.turntable if args.turntable is not None else args.animate
-        if not 1 <= count <= 1000:
-            raise UsageError(f"{sequence} takes 1..1000 frames, got {count}")
+        if not 1 <= count <= MAX_FRAMES:
+            raise UsageError(f"{sequence} takes 1..{MAX_FRAMES} frames, got {count}")
         if suffix != ".gif":
             raise UsageError(f"{sequence} writes an animated .gif: name the output *.gif")
         given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
@@ -183,33 +186,22 @@ def _check_render_outputs(args) -> None:
 
 def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
     """``args.turntable`` views of ``draw(camera)`` into a GIF, warning about empty views."""
-    from ..pictures import TILE_BACKGROUND, save_gif
-    from ..progress import progress_bar
     from ..scene.views import turntable
 
     cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
-    frames, empty = [], []
-    with progress_bar("turntable", len(cameras)) as advance:
-        for k, camera in enumerate(cameras):
-            frame = draw(camera)
-            if frame.stats["covered"] == 0:
-                empty.append(str(k + 1))
-            frames.append(frame.rgba8(background or TILE_BACKGROUND))
-            advance(k + 1)
-    save_gif(frames, args.output)
-    print(f"wrote {args.output} ({len(frames)} views)")
+    empty = _stream_gif(args.output, "turntable", map(draw, cameras), len(cameras),
+                        background)
+    print(f"wrote {args.output} ({len(cameras)} views)")
     if empty:
         many = len(empty) > 1
-        _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
-                              f"cover{'' if many else 's'}")
+        _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of "
+                              f"{len(cameras)} cover{'' if many else 's'}")
     return 0
 
 
 def _render_animation(args, obj, camera, draw, background) -> int:
     """``args.animate`` frames of ``obj``'s animation (its ``time`` render option) into a GIF."""
     from ..core.params import ANIMATION_TIME
-    from ..pictures import TILE_BACKGROUND, save_gif
-    from ..progress import progress_bar
     from ..render import render_options
 
     if ANIMATION_TIME not in {opt.name for opt in render_options(obj)}:
@@ -217,15 +209,30 @@ def _render_animation(args, obj, camera, draw, background) -> int:
                          "(no --time option); use --turntable for views around it")
     if given_options(args).get(ANIMATION_TIME) is not None:
         raise UsageError("--animate sets the time of each frame itself: leave out --time")
-    frames = []
-    with progress_bar("animate", args.animate) as advance:
-        for k in range(args.animate):
-            frames.append(draw(camera, **{ANIMATION_TIME: k / args.animate}).rgba8(
-                background or TILE_BACKGROUND))
-            advance(k + 1)
-    save_gif(frames, args.output)
-    print(f"wrote {args.output} ({len(frames)} frames)")
+    count = args.animate
+    frames = (draw(camera, **{ANIMATION_TIME: k / count}) for k in range(count))
+    _stream_gif(args.output, "animate", frames, count, background)
+    print(f"wrote {args.output} ({count} frames)")
     return 0
+
+
+def _stream_gif(path, description: str, frames, count: int, background) -> list[str]:
+    """Draw ``frames`` (an iterator of ``count`` Frames) into the GIF at ``path`` one at a
+    time, with progress, so memory stays one frame's; returns the numbers (from 1) of the
+    frames that cover no pixel."""
+    from ..pictures import TILE_BACKGROUND, save_gif
+    from ..progress import progress_bar
+
+    empty = []
+    with progress_bar(description, count) as advance:
+        def picture(k: int, frame):
+            if frame.stats["covered"] == 0:
+                empty.append(str(k + 1))
+            advance(k + 1)
+            return frame.rgba8(background or TILE_BACKGROUND)
+
+        save_gif(itertools.starmap(picture, enumerate(frames)), path)
+    return empty
 
 
 def _write_stats(args, frame, counted) -> None:
