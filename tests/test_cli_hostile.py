@@ -478,3 +478,43 @@ def test_a_gif_over_the_file_size_limit_is_one_line(tmp_path, sequence):
                             if not line.startswith(("turntable: ", "animate: ")))  # progress
     assert_one_line_error(result, "x.gif", "File too large", code=2)
     assert os.listdir(out) == []
+
+
+# ------------------------------------------------------------------ 11. several outputs
+
+def _full_disk_for(monkeypatch, name: str):
+    """Writing the temporary file of the output ``name`` fails as on a full disk."""
+    import errno
+
+    real = Path.write_text
+
+    def write_text(self, *args, **kwargs):
+        if self.name.startswith(f".{name}."):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", write_text)
+
+
+def test_a_render_whose_stats_cannot_be_written_leaves_none_of_its_outputs(
+        gl, tmp_path, capsys, monkeypatch):
+    _full_disk_for(monkeypatch, "s.json")
+    status = cli.main(["render", "demo:blob", "--size", "16x16", "-o", str(tmp_path / "x.png"),
+                       "--aovs", str(tmp_path / "a.npz"), "--stats", str(tmp_path / "s.json")])
+    captured = capsys.readouterr()
+    assert status == 2 and "wrote" not in captured.out, captured
+    assert captured.err.strip().splitlines() == [
+        f"error: cannot write {tmp_path / 's.json'}: No space left on device; nothing was "
+        "written"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_compare_whose_json_cannot_be_written_leaves_none_of_its_files(
+        gl, tmp_path, capsys, monkeypatch):
+    _full_disk_for(monkeypatch, "metrics.json")
+    out = tmp_path / "c"
+    status = cli.main(["compare", "demo:blob", "--depth-res", "16", "--size", "16x16",
+                       "--out", str(out)])
+    assert status == 2, capsys.readouterr().err
+    assert "No space left" in capsys.readouterr().err
+    assert list(out.iterdir()) == []

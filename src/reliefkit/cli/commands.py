@@ -138,17 +138,27 @@ def cmd_render(args) -> int:
     if args.animate is not None:
         return _render_animation(args, obj, camera, draw, background)
     frame = draw(camera)
-    frame.save(args.output, background)
+    counted = draw(camera, msaa=1, count_iterations=True) if args.stats else None  # 1 sample
+    _write_render_outputs(args, frame, counted, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
     if frame.stats["covered"] == 0:
         _warn_nothing_visible("the render covers")
-    if args.aovs:
-        frame.save_aovs(args.aovs)
-        print(f"wrote {args.aovs}")
-    if args.stats:
-        counted = draw(camera, msaa=1, count_iterations=True)  # counters are single-sample
-        _write_stats(args, frame, counted)
+    for path in (args.aovs, args.stats):
+        if path:
+            print(f"wrote {path}")
     return 0
+
+
+def _write_render_outputs(args, frame, counted, background) -> None:
+    """The picture, --aovs and --stats: all of them or, if one cannot be written, none."""
+    from ..io.atomic import written_together
+
+    with written_together():
+        frame.save(args.output, background)
+        if args.aovs:
+            frame.save_aovs(args.aovs)
+        if args.stats:
+            _write_stats(args, frame, counted)
 
 
 def _check_render_outputs(args) -> None:
@@ -243,7 +253,6 @@ def _write_stats(args, frame, counted) -> None:
              **counted.stats, **frame.stats}
     with atomic_path(args.stats) as tmp:
         tmp.write_text(json.dumps(stats, indent=2) + "\n")
-    print(f"wrote {args.stats}")
 
 
 def cmd_compare(args) -> int:

@@ -9,6 +9,7 @@ destination, never the temporary file.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import os
 import tempfile
@@ -19,6 +20,9 @@ from ..interrupts import raise_pending
 
 TEMP_NAME_BYTES = 40  # of the destination's name in the temporary file's (then 8 random + .tmp)
 TEMP_SUFFIX = ".tmp"
+# inside `written_together`: the (temporary, destination) pairs waiting to be moved together
+_deferred: contextvars.ContextVar[list | None] = contextvars.ContextVar("deferred",
+                                                                       default=None)
 
 
 @functools.cache
@@ -109,6 +113,10 @@ def atomic_path(path, *, error: type = UsageError):
         with open(tmp, "rb+") as handle:
             os.fsync(handle.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give outputs the usual mode
+        group = _deferred.get()
+        if group is not None:  # moved into place with the others at the group's end
+            group.append((tmp, dest))
+            return
         os.replace(tmp, dest)
     except BaseException as exc:
         with contextlib.suppress(OSError):
@@ -118,6 +126,41 @@ def atomic_path(path, *, error: type = UsageError):
                         "written") from exc
         raise
     _fsync_folder(folder)
+
+
+@contextlib.contextmanager
+def written_together(*, error: type = UsageError):
+    """Every `atomic_path` inside the block writes its temporary file, and all of them are
+    moved into place at the block's end, or none (a failure or an interruption on the way
+    removes them all): a command with several outputs (an image, its AOVs and its stats)
+    never leaves some of them new and others missing or old."""
+    if _deferred.get() is not None:  # already in a group: join it
+        yield
+        return
+    group: list[tuple[str, Path]] = []
+    token = _deferred.set(group)
+    try:
+        yield
+        raise_pending()
+    except BaseException:
+        _remove(tmp for tmp, _ in group)
+        raise
+    finally:
+        _deferred.reset(token)
+    for k, (tmp, dest) in enumerate(group):
+        try:
+            os.replace(tmp, dest)
+        except OSError as exc:
+            _remove(tmp for tmp, _ in group[k:])
+            raise error(f"cannot write {dest}: {_reason(exc)}") from exc
+    for folder in {dest.parent for _, dest in group}:
+        _fsync_folder(folder)
+
+
+def _remove(paths) -> None:
+    for path in paths:
+        with contextlib.suppress(OSError):
+            os.unlink(path)
 
 
 def _fsync_folder(folder: Path) -> None:
