@@ -518,3 +518,51 @@ def test_a_compare_whose_json_cannot_be_written_leaves_none_of_its_files(
     assert status == 2, capsys.readouterr().err
     assert "No space left" in capsys.readouterr().err
     assert list(out.iterdir()) == []
+
+
+# ------------------------------------------------------------------ 12. sizes before inflating
+
+def test_an_array_over_its_kinds_limit_is_refused_before_inflating(tmp_path):
+    """A 300 KB displacement file declaring a 268 MB height field (one row over 8192 x 8192
+    texels, under the container's 4 GiB cap) is refused from its declared shape, having
+    allocated a few kilobytes; info says so in one line."""
+    import tracemalloc
+    import zipfile
+
+    from reliefkit.errors import FormatError
+    from reliefkit.io.rk import load, save
+    from reliefkit.scene.assets import make_asset
+    from reliefkit.techniques.slicing import DisplacementMap
+
+    small = tmp_path / "small.rk"
+    save(small, DisplacementMap(make_asset("plane"), np.ones((4, 4, 4), np.float32),
+                                np.zeros((4, 4), np.float32), 0.1))
+    shape = (8193, 8192)
+    forged = tmp_path / "forged.rk"
+    with zipfile.ZipFile(small) as src, \
+            zipfile.ZipFile(forged, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as dst:
+        for info in src.infolist():
+            data = src.read(info)
+            if info.filename == "manifest.json":
+                manifest = json.loads(data)
+                manifest["arrays"]["height"]["shape"] = list(shape)
+                dst.writestr(info, json.dumps(manifest))
+            elif info.filename != "height.npy":
+                dst.writestr(info, data)
+        with dst.open("height.npy", "w") as member:
+            np.lib.format.write_array_header_1_0(
+                member, {"descr": "<f4", "fortran_order": False, "shape": shape})
+            left = shape[0] * shape[1] * 4
+            while left:
+                member.write(bytes(min(left, 1 << 22)))
+                left -= min(left, 1 << 22)
+    assert forged.stat().st_size < 1 << 20
+    tracemalloc.start()
+    try:
+        with pytest.raises(FormatError, match="height.*at most 67,108,864"):
+            load(forged)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 4 << 20, peak
+    assert_one_line_error(run_cli("info", forged), "forged.rk", "at most", code=1)

@@ -87,6 +87,8 @@ class ArraySpec:
     required : whether every file of the kind must hold the array.
     finite : whether NaN and Inf are forbidden (checked on write and after reading).
     trailing : fixed trailing dimensions, ``None`` for a free one, e.g. ``(4, 4)``.
+    max_size : the most elements the kind accepts (its own limits, such as a texture's
+        texels), or None; checked on the declared shape, before any data is inflated.
     """
 
     dtypes: tuple[str, ...]
@@ -94,6 +96,7 @@ class ArraySpec:
     required: bool = True
     finite: bool = False
     trailing: tuple[int | None, ...] | None = None
+    max_size: int | None = None
 
 
 @dataclass(frozen=True)
@@ -249,6 +252,9 @@ def _check_array(kind: str, name: str, spec: ArraySpec, dtype: np.dtype, shape: 
     if not ok:
         raise FormatError(f"array '{name}' has shape {tuple(shape)}; kind '{kind}' expects "
                           f"{_expected_shape(spec)}")
+    if spec.max_size is not None and math.prod(shape) > spec.max_size:
+        raise FormatError(f"array '{name}' has shape {tuple(shape)}, {math.prod(shape):,} "
+                          f"elements; kind '{kind}' takes at most {spec.max_size:,}")
 
 
 def _check_array_set(codec: Codec, names: Iterable[str]) -> None:

@@ -14,16 +14,19 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FormatError, MeshError, UsageError
-from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
+from ...io.mesh_codec import BASE_MESH_ARRAYS, MAX_BASE_VERTICES, check_base_arrays
 from ...io.rk import ArraySpec, Codec
 from .representation import TexturedShell
 from .textures import MAX_VOXELS, VolumeTexture
 
 ARRAYS = BASE_MESH_ARRAYS | {
-    "thickness": ArraySpec(("float64",), ndim=1, finite=True),
-    "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True),
-    "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True),
-    "texture_glow": ArraySpec(("float32",), ndim=3, required=False, finite=True),
+    "thickness": ArraySpec(("float64",), ndim=1, finite=True, max_size=MAX_BASE_VERTICES),
+    "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True,
+                              max_size=4 * MAX_VOXELS),
+    "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True,
+                                max_size=3 * MAX_VOXELS),
+    "texture_glow": ArraySpec(("float32",), ndim=3, required=False, finite=True,
+                              max_size=MAX_VOXELS),
 }
 
 

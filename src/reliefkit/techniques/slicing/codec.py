@@ -15,11 +15,15 @@ from ...io.rk import ArraySpec, Codec
 from .depth_images import MAX_RESOLUTION, DepthImages, face_boxes
 from .representation import DepthObject, VisualHull
 
+_TEXELS = 6 * MAX_RESOLUTION**2  # six faces of N x N
 ARRAYS = {
-    "depth": ArraySpec(("float32",), ndim=3, trailing=(None, None), finite=True),
-    "mask": ArraySpec(("uint8",), ndim=3, trailing=(None, None)),
-    "color": ArraySpec(("float32",), ndim=4, trailing=(None, None, 4), finite=True),
-    "normal": ArraySpec(("float32",), ndim=4, trailing=(None, None, 3), finite=True),
+    "depth": ArraySpec(("float32",), ndim=3, trailing=(None, None), finite=True,
+                       max_size=_TEXELS),
+    "mask": ArraySpec(("uint8",), ndim=3, trailing=(None, None), max_size=_TEXELS),
+    "color": ArraySpec(("float32",), ndim=4, trailing=(None, None, 4), finite=True,
+                       max_size=4 * _TEXELS),
+    "normal": ArraySpec(("float32",), ndim=4, trailing=(None, None, 3), finite=True,
+                        max_size=3 * _TEXELS),
     "cube_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
 }
 

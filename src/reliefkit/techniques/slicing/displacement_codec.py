@@ -17,8 +17,9 @@ from ...io.rk import ArraySpec, Codec
 from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
 ARRAYS = BASE_MESH_ARRAYS | {
-    "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True),
-    "height": ArraySpec(("float32",), ndim=2, finite=True),
+    "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True,
+                       max_size=4 * MAX_TEXELS),
+    "height": ArraySpec(("float32",), ndim=2, finite=True, max_size=MAX_TEXELS),
 }
 OWN = ("scale", "tile", "wrap")
 
