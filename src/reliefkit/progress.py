@@ -3,13 +3,14 @@
 On a terminal this draws a rich bar. Anywhere else (a log file, a pipe, CI) a bar would be
 noise or nothing at all, so progress becomes plain lines such as ``demo: 3/8``: at most one
 every `PLAIN_INTERVAL` seconds, plus a final ``demo: 8/8, done in 12.3 s``. This module is the one
-place that decides; commands only call `progress_bar` or `activity`.
+place that decides; commands only call `progress_bar`, `activity` or `waiting`.
 """
 
 from __future__ import annotations
 
 import contextlib
 import sys
+import threading
 import time
 
 from .interrupts import raise_pending
@@ -71,6 +72,51 @@ def activity(description: str, *, stream=None):
 
         yield log
     print(f"{description}: done in {time.monotonic() - start:.1f} s", file=stream, flush=True)
+
+
+@contextlib.contextmanager
+def waiting(description: str, *, stream=None, after: float | None = None,
+            interval: float | None = None):
+    """For one long call that reports no steps (a single render): nothing if the block ends
+    within ``after`` seconds (default `PLAIN_INTERVAL`), so quick commands stay silent; then
+    the elapsed time, as a spinner on a terminal or a plain line every ``interval`` seconds
+    elsewhere (``render: 10 s``), and a final ``render: done in 46.0 s``. The time is shown
+    from a thread, so the call itself needs no callback."""
+    stream = stream if stream is not None else sys.stderr
+    after = PLAIN_INTERVAL if after is None else after
+    interval = PLAIN_INTERVAL if interval is None else interval
+    start = time.monotonic()
+    finished = threading.Event()
+    shown = threading.Event()
+
+    def elapsed() -> str:
+        return f"{description}: {time.monotonic() - start:.0f} s"
+
+    def show() -> None:
+        if finished.wait(after):
+            return
+        shown.set()
+        if _is_terminal(stream):
+            from rich.console import Console
+
+            with Console(file=stream).status(elapsed()) as status:
+                while not finished.wait(1.0):
+                    status.update(elapsed())
+            return
+        print(elapsed(), file=stream, flush=True)
+        while not finished.wait(interval):
+            print(elapsed(), file=stream, flush=True)
+
+    thread = threading.Thread(target=show, name=f"progress: {description}", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        finished.set()
+        thread.join()
+    if shown.is_set():
+        print(f"{description}: done in {time.monotonic() - start:.1f} s", file=stream,
+              flush=True)
 
 
 @contextlib.contextmanager

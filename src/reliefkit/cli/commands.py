@@ -137,8 +137,11 @@ def cmd_render(args) -> int:
     camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
     if args.animate is not None:
         return _render_animation(args, obj, camera, draw, background)
-    frame = draw(camera)
-    counted = draw(camera, msaa=1, count_iterations=True) if args.stats else None  # 1 sample
+    from ..progress import waiting
+
+    with waiting("render"):  # silent unless it takes long (a peeled shell: 46 s)
+        frame = draw(camera)
+        counted = draw(camera, msaa=1, count_iterations=True) if args.stats else None
     _write_render_outputs(args, frame, counted, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
     if frame.stats["covered"] == 0:
