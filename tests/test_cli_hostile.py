@@ -337,28 +337,38 @@ def test_a_signal_at_any_moment_is_one_line_and_no_output(tmp_path, name, delay)
     assert list(tmp_path.iterdir()) == []
 
 
-def test_an_interrupt_swallowed_by_a_dependency_still_stops_the_command(tmp_path, capsys,
-                                                                        monkeypatch):
-    """trimesh imports optional modules under ``except BaseException``: a Ctrl-C raised
-    there is swallowed, yet the command must not go on to write its output."""
-    import contextlib
+def _swallow(exc):
+    return None  # an import guard (trimesh's ``except BaseException``)
+
+
+def _wrap(exc):
+    raise RuntimeError("Error calling __set_name__") from exc  # what dataclasses does
+
+
+@pytest.mark.parametrize("library", [_swallow, _wrap])
+def test_an_interrupt_a_library_swallows_or_wraps_still_stops_the_command(
+        tmp_path, capsys, monkeypatch, library):
+    """A Ctrl-C that a library swallows, or turns into its own exception, must neither let
+    the command go on to write its output nor be reported as an internal error."""
     import importlib
     import signal
 
     bake_module = importlib.import_module("reliefkit.bake")
     real_bake = bake_module.bake
 
-    def bake_under_a_guard(*args, **kwargs):
-        with contextlib.suppress(BaseException):  # what an import guard does
+    def bake_inside_a_library(*args, **kwargs):
+        try:
             os.kill(os.getpid(), signal.SIGINT)
+        except BaseException as exc:
+            library(exc)
         return real_bake(*args, **kwargs)
 
-    monkeypatch.setattr(bake_module, "bake", bake_under_a_guard)
+    monkeypatch.setattr(bake_module, "bake", bake_inside_a_library)
     out = tmp_path / "h.rk"
     status = cli.main(["bake", "demo:blob", "--as", "relief", "--depth-res", "16",
                        "--no-safety", "-o", str(out)])
-    assert status == 130
-    assert capsys.readouterr().err.strip().splitlines()[-1] == "error: interrupted"
+    assert (status, capsys.readouterr().err.strip().splitlines()[-1]) == \
+        (130, "error: interrupted")
     assert list(tmp_path.iterdir()) == []
 
 

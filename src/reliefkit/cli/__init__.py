@@ -42,13 +42,28 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_TERMINATED
 
 
-def _parse_and_run(argv: list[str] | None) -> int:
-    from .parser import build_parser
+def run() -> None:
+    """The console script and ``python -m reliefkit.cli``: `main`, then exit. After Ctrl-C or
+    SIGTERM it exits at once (the interpreter would report a KeyboardInterrupt a library
+    once saw as a death by SIGINT, and finalizers could still print)."""
+    status = main()
+    if status in (EXIT_INTERRUPTED, EXIT_TERMINATED):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)
 
+
+def _parse_and_run(argv: list[str] | None) -> int:
     try:
+        from .parser import build_parser
+
         parser = build_parser()
-    except ReliefkitError as exc:  # a technique failed to register
-        print(f"error: {exc}", file=sys.stderr)
+    except Exception as exc:
+        raise_pending()  # a signal a library turned into its own error (a RuntimeError)
+        if not isinstance(exc, ReliefkitError):
+            raise
+        print(f"error: {exc}", file=sys.stderr)  # a technique failed to register
         return EXIT_INPUT
     raise_pending()  # a signal an import guard swallowed
     args = parser.parse_args(argv)
@@ -95,6 +110,7 @@ def _run(args) -> int:
         print(f"error: cannot access{name}: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_INPUT
     except Exception as exc:  # a bug, not bad input: still one line, details on request
+        raise_pending()  # ... unless a library turned Ctrl-C or SIGTERM into this error
         if os.environ.get("RELIEFKIT_DEBUG"):
             raise
         print(f"error: internal error ({type(exc).__name__}: {exc}); "
@@ -114,5 +130,5 @@ def _broken_pipe() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run()
 
