@@ -16,6 +16,7 @@ import time
 from .interrupts import raise_pending
 
 PLAIN_INTERVAL = 5.0  # seconds between two plain progress lines
+QUIET_WAIT = 10.0     # seconds a call without steps (a render) runs before `waiting` shows it
 
 
 def _is_terminal(stream) -> bool:
@@ -78,12 +79,12 @@ def activity(description: str, *, stream=None):
 def waiting(description: str, *, stream=None, after: float | None = None,
             interval: float | None = None):
     """For one long call that reports no steps (a single render): nothing if the block ends
-    within ``after`` seconds (default `PLAIN_INTERVAL`), so quick commands stay silent; then
+    within ``after`` seconds (default `QUIET_WAIT`), so quick commands stay silent; then
     the elapsed time, as a spinner on a terminal or a plain line every ``interval`` seconds
     elsewhere (``render: 10 s``), and a final ``render: done in 46.0 s``. The time is shown
     from a thread, so the call itself needs no callback."""
     stream = stream if stream is not None else sys.stderr
-    after = PLAIN_INTERVAL if after is None else after
+    after = QUIET_WAIT if after is None else after
     interval = PLAIN_INTERVAL if interval is None else interval
     start = time.monotonic()
     finished = threading.Event()
