@@ -546,12 +546,36 @@ def test_a_compare_whose_json_cannot_be_written_leaves_none_of_its_files(
 
 # ------------------------------------------------------------------ 12. sizes before inflating
 
-def test_an_array_over_its_kinds_limit_is_refused_before_inflating(tmp_path):
-    """A 300 KB displacement file declaring a 268 MB height field (one row over 8192 x 8192
-    texels, under the container's 4 GiB cap) is refused from its declared shape, having
-    allocated a few kilobytes; info says so in one line."""
-    import tracemalloc
+def _forge_shape(small, out, name: str, shape: tuple) -> Path:
+    """A copy of the .rk ``small`` whose array ``name`` declares ``shape`` (zeros, deflated
+    level 9 as they stream: a few hundred KB for hundreds of MB)."""
     import zipfile
+
+    with zipfile.ZipFile(small) as src, \
+            zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as dst:
+        manifest = json.loads(src.read("manifest.json"))
+        dtype = np.dtype(manifest["arrays"][name]["dtype"])
+        manifest["arrays"][name]["shape"] = list(shape)
+        for info in src.infolist():
+            if info.filename == "manifest.json":
+                dst.writestr(info, json.dumps(manifest))
+            elif info.filename != f"{name}.npy":
+                dst.writestr(info, src.read(info))
+        with dst.open(f"{name}.npy", "w") as member:
+            np.lib.format.write_array_header_1_0(
+                member, {"descr": dtype.str, "fortran_order": False, "shape": shape})
+            left = int(np.prod(shape)) * dtype.itemsize
+            while left:
+                member.write(bytes(min(left, 1 << 22)))
+                left -= min(left, 1 << 22)
+    return out
+
+
+def test_an_array_over_its_kinds_limit_is_refused_before_inflating(tmp_path):
+    """A 0.3 MB displacement file declaring a 268 MB height field (one row over 8192 x 8192
+    texels, under the container's 4 GiB cap) is refused from its declared shape, having
+    allocated a few megabytes; info says so in one line."""
+    import tracemalloc
 
     from reliefkit.errors import FormatError
     from reliefkit.io.rk import load, save
@@ -561,25 +585,7 @@ def test_an_array_over_its_kinds_limit_is_refused_before_inflating(tmp_path):
     small = tmp_path / "small.rk"
     save(small, DisplacementMap(make_asset("plane"), np.ones((4, 4, 4), np.float32),
                                 np.zeros((4, 4), np.float32), 0.1))
-    shape = (8193, 8192)
-    forged = tmp_path / "forged.rk"
-    with zipfile.ZipFile(small) as src, \
-            zipfile.ZipFile(forged, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as dst:
-        for info in src.infolist():
-            data = src.read(info)
-            if info.filename == "manifest.json":
-                manifest = json.loads(data)
-                manifest["arrays"]["height"]["shape"] = list(shape)
-                dst.writestr(info, json.dumps(manifest))
-            elif info.filename != "height.npy":
-                dst.writestr(info, data)
-        with dst.open("height.npy", "w") as member:
-            np.lib.format.write_array_header_1_0(
-                member, {"descr": "<f4", "fortran_order": False, "shape": shape})
-            left = shape[0] * shape[1] * 4
-            while left:
-                member.write(bytes(min(left, 1 << 22)))
-                left -= min(left, 1 << 22)
+    forged = _forge_shape(small, tmp_path / "forged.rk", "height", (8193, 8192))
     assert forged.stat().st_size < 1 << 20
     tracemalloc.start()
     try:
@@ -590,3 +596,17 @@ def test_an_array_over_its_kinds_limit_is_refused_before_inflating(tmp_path):
         tracemalloc.stop()
     assert peak < 4 << 20, peak
     assert_one_line_error(run_cli("info", forged), "forged.rk", "at most", code=1)
+
+
+def test_a_billboard_cloud_over_its_rectangles_is_refused_from_its_manifest(tmp_path):
+    """``read_manifest`` reads no array data: the limit is on the declared rows."""
+    from reliefkit import bake
+    from reliefkit.errors import FormatError
+    from reliefkit.io.rk import read_manifest, save
+    from reliefkit.scene.assets import make_asset
+
+    small = tmp_path / "small.rk"
+    save(small, bake(make_asset("plane"), "billboard-cloud"))
+    forged = _forge_shape(small, tmp_path / "forged.rk", "corners", (4097, 3))
+    with pytest.raises(FormatError, match="corners.*at most 12,288"):
+        read_manifest(forged)
