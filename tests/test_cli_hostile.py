@@ -7,6 +7,7 @@ Each case asserts its outcome class: one ``error:`` line and the documented exit
 import dataclasses
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -609,4 +610,25 @@ def test_a_billboard_cloud_over_its_rectangles_is_refused_from_its_manifest(tmp_
     save(small, bake(make_asset("plane"), "billboard-cloud"))
     forged = _forge_shape(small, tmp_path / "forged.rk", "corners", (4097, 3))
     with pytest.raises(FormatError, match="corners.*at most 12,288"):
+        read_manifest(forged)
+
+
+@pytest.mark.parametrize("kind, params, name, shape, words", [
+    ("depth-object", {"res": 8}, "depth", (6, 2048, 2048), "depth object: mask must have"),
+    ("displacement", {}, "color", (2048, 2048, 4), "'color' (2048, 2048, 4) and 'height'"),
+])
+def test_arrays_whose_shapes_disagree_are_refused_before_inflating(tmp_path, kind, params,
+                                                                   name, shape, words):
+    """One array declared 100 MB, the others its kind's small ones: the disagreement is in
+    the declared shapes, so ``read_manifest`` (no array data) refuses it."""
+    from reliefkit import bake
+    from reliefkit.errors import FormatError
+    from reliefkit.io.rk import read_manifest, save
+    from reliefkit.scene.assets import make_asset
+
+    small = tmp_path / "small.rk"
+    save(small, bake(make_asset("blob" if kind == "depth-object" else "plane"), kind,
+                     **params))
+    forged = _forge_shape(small, tmp_path / "forged.rk", name, shape)
+    with pytest.raises(FormatError, match=re.escape(words)):
         read_manifest(forged)

@@ -111,6 +111,9 @@ class Codec:
     to_arrays : ``rep -> (arrays, params)``; optional arrays may be left out or None.
     from_arrays : ``(arrays, params) -> rep``; gets validated arrays only.
     version : the kind's own version; files with a newer one are refused.
+    check_shapes : ``{name: shape} -> None``, raising `FormatError` where the arrays' shapes
+        disagree (a colour image not the size of its height field), or None; run on the
+        declared shapes before anything is inflated, and before writing.
     """
 
     kind: str
@@ -119,6 +122,7 @@ class Codec:
     to_arrays: Callable[[object], tuple[dict[str, np.ndarray], dict]]
     from_arrays: Callable[[dict[str, np.ndarray], dict], object]
     version: int = 1
+    check_shapes: Callable[[dict[str, tuple[int, ...]]], None] | None = None
 
 
 @dataclass(frozen=True)
@@ -372,6 +376,8 @@ def _prepare_arrays(codec: Codec, arrays) -> dict[str, np.ndarray]:
         if spec.finite:
             _check_finite(name, arr)
         out[name] = arr.astype(arr.dtype.newbyteorder("<"), order="C", copy=False)
+    if codec.check_shapes is not None:
+        codec.check_shapes({name: arr.shape for name, arr in out.items()})
     return out
 
 
@@ -550,6 +556,8 @@ def _inspect(archive: _Archive, max_bytes: int | None):
     spans = _layout(archive, infos.values())
     members = {name: _inspect_member(archive, codec, name, entry, spans[f"{name}.npy"])
                for name, entry in entries.items()}
+    if codec.check_shapes is not None:
+        codec.check_shapes({name: member.shape for name, member in members.items()})
     total = sum(m.nbytes for m in members.values())
     if max_bytes is not None and total > max_bytes:
         raise FormatError(f"arrays declare {total / 2**30:.2f} GiB, over the "
