@@ -150,12 +150,9 @@ BASE_MESH_ARRAYS = {
 
 
 def check_base_arrays(arrays: dict, kind: str, per_vertex=("normals", "uvs")) -> int:
-    """Refuse a base over the size caps or whose per-vertex arrays (``per_vertex``) have
-    another length than ``positions``; returns the vertex count."""
+    """Refuse a base whose per-vertex arrays (``per_vertex``) have another length than
+    ``positions`` (the size caps are `BASE_MESH_ARRAYS`' own); returns the vertex count."""
     count = len(arrays["positions"])
-    if count > MAX_BASE_VERTICES or len(arrays["indices"]) > MAX_BASE_TRIANGLES:
-        raise FormatError(f"a {kind}'s base has at most {MAX_BASE_VERTICES} vertices and "
-                          f"{MAX_BASE_TRIANGLES} triangles")
     for key in per_vertex:
         if len(arrays[key]) != count:
             raise FormatError(f"{kind} array '{key}' has {len(arrays[key])} rows, the base "

@@ -59,10 +59,7 @@ def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
         raise FormatError(f"shell-volume param 'tile' must be two whole numbers, got {tile!r}")
     positions = arrays["positions"]
     count = check_base_arrays(arrays, "shell-volume", ("normals", "uvs", "thickness"))
-    rgba = arrays["texture_rgba"]
-    if int(np.prod(rgba.shape[:3])) > MAX_VOXELS:
-        raise FormatError(f"a shell's texture has at most {MAX_VOXELS} voxels, got "
-                          f"{rgba.shape[:3]}")
+    rgba = arrays["texture_rgba"]  # at most MAX_VOXELS: ARRAYS' max_size
     try:
         texture = VolumeTexture(rgba, arrays["texture_normal"], name, tuple(tile),
                                 arrays.get("texture_glow"), float(length))
