@@ -7,6 +7,7 @@ Each case asserts its outcome class: one ``error:`` line and the documented exit
 import dataclasses
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -124,7 +125,8 @@ def test_camera_framing_refuses_non_finite_bounds():
 @pytest.mark.parametrize("flag, name", [("--aovs", "missing/a.npz"), ("--aovs", "adir.npz"),
                                         ("--stats", "missing/s.json"),
                                         ("--stats", "adir.json"), ("-o", "missing/x.png"),
-                                        ("-o", "adir.png")])
+                                        ("-o", "adir.png"), ("-o", "x.png/"),
+                                        ("--aovs", "a.npz/"), ("--stats", "s.json/")])
 def test_a_bad_output_path_is_refused_before_rendering(tmp_path, flag, name):
     (tmp_path / "adir.npz").mkdir()
     (tmp_path / "adir.json").mkdir()
@@ -159,6 +161,12 @@ def test_a_read_only_folder_is_refused_before_rendering(tmp_path, monkeypatch, c
     status = cli.main(["bake", "demo:blob", "-o", str(locked / "b.rk")])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "not writable" in err[0]
+
+
+def test_a_bake_output_with_a_trailing_slash_is_refused(tmp_path):
+    result = run_cli("bake", "demo:blob", "--as", "relief", "-o", "b.rk/", cwd=tmp_path)
+    assert_one_line_error(result, "b.rk/", "names a folder", code=2)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_compare_out_that_is_a_file_is_refused_before_the_bake(tmp_path):
@@ -300,3 +308,350 @@ def test_python_warnings_become_one_warning_line(capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err[0] == "warning: a big texture" and len(err) == 2, err
     assert err[1].startswith("warning: Image size (200000000 pixels)"), err
+
+
+# ------------------------------------------------------------------ 7. signals at any moment
+
+SIGNAL_OUTCOMES = {"SIGINT": (130, "error: interrupted"),
+                   "SIGTERM": (143, "error: terminated (SIGTERM)")}
+
+
+def _wait_for_numpy(proc) -> None:
+    """Until the child has mapped numpy's core library: by then its own code runs (the CLI
+    imports numpy only after taking the signals), past the interpreter's startup, however
+    loaded the machine is."""
+    import time
+
+    maps = Path(f"/proc/{proc.pid}/maps")
+    while "_multiarray_umath" not in maps.read_text():
+        assert proc.poll() is None, "the command ended before importing numpy"
+        time.sleep(0.005)
+
+
+@pytest.mark.skipif(not Path("/proc/self/maps").exists(), reason="needs /proc")
+@pytest.mark.parametrize("name", sorted(SIGNAL_OUTCOMES))
+@pytest.mark.parametrize("delay", [0.0, 0.5, 1.2, 3.0])
+def test_a_signal_at_any_moment_is_one_line_and_no_output(tmp_path, name, delay):
+    """Delays from numpy's import fall in the libraries' imports (the first ~2 s), the
+    parser's and the bake: each ends in the documented line and exit status, no file left."""
+    import signal
+    import time
+
+    out = tmp_path / "t.rk"
+    proc = subprocess.Popen([sys.executable, "-m", "reliefkit.cli", "bake", "demo:terrain",
+                             "--as", "relief", "--depth-res", "512", "-o", out],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for_numpy(proc)
+    time.sleep(delay)
+    proc.send_signal(getattr(signal, name))
+    _, err = proc.communicate(timeout=300)
+    code, line = SIGNAL_OUTCOMES[name]
+    assert proc.returncode == code, err
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(line), err
+    assert list(tmp_path.iterdir()) == []
+
+
+def _swallow(exc):
+    return None  # an import guard (trimesh's ``except BaseException``)
+
+
+def _wrap(exc):
+    raise RuntimeError("Error calling __set_name__") from exc  # what dataclasses does
+
+
+@pytest.mark.parametrize("library", [_swallow, _wrap])
+def test_an_interrupt_a_library_swallows_or_wraps_still_stops_the_command(
+        tmp_path, capsys, monkeypatch, library):
+    """A Ctrl-C that a library swallows, or turns into its own exception, must neither let
+    the command go on to write its output nor be reported as an internal error."""
+    import importlib
+    import signal
+
+    bake_module = importlib.import_module("reliefkit.bake")
+    real_bake = bake_module.bake
+
+    def bake_inside_a_library(*args, **kwargs):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+        except BaseException as exc:
+            library(exc)
+        return real_bake(*args, **kwargs)
+
+    monkeypatch.setattr(bake_module, "bake", bake_inside_a_library)
+    out = tmp_path / "h.rk"
+    status = cli.main(["bake", "demo:blob", "--as", "relief", "--depth-res", "16",
+                       "--no-safety", "-o", str(out)])
+    assert (status, capsys.readouterr().err.strip().splitlines()[-1]) == \
+        (130, "error: interrupted")
+    assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ 8. exit statuses
+
+@pytest.mark.parametrize("args, code", [
+    (["render", "missing.obj", "-o", "x.png"], 1),
+    (["render", "demo:nope", "-o", "x.png"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "missing.npy", "-o",
+      "x.rk"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "missing.obj", "-o",
+      "x.rk"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "demo:nope", "-o",
+      "x.rk"], 1),
+    (["bake", "demo:sphere", "--as", "shell-volume", "--texture", "furr", "-o", "x.rk"], 2),
+    (["render", "demo:blob", "--view", "1,2,3,4", "-o", "x.png"], 2),
+])
+def test_exit_statuses_follow_the_table(tmp_path, args, code):
+    """docs/cli.md: 1 for a missing input, whichever flag names it; 2 for a bad value."""
+    assert_one_line_error(run_cli(*args, cwd=tmp_path), code=code)
+    assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ 9. forged values out
+
+def _with_manifest(path, out, edit):
+    """A copy of the .rk ``path`` whose manifest text went through ``edit``."""
+    import zipfile
+
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(out, "w") as dst:
+        for info in src.infolist():
+            data = src.read(info)
+            if info.filename == "manifest.json":
+                data = edit(data.decode()).encode()
+            dst.writestr(info, data)
+    return out
+
+
+def test_info_json_is_strict_json_for_forged_non_finite_params(small_rk, tmp_path):
+    def add_params(text):
+        manifest = json.loads(text)
+        manifest["params"].update(forged_nan="@NaN", forged_inf=["@Infinity", 1.5])
+        return json.dumps(manifest).replace('"@NaN"', "NaN").replace('"@Infinity"',
+                                                                     "-Infinity")
+
+    forged = _with_manifest(small_rk, tmp_path / "nan.rk", add_params)
+    result = run_cli("info", "--json", forged)
+    assert result.returncode == 0, result.stderr
+
+    def refuse(constant):
+        raise ValueError(f"not JSON: {constant}")
+
+    params = json.loads(result.stdout, parse_constant=refuse)["file"]["params"]
+    assert params["forged_nan"] is None and params["forged_inf"] == [None, 1.5]
+
+
+# ------------------------------------------------------------------ 10. sequences
+
+@pytest.mark.parametrize("name", ["a.gif", "seq/%02d.png", "a.mp4"])
+def test_streamed_animations_are_written_frame_by_frame(tmp_path, name):
+    """Each frame is encoded and released before the next is drawn (a 1,000-view turntable
+    at 2048x2048 needs one frame's memory), and decodes to what was given."""
+    import weakref
+
+    from PIL import Image
+
+    from reliefkit.animation import save_animation
+
+    rng = np.random.default_rng(1)
+    palette = rng.integers(0, 256, (200, 3), dtype=np.uint8)  # few colours: exact in a GIF
+    given, alive = [], []
+
+    def frame(k):
+        assert not any(ref() is not None for ref in alive), f"a frame before {k} is kept"
+        rgba = np.full((24, 32, 4), 255, np.uint8)
+        rgba[..., :3] = palette[rng.integers(0, 200, (24, 32))]
+        given.append(rgba[..., :3].copy())
+        alive.append(weakref.ref(rgba))
+        return rgba
+
+    def frames():
+        for k in range(5):
+            yield frame(k)
+
+    save_animation(frames(), tmp_path / name, 5)
+    assert len(given) == 5
+    if name.endswith(".mp4"):
+        import imageio_ffmpeg
+
+        assert imageio_ffmpeg.count_frames_and_secs(str(tmp_path / name))[0] == 5
+        return
+    if name.endswith(".gif"):
+        with Image.open(tmp_path / name) as gif:
+            assert gif.n_frames == 5 and gif.info["loop"] == 0
+            decoded = []
+            for k in range(5):
+                gif.seek(k)
+                decoded.append(np.asarray(gif.convert("RGB")))
+    else:
+        decoded = [np.asarray(Image.open(tmp_path / (name % k)).convert("RGB"))
+                   for k in range(5)]
+    for got, expected in zip(decoded, given, strict=True):
+        np.testing.assert_array_equal(got, expected)
+
+
+def test_held_formats_are_refused_when_their_frames_would_not_fit(tmp_path):
+    """APNG and WebP writers take every frame at once: refused up front with the estimate,
+    pointing at the formats that stream."""
+    result = run_cli("render", "demo:blob", "--turntable", "3600", "--size", "2048x2048",
+                     "-o", tmp_path / "spin.webp")
+    assert_one_line_error(result, "GiB", ".gif", ".mp4", code=2)
+    assert not (tmp_path / "spin.webp").exists()
+
+
+@pytest.mark.parametrize("flag", ["--turntable", "--animate"])
+def test_sequence_lengths_follow_the_docs(tmp_path, flag):
+    result = run_cli("render", "demo:blob", flag, "3601", "-o", tmp_path / "s.gif")
+    assert_one_line_error(result, flag, "1..3600", code=2)
+
+
+@pytest.mark.parametrize("sequence", [["demo:blob", "--turntable", "6"],
+                                      ["demo:sphere:shell", "--animate", "6"]])
+def test_a_gif_over_the_file_size_limit_is_one_line(tmp_path, sequence):
+    resource = pytest.importorskip("resource")
+    if sequence[0] == "demo:sphere:shell":
+        shell = tmp_path / "s.rk"
+        baked = run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture-size",
+                        "8,8,4", "-o", shell)
+        assert baked.returncode == 0, baked.stderr
+        sequence = [shell, *sequence[1:]]
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (8 * 1024, 8 * 1024))
+
+    out = tmp_path / "out"
+    out.mkdir()
+    result = run_cli("render", *sequence, "--size", "96x96", "-o", "x.gif", cwd=out,
+                     preexec_fn=limit, env={**os.environ, "MESA_SHADER_CACHE_DISABLE": "true"})
+    result.stderr = "".join(line for line in result.stderr.splitlines(keepends=True)
+                            if not line.startswith(("turntable: ", "animate: ")))  # progress
+    assert_one_line_error(result, "x.gif", "File too large", code=2)
+    assert os.listdir(out) == []
+
+
+# ------------------------------------------------------------------ 11. several outputs
+
+def _full_disk_for(monkeypatch, name: str):
+    """Writing the temporary file of the output ``name`` fails as on a full disk."""
+    import errno
+
+    real = Path.write_text
+
+    def write_text(self, *args, **kwargs):
+        if self.name.startswith(f".{name}."):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", write_text)
+
+
+def test_a_render_whose_stats_cannot_be_written_leaves_none_of_its_outputs(
+        gl, tmp_path, capsys, monkeypatch):
+    _full_disk_for(monkeypatch, "s.json")
+    status = cli.main(["render", "demo:blob", "--size", "16x16", "-o", str(tmp_path / "x.png"),
+                       "--aovs", str(tmp_path / "a.npz"), "--stats", str(tmp_path / "s.json")])
+    captured = capsys.readouterr()
+    assert status == 2 and "wrote" not in captured.out, captured
+    assert captured.err.strip().splitlines() == [
+        f"error: cannot write {tmp_path / 's.json'}: No space left on device; nothing was "
+        "written"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_compare_whose_json_cannot_be_written_leaves_none_of_its_files(
+        gl, tmp_path, capsys, monkeypatch):
+    _full_disk_for(monkeypatch, "metrics.json")
+    out = tmp_path / "c"
+    status = cli.main(["compare", "demo:blob", "--depth-res", "16", "--size", "16x16",
+                       "--out", str(out)])
+    assert status == 2, capsys.readouterr().err
+    assert "No space left" in capsys.readouterr().err
+    assert list(out.iterdir()) == []
+
+
+# ------------------------------------------------------------------ 12. sizes before inflating
+
+def _forge_shape(small, out, name: str, shape: tuple) -> Path:
+    """A copy of the .rk ``small`` whose array ``name`` declares ``shape`` (zeros, deflated
+    level 9 as they stream: a few hundred KB for hundreds of MB)."""
+    import zipfile
+
+    with zipfile.ZipFile(small) as src, \
+            zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as dst:
+        manifest = json.loads(src.read("manifest.json"))
+        dtype = np.dtype(manifest["arrays"][name]["dtype"])
+        manifest["arrays"][name]["shape"] = list(shape)
+        for info in src.infolist():
+            if info.filename == "manifest.json":
+                dst.writestr(info, json.dumps(manifest))
+            elif info.filename != f"{name}.npy":
+                dst.writestr(info, src.read(info))
+        with dst.open(f"{name}.npy", "w") as member:
+            np.lib.format.write_array_header_1_0(
+                member, {"descr": dtype.str, "fortran_order": False, "shape": shape})
+            left = int(np.prod(shape)) * dtype.itemsize
+            while left:
+                member.write(bytes(min(left, 1 << 22)))
+                left -= min(left, 1 << 22)
+    return out
+
+
+def test_an_array_over_its_kinds_limit_is_refused_before_inflating(tmp_path):
+    """A 0.3 MB displacement file declaring a 268 MB height field (one row over 8192 x 8192
+    texels, under the container's 4 GiB cap) is refused from its declared shape, having
+    allocated a few megabytes; info says so in one line."""
+    import tracemalloc
+
+    from reliefkit.errors import FormatError
+    from reliefkit.io.rk import load, save
+    from reliefkit.scene.assets import make_asset
+    from reliefkit.techniques.slicing import DisplacementMap
+
+    small = tmp_path / "small.rk"
+    save(small, DisplacementMap(make_asset("plane"), np.ones((4, 4, 4), np.float32),
+                                np.zeros((4, 4), np.float32), 0.1))
+    forged = _forge_shape(small, tmp_path / "forged.rk", "height", (8193, 8192))
+    assert forged.stat().st_size < 1 << 20
+    tracemalloc.start()
+    try:
+        with pytest.raises(FormatError, match="height.*at most 67,108,864"):
+            load(forged)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 4 << 20, peak
+    assert_one_line_error(run_cli("info", forged), "forged.rk", "at most", code=1)
+
+
+def test_a_billboard_cloud_over_its_rectangles_is_refused_from_its_manifest(tmp_path):
+    """``read_manifest`` reads no array data: the limit is on the declared rows."""
+    from reliefkit import bake
+    from reliefkit.errors import FormatError
+    from reliefkit.io.rk import read_manifest, save
+    from reliefkit.scene.assets import make_asset
+
+    small = tmp_path / "small.rk"
+    save(small, bake(make_asset("plane"), "billboard-cloud"))
+    forged = _forge_shape(small, tmp_path / "forged.rk", "corners", (4097, 3))
+    with pytest.raises(FormatError, match="corners.*at most 12,288"):
+        read_manifest(forged)
+
+
+@pytest.mark.parametrize("kind, params, name, shape, words", [
+    ("depth-object", {"res": 8}, "depth", (6, 2048, 2048), "depth object: mask must have"),
+    ("displacement", {}, "color", (2048, 2048, 4), "'color' (2048, 2048, 4) and 'height'"),
+])
+def test_arrays_whose_shapes_disagree_are_refused_before_inflating(tmp_path, kind, params,
+                                                                   name, shape, words):
+    """One array declared 100 MB, the others its kind's small ones: the disagreement is in
+    the declared shapes, so ``read_manifest`` (no array data) refuses it."""
+    from reliefkit import bake
+    from reliefkit.errors import FormatError
+    from reliefkit.io.rk import read_manifest, save
+    from reliefkit.scene.assets import make_asset
+
+    small = tmp_path / "small.rk"
+    save(small, bake(make_asset("blob" if kind == "depth-object" else "plane"), kind,
+                     **params))
+    forged = _forge_shape(small, tmp_path / "forged.rk", name, shape)
+    with pytest.raises(FormatError, match=re.escape(words)):
+        read_manifest(forged)

@@ -87,3 +87,42 @@ def toy_bench():
 
     with toy_technique():
         yield
+
+
+def _until_shown(stream, text: str) -> None:
+    """Block like a long render until ``text`` was written (no timing assumed)."""
+    import time
+
+    while text not in stream.getvalue():
+        time.sleep(0.01)
+
+
+def test_a_long_single_call_shows_its_time_and_a_final_line():
+    from reliefkit.progress import waiting
+
+    stream = io.StringIO()
+    with waiting("render", stream=stream, after=0.0, interval=0.0):
+        _until_shown(stream, "\nrender: ")  # at least two lines of elapsed time
+    lines = stream.getvalue().splitlines()
+    assert len(lines) >= 3 and all(line.startswith("render: ") for line in lines)
+    assert [line.endswith(" s") and "done" not in line for line in lines[:-1]] == \
+        [True] * (len(lines) - 1)
+    assert lines[-1].startswith("render: done in ")
+
+
+def test_a_short_single_call_prints_nothing():
+    from reliefkit.progress import waiting
+
+    stream = io.StringIO()
+    with waiting("render", stream=stream, after=3600.0):
+        pass
+    assert stream.getvalue() == ""
+
+
+def test_a_long_single_call_on_a_terminal_shows_a_spinner():
+    from reliefkit.progress import waiting
+
+    stream = Terminal()
+    with waiting("render", stream=stream, after=0.0):
+        _until_shown(stream, "render: ")
+    assert "render: done in " in stream.getvalue().splitlines()[-1]  # after the spinner

@@ -5,46 +5,55 @@
 >>> frame = rk.render(mesh, rk.Camera.orbit(mesh.center, 30, 25, 3 * mesh.radius))
 """
 
-from . import metrics
-from .bake import bake
-from .errors import FormatError, GPUError, MeshError, ReliefkitError, UsageError
-from .io.inputs import load_mesh
-from .io.rk import load, save
-from .render import Frame, render
-from .scene.camera import Camera
-from .scene.light import DirectionalLight
-from .scene.mesh import RenderMesh
-from .techniques.billboard import (
-    BillboardBoxes,
-    BillboardCloud,
-    bake_billboard_cloud,
-    bake_boxes,
-    build_billboard_cloud,
-)
-from .techniques.relief import (
-    ReliefObject,
-    ReliefTexture,
-    bake_relief,
-    bake_relief_cube,
-    bake_relief_frustum,
-    relief_from_heights,
-)
-from .techniques.shellvolume import TexturedShell, VolumeTexture, build_shell, visibility_order
-from .techniques.slicing import (
-    DepthImages,
-    DepthObject,
-    DisplacementMap,
-    VisualHull,
-    bake_depth_images,
-)
+from __future__ import annotations
 
-__all__ = [
-    "load_mesh", "RenderMesh", "Camera", "DirectionalLight", "render", "Frame", "save", "load",
-    "bake", "metrics", "bake_relief", "bake_relief_frustum", "bake_relief_cube",
-    "relief_from_heights", "ReliefTexture", "ReliefObject", "build_billboard_cloud",
-    "bake_billboard_cloud", "bake_boxes", "BillboardCloud", "BillboardBoxes",
-    "build_shell", "visibility_order", "VolumeTexture", "TexturedShell",
-    "bake_depth_images", "DepthImages", "DepthObject", "VisualHull", "DisplacementMap",
-    "ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError",
-]
+import importlib
+import sys
+import types
+
+# each public name and the module it lives in; imported on first use (PEP 562), so that
+# `import reliefkit.cli` is quick and the command line takes Ctrl-C from its first moment
+_EXPORTS = {
+    "metrics": "", "bake": ".bake", "load": ".io.rk", "save": ".io.rk",
+    "Frame": ".render", "render": ".render", "Camera": ".scene.camera",
+    "DirectionalLight": ".scene.light", "load_mesh": ".io.inputs",
+    "RenderMesh": ".scene.mesh",
+    **dict.fromkeys(("ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError"),
+                    ".errors"),
+    **dict.fromkeys(("BillboardBoxes", "BillboardCloud", "bake_billboard_cloud", "bake_boxes",
+                     "build_billboard_cloud"), ".techniques.billboard"),
+    **dict.fromkeys(("ReliefObject", "ReliefTexture", "bake_relief", "bake_relief_cube",
+                     "bake_relief_frustum", "relief_from_heights"), ".techniques.relief"),
+    **dict.fromkeys(("TexturedShell", "VolumeTexture", "build_shell", "visibility_order"),
+                    ".techniques.shellvolume"),
+    **dict.fromkeys(("DepthImages", "DepthObject", "DisplacementMap", "VisualHull",
+                     "bake_depth_images"), ".techniques.slicing"),
+}
+__all__ = list(_EXPORTS)
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module = importlib.import_module(_EXPORTS[name] or f".{name}", __name__)
+    value = module if not _EXPORTS[name] else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})
+
+
+class _Package(types.ModuleType):
+    """Importing the packages ``reliefkit.bake`` and ``reliefkit.render`` sets them as
+    attributes here; the public names ``bake`` and ``render`` stay their functions."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if isinstance(value, types.ModuleType) and _EXPORTS.get(name) == f".{name}":
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

@@ -9,7 +9,10 @@
 
 Every format but MP4 keeps a transparent background (PNG, APNG and WebP keep alpha
 exactly); MP4 frames are composited over the tile background unless ``--background`` is
-given. Each file is written atomically.
+given. Each file is written atomically. PNG sequences, GIF and MP4 are written a frame at a
+time as the frames are drawn (memory is one frame's at any length); Pillow's APNG and WebP
+writers take every frame at once, so those are refused up front when the frames would not
+fit in `held_limit` (name a .gif, .mp4 or a PNG sequence instead).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import UsageError
+from .gl.targets import host_limit
 from .io.atomic import atomic_path, check_writable
 from .pictures import TILE_BACKGROUND
 
@@ -31,6 +35,7 @@ FORMATS = {".gif": "gif", ".png": "apng", ".apng": "apng", ".webp": "webp", ".mp
 SEQUENCE, FOLDER = "png-sequence", "png-folder"
 NAMES = "*.gif, *.png or *.apng (APNG), *.webp, *.mp4, frames/%04d.png or a folder/"
 _PATTERN = re.compile(r"%0?\d*d")
+_HELD = ("apng", "webp")  # formats whose writer takes every frame at once
 
 
 def animation_format(path) -> str:
@@ -59,18 +64,33 @@ def is_animation_name(path) -> bool:
     return found != "apng" or Path(str(path)).suffix.lower() == ".apng"
 
 
-def check_animation_output(path, size: tuple[int, int], flag: str = "-o") -> str:
+def check_animation_output(path, size: tuple[int, int], count: int = 1,
+                           flag: str = "-o") -> str:
     """Refuse before any work a name no format matches, an MP4 of odd size (H.264 in
-    yuv420p halves both) or an output that cannot be written; returns the format."""
+    yuv420p halves both), APNG or WebP frames that would not fit in memory together, or an
+    output that cannot be written; returns the format."""
     found = animation_format(path)
     if found == "mp4" and (size[0] % 2 or size[1] % 2):
         raise UsageError(f"an .mp4 needs an even width and height (H.264, yuv420p), got "
                          f"{size[0]}x{size[1]}")
+    needed = held_bytes(size, count)
+    if found in _HELD and needed > host_limit():
+        raise UsageError(f"{count} frames of {size[0]}x{size[1]} as {found.upper()} are held "
+                         f"in memory together (about {needed / 2**30:.1f} GiB, limit "
+                         f"{host_limit() / 2**30:.1f} GiB): write a .gif, an .mp4 or "
+                         "frames/%04d.png, which are written a frame at a time, or fewer "
+                         "or smaller frames")
     if found == SEQUENCE:  # the pattern's folder may be one still to be made
         check_writable(Path(path).parent, flag, folder=True)
     else:
         check_writable(path, flag, folder=found == FOLDER)
     return found
+
+
+def held_bytes(size: tuple[int, int], count: int) -> int:
+    """Memory of ``count`` RGBA8 frames held for APNG or WebP: our arrays and Pillow's
+    images of them."""
+    return 2 * 4 * size[0] * size[1] * count
 
 
 def frame_background(path, background):
@@ -81,27 +101,30 @@ def frame_background(path, background):
     return TILE_BACKGROUND
 
 
-def save_animation(frames: list[np.ndarray], path, fps: float = FPS) -> str:
-    """Write RGBA uint8 frames (straight alpha) as ``path`` asks; returns what was written."""
+def save_animation(frames, path, count: int, fps: float = FPS) -> str:
+    """Write ``count`` RGBA uint8 frames (straight alpha, any iterable: a generator is drawn
+    a frame at a time) as ``path`` asks; returns what was written."""
     found = animation_format(path)
     if found in (SEQUENCE, FOLDER):
-        return _save_sequence(frames, path, found)
+        return _save_sequence(frames, path, found, count)
+    if found in _HELD:
+        frames = list(frames)  # checked by `check_animation_output`
     {"apng": _save_apng, "webp": _save_webp, "gif": _save_gif, "mp4": _save_mp4}[found](
         frames, path, fps)
     return str(path)
 
 
-def _save_sequence(frames, path, found: str) -> str:
+def _save_sequence(frames, path, found: str, count: int) -> str:
     from PIL import Image
 
     if found == FOLDER:
         folder = Path(path)
         folder.mkdir(parents=True, exist_ok=True)
-        digits = max(4, len(str(len(frames) - 1)))
-        names = [folder / f"{k:0{digits}d}.png" for k in range(len(frames))]
+        digits = max(4, len(str(count - 1)))
+        names = [folder / f"{k:0{digits}d}.png" for k in range(count)]
     else:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        names = [Path(str(path) % k) for k in range(len(frames))]
+        names = [Path(str(path) % k) for k in range(count)]
     for name, rgba in zip(names, frames, strict=True):
         with atomic_path(name) as tmp:
             Image.fromarray(rgba, "RGBA").save(tmp, format="PNG")
@@ -144,17 +167,34 @@ def _gif_frame(rgba: np.ndarray):
 
 
 def _save_gif(frames, path, fps: float) -> None:
-    images = [_gif_frame(f) for f in frames]
-    with atomic_path(path) as tmp:  # disposal 2: each frame starts from transparent
-        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
-                       duration=1000.0 / fps, loop=0, disposal=2, transparency=255,
-                       optimize=False)
+    """Each frame encoded as it comes (Pillow's frame writer) and dropped; disposal 2: each
+    frame starts from transparent."""
+    from PIL import GifImagePlugin
+
+    count = 0
+    with atomic_path(path) as tmp, open(tmp, "wb") as out:
+        for image in map(_gif_frame, frames):
+            info = {"duration": 1000.0 / fps, "disposal": 2, "transparency": 255}
+            if count == 0:
+                header, _ = GifImagePlugin.getheader(image, info={"loop": 0, **info})
+                out.write(b"".join(header))
+            out.writelines(GifImagePlugin.getdata(image, include_color_table=True, **info))
+            count += 1
+        if count == 0:
+            raise UsageError(f"{path}: an animation needs at least one frame")
+        out.write(b";")  # the GIF trailer
 
 
 def _save_mp4(frames, path, fps: float) -> None:
+    import itertools
+
     import imageio_ffmpeg
 
-    height, width = frames[0].shape[:2]
+    frames = iter(frames)
+    first = next(frames, None)
+    if first is None:
+        raise UsageError(f"{path}: an animation needs at least one frame")
+    height, width = first.shape[:2]
     with atomic_path(path) as tmp:
         writer = imageio_ffmpeg.write_frames(
             str(tmp), (width, height), fps=fps, codec="libx264", pix_fmt_in="rgb24",
@@ -162,7 +202,7 @@ def _save_mp4(frames, path, fps: float) -> None:
             ffmpeg_log_level="error", quality=8)
         try:
             writer.send(None)
-            for rgba in frames:
+            for rgba in itertools.chain([first], frames):
                 writer.send(np.ascontiguousarray(rgba[..., :3]).tobytes())
             writer.close()
         except RuntimeError as exc:  # ffmpeg's own failure, in many lines: keep its last

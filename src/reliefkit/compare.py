@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .io.atomic import atomic_path
+from .io.atomic import atomic_path, written_together
 from .pictures import TILE_BACKGROUND
 from .units import format_bytes
 
@@ -185,17 +185,19 @@ def _cell(value, column: str) -> str:
 
 
 def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]:
-    """compare.png, metrics.md and metrics.json in ``out_dir`` (created)."""
+    """compare.png, metrics.md and metrics.json in ``out_dir`` (created): all three, or none
+    if one cannot be written."""
     from .pictures import save_image
 
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = {"picture": out_dir / "compare.png", "markdown": out_dir / "metrics.md",
              "json": out_dir / "metrics.json"}
-    save_image(comparison_sheet(result, title), paths["picture"])
-    with atomic_path(paths["markdown"]) as tmp:
-        tmp.write_text(metrics_markdown(result, title))
-    with atomic_path(paths["json"]) as tmp:
-        tmp.write_text(metrics_json(result, title))
+    with written_together():
+        save_image(comparison_sheet(result, title), paths["picture"])
+        with atomic_path(paths["markdown"]) as tmp:
+            tmp.write_text(metrics_markdown(result, title))
+        with atomic_path(paths["json"]) as tmp:
+            tmp.write_text(metrics_json(result, title))
     return paths
 
 

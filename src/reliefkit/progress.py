@@ -3,16 +3,20 @@
 On a terminal this draws a rich bar. Anywhere else (a log file, a pipe, CI) a bar would be
 noise or nothing at all, so progress becomes plain lines such as ``demo: 3/8``: at most one
 every `PLAIN_INTERVAL` seconds, plus a final ``demo: 8/8, done in 12.3 s``. This module is the one
-place that decides; commands only call `progress_bar` or `activity`.
+place that decides; commands only call `progress_bar`, `activity` or `waiting`.
 """
 
 from __future__ import annotations
 
 import contextlib
 import sys
+import threading
 import time
 
+from .interrupts import raise_pending
+
 PLAIN_INTERVAL = 5.0  # seconds between two plain progress lines
+QUIET_WAIT = 10.0     # seconds a call without steps (a render) runs before `waiting` shows it
 
 
 def _is_terminal(stream) -> bool:
@@ -23,17 +27,27 @@ def _is_terminal(stream) -> bool:
 @contextlib.contextmanager
 def progress_bar(description: str, total: int, *, enabled: bool = True, stream=None,
                  interval: float = PLAIN_INTERVAL):
-    """Yield ``advance(done, total=None)``, the callback long loops (and bakers) call."""
+    """Yield ``advance(done, total=None)``, the callback long loops (and bakers) call; each
+    call also stops the work if Ctrl-C or SIGTERM came and was swallowed (`interrupts`)."""
     stream = stream if stream is not None else sys.stderr
     if not enabled:
-        yield lambda done, total_=None: None
+        yield _checked(lambda done, total_=None: None)
     elif _is_terminal(stream):
         with _rich_bar(description, total, stream) as advance:
-            yield advance
+            yield _checked(advance)
     else:
         lines = _PlainLines(description, total, stream, interval)
-        yield lines.advance
+        yield _checked(lines.advance)
         lines.finish()
+
+
+def _checked(advance):
+    """``advance`` that first raises a pending interruption."""
+    def checked(done: int, total: int | None = None) -> None:
+        raise_pending()
+        advance(done, total)
+
+    return checked
 
 
 @contextlib.contextmanager
@@ -59,6 +73,51 @@ def activity(description: str, *, stream=None):
 
         yield log
     print(f"{description}: done in {time.monotonic() - start:.1f} s", file=stream, flush=True)
+
+
+@contextlib.contextmanager
+def waiting(description: str, *, stream=None, after: float | None = None,
+            interval: float | None = None):
+    """For one long call that reports no steps (a single render): nothing if the block ends
+    within ``after`` seconds (default `QUIET_WAIT`), so quick commands stay silent; then
+    the elapsed time, as a spinner on a terminal or a plain line every ``interval`` seconds
+    elsewhere (``render: 10 s``), and a final ``render: done in 46.0 s``. The time is shown
+    from a thread, so the call itself needs no callback."""
+    stream = stream if stream is not None else sys.stderr
+    after = QUIET_WAIT if after is None else after
+    interval = PLAIN_INTERVAL if interval is None else interval
+    start = time.monotonic()
+    finished = threading.Event()
+    shown = threading.Event()
+
+    def elapsed() -> str:
+        return f"{description}: {time.monotonic() - start:.0f} s"
+
+    def show() -> None:
+        if finished.wait(after):
+            return
+        shown.set()
+        if _is_terminal(stream):
+            from rich.console import Console
+
+            with Console(file=stream).status(elapsed()) as status:
+                while not finished.wait(1.0):
+                    status.update(elapsed())
+            return
+        print(elapsed(), file=stream, flush=True)
+        while not finished.wait(interval):
+            print(elapsed(), file=stream, flush=True)
+
+    thread = threading.Thread(target=show, name=f"progress: {description}", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        finished.set()
+        thread.join()
+    if shown.is_set():
+        print(f"{description}: done in {time.monotonic() - start:.1f} s", file=stream,
+              flush=True)
 
 
 @contextlib.contextmanager

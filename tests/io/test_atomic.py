@@ -142,3 +142,28 @@ def test_sigterm_during_a_write_removes_the_temp_file(gl, tmp_path):
     assert len(lines) == 1 and lines[0].startswith("error: terminated"), err
     assert not [n for n in os.listdir(tmp_path) if n.endswith(".tmp")], os.listdir(tmp_path)
     assert "b.npz" not in os.listdir(tmp_path)
+
+
+def test_outputs_written_together_appear_all_or_none(tmp_path):
+    from reliefkit.io.atomic import written_together
+
+    old = tmp_path / "a.png"
+    old.write_bytes(b"old")
+    full = pytest.raises(UsageError, match="cannot write .*b.npz: No space left")
+    with full, written_together():
+        with atomic_path(old) as tmp:
+            tmp.write_bytes(b"new")
+        with atomic_path(tmp_path / "b.npz"):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    assert listing(tmp_path) == ["a.png"] and old.read_bytes() == b"old"
+    with pytest.raises(KeyboardInterrupt), written_together():
+        with atomic_path(old) as tmp:
+            tmp.write_bytes(b"new")
+        raise KeyboardInterrupt
+    assert listing(tmp_path) == ["a.png"] and old.read_bytes() == b"old"
+    with written_together():
+        for name in ("a.png", "b.npz"):
+            with atomic_path(tmp_path / name) as tmp:
+                tmp.write_bytes(name.encode())
+        assert old.read_bytes() == b"old"  # nothing moved before the group's end
+    assert [(tmp_path / n).read_bytes() for n in listing(tmp_path)] == [b"a.png", b"b.npz"]

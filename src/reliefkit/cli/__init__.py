@@ -12,49 +12,66 @@ from __future__ import annotations
 
 import contextlib
 import os
-import signal
 import sys
 import warnings
 
 from ..errors import ReliefkitError, UsageError
-from .exits import EXIT_BROKEN_PIPE, EXIT_INPUT, EXIT_INTERNAL, EXIT_TERMINATED, EXIT_USAGE
-from .parser import build_parser
+from ..interrupts import Terminated, handled, raise_pending
+from .exits import (
+    EXIT_BROKEN_PIPE,
+    EXIT_INPUT,
+    EXIT_INTERNAL,
+    EXIT_INTERRUPTED,
+    EXIT_TERMINATED,
+    EXIT_USAGE,
+)
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command. Ctrl-C and SIGTERM are taken from the start, before the heavy
+    imports (the parser imports every technique), so at any moment they end in one line."""
+    with handled():
+        try:
+            return _parse_and_run(argv)
+        except KeyboardInterrupt:
+            print("error: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        except Terminated:
+            print("error: terminated (SIGTERM); no output was left half-written",
+                  file=sys.stderr)
+            return EXIT_TERMINATED
+
+
+def run() -> None:
+    """The console script and ``python -m reliefkit.cli``: `main`, then exit. After Ctrl-C or
+    SIGTERM it exits at once (the interpreter would report a KeyboardInterrupt a library
+    once saw as a death by SIGINT, and finalizers could still print)."""
+    status = main()
+    if status in (EXIT_INTERRUPTED, EXIT_TERMINATED):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)
+
+
+def _parse_and_run(argv: list[str] | None) -> int:
     try:
+        from .parser import build_parser
+
         parser = build_parser()
-    except ReliefkitError as exc:  # a technique failed to register
-        print(f"error: {exc}", file=sys.stderr)
+    except Exception as exc:
+        raise_pending()  # a signal a library turned into its own error (a RuntimeError)
+        if not isinstance(exc, ReliefkitError):
+            raise
+        print(f"error: {exc}", file=sys.stderr)  # a technique failed to register
         return EXIT_INPUT
+    raise_pending()  # a signal an import guard swallowed
     args = parser.parse_args(argv)
     if not getattr(args, "run", None):
         parser.print_help()
         return EXIT_USAGE
-    with _one_line_warnings(), _sigterm_interrupts():
+    with _one_line_warnings():
         return _run(args)
-
-
-class Terminated(BaseException):
-    """SIGTERM arrived: unwinds like KeyboardInterrupt, so every `atomic_path` removes its
-    temporary file, and is no Exception, so no `except Exception` swallows it."""
-
-
-@contextlib.contextmanager
-def _sigterm_interrupts():
-    """While a command runs, SIGTERM raises `Terminated` (where Python can take signals)."""
-    def handler(signum, frame):
-        raise Terminated
-
-    try:
-        previous = signal.signal(signal.SIGTERM, handler)
-    except ValueError:  # not the main thread (main() called from a test's thread)
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 @contextlib.contextmanager
@@ -92,13 +109,8 @@ def _run(args) -> int:
         name = f" {exc.filename}" if getattr(exc, "filename", None) else ""
         print(f"error: cannot access{name}: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_INPUT
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return 130
-    except Terminated:
-        print("error: terminated (SIGTERM); no output was left half-written", file=sys.stderr)
-        return EXIT_TERMINATED
     except Exception as exc:  # a bug, not bad input: still one line, details on request
+        raise_pending()  # ... unless a library turned Ctrl-C or SIGTERM into this error
         if os.environ.get("RELIEFKIT_DEBUG"):
             raise
         print(f"error: internal error ({type(exc).__name__}: {exc}); "
@@ -118,5 +130,5 @@ def _broken_pipe() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run()
 

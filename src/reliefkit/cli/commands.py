@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import itertools
 import json
+import math
 import sys
 from pathlib import Path
 
 from ..errors import FormatError, UsageError
 from .options import applicable, given_options
+
+MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
 
 
 def _check_not_empty(spec: str) -> None:
@@ -177,19 +181,32 @@ def cmd_render(args) -> int:
     camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
     if args.animate is not None:
         return _render_animation(args, obj, camera, draw, background)
-    frame = draw(camera)
-    frame.save(args.output, background)
+    from ..progress import waiting
+
+    with waiting("render"):  # silent unless it takes long (a peeled shell: 46 s)
+        frame = draw(camera)
+        counted = draw(camera, msaa=1, count_iterations=True) if args.stats else None
+    _write_render_outputs(args, frame, counted, background)
     print(f"wrote {args.output} ({size[0]}x{size[1]}, {frame.stats['covered']} pixels covered)")
     if frame.stats["covered"] == 0:
         _warn_nothing_visible("the render covers")
     _print_frame_warnings([frame.warnings])
-    if args.aovs:
-        frame.save_aovs(args.aovs)
-        print(f"wrote {args.aovs}")
-    if args.stats:
-        counted = draw(camera, msaa=1, count_iterations=True)  # counters are single-sample
-        _write_stats(args, frame, counted)
+    for path in (args.aovs, args.stats):
+        if path:
+            print(f"wrote {path}")
     return 0
+
+
+def _write_render_outputs(args, frame, counted, background) -> None:
+    """The picture, --aovs and --stats: all of them or, if one cannot be written, none."""
+    from ..io.atomic import written_together
+
+    with written_together():
+        frame.save(args.output, background)
+        if args.aovs:
+            frame.save_aovs(args.aovs)
+        if args.stats:
+            _write_stats(args, frame, counted)
 
 
 def _check_render_outputs(args) -> None:
@@ -204,12 +221,12 @@ def _check_render_outputs(args) -> None:
         "--animate" if args.animate is not None else None
     if sequence:
         count = args.turntable if args.turntable is not None else args.animate
-        if not 1 <= count <= 1000:
-            raise UsageError(f"{sequence} takes 1..1000 frames, got {count}")
+        if not 1 <= count <= MAX_FRAMES:
+            raise UsageError(f"{sequence} takes 1..{MAX_FRAMES} frames, got {count}")
         from ..animation import check_animation_output
         from ..scene.views import parse_size
 
-        check_animation_output(args.output, parse_size(args.size))
+        check_animation_output(args.output, parse_size(args.size), count)
         given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
                  if value]
         if given:
@@ -235,34 +252,23 @@ def _check_render_outputs(args) -> None:
 def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
     """``args.turntable`` views of ``draw(camera)`` into an animation, warning about empty
     views."""
-    from ..animation import frame_background, save_animation
-    from ..progress import progress_bar
     from ..scene.views import turntable
 
     cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
-    frames, empty, warned = [], [], []
-    with progress_bar("turntable", len(cameras)) as advance:
-        for k, camera in enumerate(cameras):
-            frame = draw(camera)
-            if frame.stats["covered"] == 0:
-                empty.append(str(k + 1))
-            warned.append(frame.warnings)
-            frames.append(frame.rgba8(frame_background(args.output, background)))
-            advance(k + 1)
-    print(f"wrote {save_animation(frames, args.output)} ({len(frames)} views)")
+    empty, warned, written = _stream_frames(args.output, "turntable", map(draw, cameras),
+                                            len(cameras), background)
+    print(f"wrote {written} ({len(cameras)} views)")
     if empty:
         many = len(empty) > 1
-        _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of {len(frames)} "
-                              f"cover{'' if many else 's'}")
+        _warn_nothing_visible(f"view{'s' if many else ''} {', '.join(empty)} of "
+                              f"{len(cameras)} cover{'' if many else 's'}")
     _print_frame_warnings(warned, "view")
     return 0
 
 
 def _render_animation(args, obj, camera, draw, background) -> int:
     """``args.animate`` frames of ``obj``'s animation (its ``time`` render option)."""
-    from ..animation import frame_background, save_animation
     from ..core.params import ANIMATION_TIME
-    from ..progress import progress_bar
     from ..render import render_options
 
     if ANIMATION_TIME not in {opt.name for opt in render_options(obj)}:
@@ -270,16 +276,34 @@ def _render_animation(args, obj, camera, draw, background) -> int:
                          "(no --time option); use --turntable for views around it")
     if given_options(args).get(ANIMATION_TIME) is not None:
         raise UsageError("--animate sets the time of each frame itself: leave out --time")
-    frames, warned = [], []
-    with progress_bar("animate", args.animate) as advance:
-        for k in range(args.animate):
-            frame = draw(camera, **{ANIMATION_TIME: k / args.animate})
-            warned.append(frame.warnings)
-            frames.append(frame.rgba8(frame_background(args.output, background)))
-            advance(k + 1)
-    print(f"wrote {save_animation(frames, args.output)} ({len(frames)} frames)")
+    count = args.animate
+    frames = (draw(camera, **{ANIMATION_TIME: k / count}) for k in range(count))
+    _, warned, written = _stream_frames(args.output, "animate", frames, count, background)
+    print(f"wrote {written} ({count} frames)")
     _print_frame_warnings(warned, "frame")
     return 0
+
+
+def _stream_frames(path, description: str, frames, count: int, background):
+    """Draw ``frames`` (an iterator of ``count`` Frames) into the animation at ``path`` one
+    at a time, with progress, so streamed formats hold one frame at a time; returns the
+    numbers (from 1) of the frames that cover no pixel, each frame's warnings and what was
+    written."""
+    from ..animation import frame_background, save_animation
+    from ..progress import progress_bar
+
+    empty, warned = [], []
+    over = frame_background(path, background)
+    with progress_bar(description, count) as advance:
+        def picture(k: int, frame):
+            if frame.stats["covered"] == 0:
+                empty.append(str(k + 1))
+            warned.append(frame.warnings)
+            advance(k + 1)
+            return frame.rgba8(over)
+
+        written = save_animation(itertools.starmap(picture, enumerate(frames)), path, count)
+    return empty, warned, written
 
 
 def _write_stats(args, frame, counted) -> None:
@@ -290,7 +314,6 @@ def _write_stats(args, frame, counted) -> None:
              **counted.stats, **frame.stats}
     with atomic_path(args.stats) as tmp:
         tmp.write_text(json.dumps(stats, indent=2) + "\n")
-    print(f"wrote {args.stats}")
 
 
 def cmd_compare(args) -> int:
@@ -356,11 +379,23 @@ def cmd_info(args) -> int:
     if args.file:
         report["file"] = _describe_file(args.file)
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json.dumps(_finite_or_null(report), indent=2, allow_nan=False))
     else:
         for section in report.values():
             _print_section(section)
     return 0
+
+
+def _finite_or_null(value):
+    """``value`` with every NaN and infinity as None: strict JSON has no such numbers (a
+    forged file's params may hold them)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: _finite_or_null(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_or_null(item) for item in value]
+    return value
 
 
 def _print_section(section: dict) -> None:

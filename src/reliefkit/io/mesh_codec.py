@@ -136,23 +136,23 @@ register(Codec(
 
 #: The arrays of a base mesh that a representation builds its volume on (a shell, a
 #: displacement volume): world positions, triangles, the normals it extrudes along, uvs.
-BASE_MESH_ARRAYS = {
-    "positions": ArraySpec(("float64",), ndim=2, trailing=(3,), finite=True),
-    "indices": ArraySpec(("int32",), ndim=2, trailing=(3,)),
-    "normals": ArraySpec(("float32",), ndim=2, trailing=(3,), finite=True),
-    "uvs": ArraySpec(("float32",), ndim=2, trailing=(2,), finite=True),
-}
 MAX_BASE_VERTICES = 1 << 22
 MAX_BASE_TRIANGLES = 1 << 22
+BASE_MESH_ARRAYS = {
+    "positions": ArraySpec(("float64",), ndim=2, trailing=(3,), finite=True,
+                           max_size=3 * MAX_BASE_VERTICES),
+    "indices": ArraySpec(("int32",), ndim=2, trailing=(3,), max_size=3 * MAX_BASE_TRIANGLES),
+    "normals": ArraySpec(("float32",), ndim=2, trailing=(3,), finite=True,
+                         max_size=3 * MAX_BASE_VERTICES),
+    "uvs": ArraySpec(("float32",), ndim=2, trailing=(2,), finite=True,
+                     max_size=2 * MAX_BASE_VERTICES),
+}
 
 
 def check_base_arrays(arrays: dict, kind: str, per_vertex=("normals", "uvs")) -> int:
-    """Refuse a base over the size caps or whose per-vertex arrays (``per_vertex``) have
-    another length than ``positions``; returns the vertex count."""
+    """Refuse a base whose per-vertex arrays (``per_vertex``) have another length than
+    ``positions`` (the size caps are `BASE_MESH_ARRAYS`' own); returns the vertex count."""
     count = len(arrays["positions"])
-    if count > MAX_BASE_VERTICES or len(arrays["indices"]) > MAX_BASE_TRIANGLES:
-        raise FormatError(f"a {kind}'s base has at most {MAX_BASE_VERTICES} vertices and "
-                          f"{MAX_BASE_TRIANGLES} triangles")
     for key in per_vertex:
         if len(arrays[key]) != count:
             raise FormatError(f"{kind} array '{key}' has {len(arrays[key])} rows, the base "

@@ -87,6 +87,8 @@ class ArraySpec:
     required : whether every file of the kind must hold the array.
     finite : whether NaN and Inf are forbidden (checked on write and after reading).
     trailing : fixed trailing dimensions, ``None`` for a free one, e.g. ``(4, 4)``.
+    max_size : the most elements the kind accepts (its own limits, such as a texture's
+        texels), or None; checked on the declared shape, before any data is inflated.
     """
 
     dtypes: tuple[str, ...]
@@ -94,6 +96,7 @@ class ArraySpec:
     required: bool = True
     finite: bool = False
     trailing: tuple[int | None, ...] | None = None
+    max_size: int | None = None
 
 
 #: The optional array of a baked representation that keeps its source mesh's bounds, so
@@ -113,6 +116,9 @@ class Codec:
     to_arrays : ``rep -> (arrays, params)``; optional arrays may be left out or None.
     from_arrays : ``(arrays, params) -> rep``; gets validated arrays only.
     version : the kind's own version; files with a newer one are refused.
+    check_shapes : ``{name: shape} -> None``, raising `FormatError` where the arrays' shapes
+        disagree (a colour image not the size of its height field), or None; run on the
+        declared shapes before anything is inflated, and before writing.
     """
 
     kind: str
@@ -121,6 +127,7 @@ class Codec:
     to_arrays: Callable[[object], tuple[dict[str, np.ndarray], dict]]
     from_arrays: Callable[[dict[str, np.ndarray], dict], object]
     version: int = 1
+    check_shapes: Callable[[dict[str, tuple[int, ...]]], None] | None = None
 
 
 @dataclass(frozen=True)
@@ -254,6 +261,9 @@ def _check_array(kind: str, name: str, spec: ArraySpec, dtype: np.dtype, shape: 
     if not ok:
         raise FormatError(f"array '{name}' has shape {tuple(shape)}; kind '{kind}' expects "
                           f"{_expected_shape(spec)}")
+    if spec.max_size is not None and math.prod(shape) > spec.max_size:
+        raise FormatError(f"array '{name}' has shape {tuple(shape)}, {math.prod(shape):,} "
+                          f"elements; kind '{kind}' takes at most {spec.max_size:,}")
 
 
 def _check_array_set(codec: Codec, names: Iterable[str]) -> None:
@@ -371,6 +381,8 @@ def _prepare_arrays(codec: Codec, arrays) -> dict[str, np.ndarray]:
         if spec.finite:
             _check_finite(name, arr)
         out[name] = arr.astype(arr.dtype.newbyteorder("<"), order="C", copy=False)
+    if codec.check_shapes is not None:
+        codec.check_shapes({name: arr.shape for name, arr in out.items()})
     return out
 
 
@@ -549,6 +561,8 @@ def _inspect(archive: _Archive, max_bytes: int | None):
     spans = _layout(archive, infos.values())
     members = {name: _inspect_member(archive, codec, name, entry, spans[f"{name}.npy"])
                for name, entry in entries.items()}
+    if codec.check_shapes is not None:
+        codec.check_shapes({name: member.shape for name, member in members.items()})
     total = sum(m.nbytes for m in members.values())
     if max_bytes is not None and total > max_bytes:
         raise FormatError(f"arrays declare {total / 2**30:.2f} GiB, over the "

@@ -5,7 +5,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from reliefkit.errors import UsageError
+from reliefkit.errors import FormatError, UsageError
 from reliefkit.techniques.shellvolume.filtering import (
     mip_pyramid,
     naive_pyramid,
@@ -64,13 +64,13 @@ def test_load_npy_round_trip(tmp_path):
 def test_load_npy_refuses_bad_arrays(tmp_path, bad):
     path = tmp_path / "bad.npy"
     np.save(path, bad)
-    with pytest.raises(UsageError) as info:
+    with pytest.raises(FormatError) as info:
         load_texture_npy(path)
     assert "\n" not in str(info.value)
 
 
 def test_load_npy_refuses_directory_and_forged_header(tmp_path):
-    with pytest.raises(UsageError):
+    with pytest.raises(FormatError):
         load_texture_npy(tmp_path)
     path = tmp_path / "forged.npy"
     header = {"descr": "<f4", "fortran_order": False, "shape": (10000, 10000, 10000, 4)}
@@ -79,7 +79,7 @@ def test_load_npy_refuses_directory_and_forged_header(tmp_path):
         f.write(b"\0" * 64)
     tracemalloc.start()
     try:
-        with pytest.raises(UsageError, match="voxels"):
+        with pytest.raises(FormatError, match="voxels"):
             load_texture_npy(path)
         _, peak = tracemalloc.get_traced_memory()
     finally:

@@ -26,14 +26,16 @@ MAX_BOXES = 256  # a DMBBC's boxes (the paper's have 8 to 31)
 
 
 def _rows(dtype: str, cols: int) -> ArraySpec:
-    return ArraySpec((dtype,), ndim=2, trailing=(cols,), finite=True)
+    """One row per rectangle, at most `MAX_RECTANGLES` (refused before inflating)."""
+    return ArraySpec((dtype,), ndim=2, trailing=(cols,), finite=True,
+                     max_size=cols * MAX_RECTANGLES)
 
 
 CLOUD_ARRAYS = {
     "corners": _rows("float64", 3),
     "u_axes": _rows("float64", 3),
     "v_axes": _rows("float64", 3),
-    "rects": ArraySpec(("int32",), ndim=2, trailing=(5,)),
+    "rects": ArraySpec(("int32",), ndim=2, trailing=(5,), max_size=5 * MAX_RECTANGLES),
     "color": ArraySpec(("uint8",), ndim=4, trailing=(None, None, 4)),
     "normal": ArraySpec(("uint8",), ndim=4, trailing=(None, None, 3)),
     "source_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False,
@@ -54,9 +56,6 @@ def _cloud_from_arrays(arrays: dict, params: dict) -> BillboardCloud:
     if isinstance(epsilon, bool) or not isinstance(epsilon, int | float):
         raise FormatError(f"billboard-cloud param 'epsilon_world' must be a number, got "
                           f"{epsilon!r}")
-    if len(arrays["corners"]) > MAX_RECTANGLES:
-        raise FormatError(f"a billboard cloud has at most {MAX_RECTANGLES} rectangles, the "
-                          f"file has {len(arrays['corners'])}")
     try:
         return BillboardCloud(arrays["corners"], arrays["u_axes"], arrays["v_axes"],
                               arrays["rects"], arrays["color"], arrays["normal"], epsilon,

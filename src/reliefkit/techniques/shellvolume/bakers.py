@@ -9,7 +9,7 @@ import numpy as np
 from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
 from ...bake.uv_atlas import MAX_MATERIALS, has_material, material_atlas
 from ...core.params import param
-from ...errors import UsageError
+from ...errors import FormatError, UsageError
 from .representation import TexturedShell, check_tetrahedron_count
 from .shell import fitted_thickness, unusable_triangles
 from .textures import TEXTURES, load_texture_npy, texture_from_mesh
@@ -56,7 +56,9 @@ def make_texture(spec: str, size, thickness: float, progress=None):
     from ...scene.mesh import RenderMesh
 
     if not spec.startswith(DEMO_PREFIX) and not Path(spec).is_file():
-        raise UsageError(f"--texture {spec}: not one of {', '.join(TEXTURES)}, and no such "
+        # a name with a suffix is a file's, so a missing input (exit 1); else a bad value
+        error = FormatError if Path(spec).suffix else UsageError
+        raise error(f"--texture {spec}: not one of {', '.join(TEXTURES)}, and no such "
                          "file (give a generated texture's name, a .npy volume or a mesh)")
     mesh = load_input(spec)
     if not isinstance(mesh, RenderMesh):

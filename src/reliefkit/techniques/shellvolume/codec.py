@@ -16,21 +16,30 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas
+from ...bake.uv_atlas import ATLAS_SIZE, MAX_MATERIALS, MaterialAtlas
 from ...errors import FormatError, MeshError, UsageError
-from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
+from ...io.mesh_codec import (
+    BASE_MESH_ARRAYS,
+    MAX_BASE_TRIANGLES,
+    MAX_BASE_VERTICES,
+    check_base_arrays,
+)
 from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .representation import TexturedShell
 from .textures import MAX_VOXELS, VolumeTexture
 
 ARRAYS = BASE_MESH_ARRAYS | {
-    "thickness": ArraySpec(("float64",), ndim=1, finite=True),
-    "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True),
-    "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True),
-    "texture_glow": ArraySpec(("float32",), ndim=3, required=False, finite=True),
+    "thickness": ArraySpec(("float64",), ndim=1, finite=True, max_size=MAX_BASE_VERTICES),
+    "texture_rgba": ArraySpec(("float32",), ndim=4, trailing=(4,), finite=True,
+                              max_size=4 * MAX_VOXELS),
+    "texture_normal": ArraySpec(("float32",), ndim=4, trailing=(3,), finite=True,
+                                max_size=3 * MAX_VOXELS),
+    "texture_glow": ArraySpec(("float32",), ndim=3, required=False, finite=True,
+                              max_size=MAX_VOXELS),
     "source_bounds": SOURCE_BOUNDS,
-    "surface": ArraySpec(("uint8",), ndim=4, trailing=(4,), required=False),
-    "material": ArraySpec(("uint16",), ndim=1, required=False),
+    "surface": ArraySpec(("uint8",), ndim=4, trailing=(4,), required=False,
+                         max_size=4 * MAX_MATERIALS * ATLAS_SIZE ** 2),
+    "material": ArraySpec(("uint16",), ndim=1, required=False, max_size=MAX_BASE_TRIANGLES),
 }
 
 
@@ -67,10 +76,7 @@ def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
         raise FormatError(f"shell-volume param 'tile' must be two whole numbers, got {tile!r}")
     positions = arrays["positions"]
     count = check_base_arrays(arrays, "shell-volume", ("normals", "uvs", "thickness"))
-    rgba = arrays["texture_rgba"]
-    if int(np.prod(rgba.shape[:3])) > MAX_VOXELS:
-        raise FormatError(f"a shell's texture has at most {MAX_VOXELS} voxels, got "
-                          f"{rgba.shape[:3]}")
+    rgba = arrays["texture_rgba"]  # at most MAX_VOXELS: ARRAYS' max_size
     surface, material = _surface(arrays, params.pop("surface_box", None),
                                  len(arrays["indices"]))
     try:

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage
 
-from ...errors import UsageError
+from ...errors import FormatError, UsageError
 from ...io.npy import npy_header
 
 #: Largest voxel count ``load_texture_npy`` accepts (256^3 voxels).
@@ -403,34 +403,34 @@ def load_texture_npy(path, name: str | None = None) -> VolumeTexture:
         fd = os.open(path, flags)
     except OSError as exc:
         reason = exc.strerror
-        raise UsageError(f"cannot open texture {path}: {reason}; use a regular .npy") from None
+        raise FormatError(f"cannot open texture {path}: {reason}; use a regular .npy") from None
     info = os.fstat(fd)
     if not stat.S_ISREG(info.st_mode):
         os.close(fd)
-        raise UsageError(f"texture {path} is not a regular file; give a .npy file")
+        raise FormatError(f"texture {path} is not a regular file; give a .npy file")
     with os.fdopen(fd, "rb") as f:
         try:
             shape, fortran, dtype = npy_header(f)
         except ValueError as exc:
-            raise UsageError(f"texture {path} is not a valid .npy file ({exc})") from None
+            raise FormatError(f"texture {path} is not a valid .npy file ({exc})") from None
         if len(shape) != 4 or shape[3] != 4 or min(shape) < 1:
-            raise UsageError(f"texture {path} has shape {shape}; expected (D, H, W, 4)")
+            raise FormatError(f"texture {path} has shape {shape}; expected (D, H, W, 4)")
         voxels = int(shape[0]) * int(shape[1]) * int(shape[2])
         if voxels > MAX_VOXELS:
-            raise UsageError(f"texture {path} claims {voxels} voxels, over the {MAX_VOXELS} limit")
+            raise FormatError(f"texture {path} claims {voxels} voxels, over the {MAX_VOXELS} limit")
         if dtype not in (np.dtype("<f4"), np.dtype("<f8")) or fortran:
             order = " (Fortran order)" if fortran else ""
-            raise UsageError(f"texture {path} has dtype {dtype}{order}; "
+            raise FormatError(f"texture {path} has dtype {dtype}{order}; "
                              "expected little-endian float32/float64 in C order")
         count = voxels * 4
         if info.st_size - f.tell() != count * dtype.itemsize:
-            raise UsageError(f"texture {path} is truncated or has trailing data for shape {shape}")
+            raise FormatError(f"texture {path} is truncated or has trailing data for shape {shape}")
         data = np.fromfile(f, dtype=dtype, count=count)
     rgba = data.reshape(shape).astype(np.float32)
     if not np.isfinite(rgba).all():
-        raise UsageError(f"texture {path} contains NaN or Inf values")
+        raise FormatError(f"texture {path} contains NaN or Inf values")
     if (rgba[..., 3] < 0).any() or (rgba[..., 3] > 1).any():
-        raise UsageError(f"texture {path} has alpha outside [0, 1]")
+        raise FormatError(f"texture {path} has alpha outside [0, 1]")
     if (rgba[..., :3] < 0).any():
-        raise UsageError(f"texture {path} has negative colour values")
+        raise FormatError(f"texture {path} has negative colour values")
     return VolumeTexture(rgba, density_normals(rgba[..., 3]), name or path.stem)

@@ -16,11 +16,15 @@ from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .depth_images import MAX_RESOLUTION, DepthImages, check_side, face_boxes
 from .representation import DepthObject, VisualHull
 
+_TEXELS = 6 * MAX_RESOLUTION**2  # six faces of N x N
 ARRAYS = {
-    "depth": ArraySpec(("float32",), ndim=3, trailing=(None, None), finite=True),
-    "mask": ArraySpec(("uint8",), ndim=3, trailing=(None, None)),
-    "color": ArraySpec(("float32",), ndim=4, trailing=(None, None, 4), finite=True),
-    "normal": ArraySpec(("float32",), ndim=4, trailing=(None, None, 3), finite=True),
+    "depth": ArraySpec(("float32",), ndim=3, trailing=(None, None), finite=True,
+                       max_size=_TEXELS),
+    "mask": ArraySpec(("uint8",), ndim=3, trailing=(None, None), max_size=_TEXELS),
+    "color": ArraySpec(("float32",), ndim=4, trailing=(None, None, 4), finite=True,
+                       max_size=4 * _TEXELS),
+    "normal": ArraySpec(("float32",), ndim=4, trailing=(None, None, 3), finite=True,
+                        max_size=3 * _TEXELS),
     "cube_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
     "source_bounds": SOURCE_BOUNDS,
 }
@@ -46,20 +50,33 @@ def _check_cube(cube: np.ndarray) -> None:
         raise FormatError(str(exc)) from None
 
 
+def _name(cls) -> str:
+    return "visual hull" if cls.hull else "depth object"
+
+
+def _shape_checker(cls):
+    """Six N x N faces in every image (on the declared shapes: before reading)."""
+    kind = _name(cls)
+
+    def check_shapes(shapes: dict) -> None:
+        n = shapes["depth"][-1]
+        if shapes["depth"] != (6, n, n) or not 2 <= n <= MAX_RESOLUTION:
+            raise FormatError(f"{kind}: depth must be (6, N, N) with N in [2, "
+                              f"{MAX_RESOLUTION}], got {shapes['depth']}")
+        for name, shape in (("mask", (6, n, n)), ("color", (6, n, n, 4)),
+                            ("normal", (6, n, n, 3))):
+            if shapes[name] != shape:
+                raise FormatError(f"{kind}: {name} must have shape {shape}, got "
+                                  f"{shapes[name]}")
+
+    return check_shapes
+
+
 def _decoder(cls):
-    kind = "visual hull" if cls.hull else "depth object"
+    kind = _name(cls)
 
     def from_arrays(arrays: dict, params: dict) -> DepthObject:
         depth, mask = arrays["depth"], arrays["mask"]
-        n = depth.shape[-1]
-        if depth.shape != (6, n, n) or not 2 <= n <= MAX_RESOLUTION:
-            raise FormatError(f"{kind}: depth must be (6, N, N) with N in [2, "
-                              f"{MAX_RESOLUTION}], got {depth.shape}")
-        for name, shape in (("mask", (6, n, n)), ("color", (6, n, n, 4)),
-                            ("normal", (6, n, n, 3))):
-            if arrays[name].shape != shape:
-                raise FormatError(f"{kind}: {name} must have shape {shape}, got "
-                                  f"{arrays[name].shape}")
         if mask.max(initial=0) > 1:
             raise FormatError(f"{kind}: mask values must be 0 or 1")
         cube = arrays["cube_to_world"]
@@ -75,5 +92,5 @@ def _decoder(cls):
 
 
 CODECS = tuple(Codec(kind=kind, cls=cls, arrays=ARRAYS, to_arrays=_to_arrays,
-                     from_arrays=_decoder(cls), version=1)
+                     from_arrays=_decoder(cls), version=1, check_shapes=_shape_checker(cls))
                for kind, cls in (("depth-object", DepthObject), ("visual-hull", VisualHull)))

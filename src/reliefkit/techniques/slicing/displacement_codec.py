@@ -18,8 +18,9 @@ from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
 ARRAYS = BASE_MESH_ARRAYS | {
-    "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True),
-    "height": ArraySpec(("float32",), ndim=2, finite=True),
+    "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True,
+                       max_size=4 * MAX_TEXELS),
+    "height": ArraySpec(("float32",), ndim=2, finite=True, max_size=MAX_TEXELS),
     "source_bounds": SOURCE_BOUNDS,
 }
 OWN = ("scale", "tile", "wrap")
@@ -39,6 +40,13 @@ def _number(value) -> bool:
         np.isfinite(value))
 
 
+def _check_shapes(shapes: dict) -> None:
+    """The colour image is the height field's size (on the declared shapes: before reading)."""
+    if shapes["color"] != (*shapes["height"], 4):
+        raise FormatError(f"displacement arrays 'color' {shapes['color']} and 'height' "
+                          f"{shapes['height']} must be (H, W, 4) and (H, W)")
+
+
 def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
     from ...scene.mesh import RenderMesh
 
@@ -56,10 +64,6 @@ def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
     positions = arrays["positions"]
     count = check_base_arrays(arrays, "displacement map")
     height, color = arrays["height"], arrays["color"]
-    if height.size > MAX_TEXELS or color.shape != (*height.shape, 4):
-        raise FormatError(f"displacement arrays 'color' {color.shape} and 'height' "
-                          f"{height.shape} must be (H, W, 4) and (H, W), at most "
-                          f"{MAX_TEXELS} texels")
     if height.size and (height.min() < 0 or height.max() > 1):
         raise FormatError("displacement array 'height' must lie in [0, 1]")
     if color.size and (color.min() < 0 or color.max() > 1):
@@ -76,4 +80,4 @@ def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
 
 
 CODECS = (Codec(kind="displacement", cls=DisplacementMap, arrays=ARRAYS, to_arrays=_to_arrays,
-                from_arrays=_from_arrays, version=1),)
+                from_arrays=_from_arrays, version=1, check_shapes=_check_shapes),)
