@@ -101,15 +101,16 @@ def write_obj_quad(folder, mtl_text: str, material: str, positions, uvs, name: s
     return folder / f"{name}.obj"
 
 
-def run_cli(*args, cwd=None, env=None):
-    """``reliefkit ARGS`` in a fresh interpreter (stdout, stderr and the exit status)."""
+def run_cli(*args, cwd=None, env=None, **kw):
+    """``reliefkit ARGS`` in a fresh interpreter (stdout, stderr and the exit status); ``env``
+    adds to the environment, other keywords go to `subprocess.run`."""
     import os
     import subprocess
     import sys
 
     return subprocess.run([sys.executable, "-m", "reliefkit.cli", *map(str, args)],
                           capture_output=True, text=True, timeout=300, cwd=cwd,
-                          env=None if env is None else {**os.environ, **env})
+                          env=None if env is None else {**os.environ, **env}, **kw)
 
 
 def assert_one_line_error(result, *words, code=None):

@@ -7,21 +7,7 @@ import sys
 import numpy as np
 import pytest
 import trimesh
-
-
-def run_cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "reliefkit.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=300, cwd=cwd)
-
-
-def assert_one_line_error(result, *words, code=None):
-    assert result.returncode != 0
-    assert code is None or result.returncode == code, (result.returncode, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    assert "Traceback" not in result.stderr
-    for word in words:
-        assert word in lines[0], lines[0]
+from helpers import assert_one_line_error, run_cli
 
 
 @pytest.fixture(scope="module")

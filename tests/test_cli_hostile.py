@@ -14,22 +14,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import assert_one_line_error, run_cli
 
 from reliefkit import cli
-
-
-def run_cli(*args, cwd=None, **kw):
-    return subprocess.run([sys.executable, "-m", "reliefkit.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=300, cwd=cwd, **kw)
-
-
-def assert_one_line_error(result, *words, code=None):
-    assert result.returncode != 0, result.stdout
-    assert code is None or result.returncode == code, (result.returncode, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    for word in words:
-        assert word in lines[0], lines[0]
 
 
 @pytest.fixture(scope="module")

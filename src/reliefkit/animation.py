@@ -26,7 +26,7 @@ import numpy as np
 
 from .errors import UsageError
 from .gl.targets import host_limit
-from .io.atomic import atomic_path, check_writable
+from .io.atomic import atomic_path, check_writable, written_together
 from .pictures import TILE_BACKGROUND
 
 FPS = 15.0
@@ -115,20 +115,26 @@ def save_animation(frames, path, count: int, fps: float = FPS) -> str:
 
 
 def _save_sequence(frames, path, found: str, count: int) -> str:
+    """One PNG per frame, all moved into place together at the end (`written_together`): an
+    interrupted or failed sequence leaves none of its frames."""
     from PIL import Image
 
     if found == FOLDER:
-        folder = Path(path)
-        folder.mkdir(parents=True, exist_ok=True)
         digits = max(4, len(str(count - 1)))
-        names = [folder / f"{k:0{digits}d}.png" for k in range(count)]
+        names = [Path(path) / f"{k:0{digits}d}.png" for k in range(count)]
     else:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
         names = [Path(str(path) % k) for k in range(count)]
-    for name, rgba in zip(names, frames, strict=True):
-        with atomic_path(name) as tmp:
-            Image.fromarray(rgba, "RGBA").save(tmp, format="PNG")
-    return str(names[0]) if len(names) == 1 else f"{names[0]} ... {names[-1]}"
+    names[0].parent.mkdir(parents=True, exist_ok=True)
+    written = 0
+    with written_together():
+        for rgba in frames:  # not zip or enumerate: they hold the last frame while drawing
+            with atomic_path(names[written]) as tmp:
+                Image.fromarray(rgba, "RGBA").save(tmp, format="PNG")
+            del rgba  # released before the next frame is drawn
+            written += 1
+        if written != count:
+            raise ValueError(f"{count} frames were to be written, {written} came")
+    return str(names[0]) if count == 1 else f"{names[0]} ... {names[-1]}"
 
 
 def _images(frames):
@@ -186,15 +192,13 @@ def _save_gif(frames, path, fps: float) -> None:
 
 
 def _save_mp4(frames, path, fps: float) -> None:
-    import itertools
-
     import imageio_ffmpeg
 
     frames = iter(frames)
-    first = next(frames, None)
-    if first is None:
+    rgba = next(frames, None)
+    if rgba is None:
         raise UsageError(f"{path}: an animation needs at least one frame")
-    height, width = first.shape[:2]
+    height, width = rgba.shape[:2]
     with atomic_path(path) as tmp:
         writer = imageio_ffmpeg.write_frames(
             str(tmp), (width, height), fps=fps, codec="libx264", pix_fmt_in="rgb24",
@@ -202,8 +206,10 @@ def _save_mp4(frames, path, fps: float) -> None:
             ffmpeg_log_level="error", quality=8)
         try:
             writer.send(None)
-            for rgba in itertools.chain([first], frames):
+            while rgba is not None:
                 writer.send(np.ascontiguousarray(rgba[..., :3]).tobytes())
+                del rgba  # released before the next frame is drawn
+                rgba = next(frames, None)
             writer.close()
         except RuntimeError as exc:  # ffmpeg's own failure, in many lines: keep its last
             last = str(exc).strip().splitlines()[-1] if str(exc).strip() else "failed"

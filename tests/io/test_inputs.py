@@ -34,7 +34,7 @@ def test_public_load_mesh_takes_demo_names():
 
 
 def test_public_load_mesh_names_the_demo_assets_when_one_is_unknown():
-    with pytest.raises(UsageError, match="unknown asset 'nope'.*blob"):
+    with pytest.raises(MeshError, match="demo:nope: unknown asset 'nope'.*blob"):
         rk.load_mesh("demo:nope")
 
 

@@ -213,6 +213,7 @@ def _check_render_outputs(args) -> None:
     """The output names fit what is written; per-frame outputs do not go with --turntable
     or --animate."""
     from ..animation import is_animation_name
+    from ..io.atomic import check_writable
 
     suffix = Path(args.output).suffix.lower()
     if args.turntable is not None and args.animate is not None:
@@ -233,7 +234,9 @@ def _check_render_outputs(args) -> None:
             raise UsageError(f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not "
                              f"apply to {sequence} (one frame's arrays and counters): render "
                              "a single --view for them")
-    elif suffix != ".png" or is_animation_name(args.output):
+    else:
+        check_writable(args.output, "-o")  # a folder or a name ending in '/' is named so
+    if not sequence and (suffix != ".png" or is_animation_name(args.output)):
         hint = (": an animation (.gif, .png/.apng, .webp, .mp4 or a PNG per frame) needs "
                 "--turntable N or --animate N" if is_animation_name(args.output) else "")
         raise UsageError(f"output must be a .png file, got {args.output}{hint}")
@@ -241,10 +244,7 @@ def _check_render_outputs(args) -> None:
         raise UsageError(f"--stats writes JSON: name the file *.json, got {args.stats}")
     if args.aovs and Path(args.aovs).suffix.lower() != ".npz":
         raise UsageError(f"--aovs writes NumPy arrays: name the file *.npz, got {args.aovs}")
-    from ..io.atomic import check_writable
-
-    for flag, value in (("-o", None if sequence else args.output), ("--aovs", args.aovs),
-                        ("--stats", args.stats)):
+    for flag, value in (("--aovs", args.aovs), ("--stats", args.stats)):
         if value:
             check_writable(value, flag)
 

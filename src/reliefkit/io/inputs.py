@@ -28,16 +28,20 @@ def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
 
     `name` labels the mesh in pictures and messages (default: the file name without its
     extension, or the asset's own name). Raises `MeshError` for a file that cannot be
-    loaded, `UsageError` for an unknown demo name.
+    loaded or an unknown demo name.
     """
     if not _is_demo(spec):
         from ..scene.loader import load_mesh as load_mesh_file
 
         return load_mesh_file(spec, name=name)
+    from ..errors import MeshError, UsageError
     from ..scene.assets import make_asset
     from ..scene.mesh import RenderMesh
 
-    mesh = make_asset(spec[len(DEMO_PREFIX):])
+    try:
+        mesh = make_asset(spec[len(DEMO_PREFIX):])
+    except UsageError as exc:  # an unknown name: a missing input (exit 1), not a bad flag
+        raise MeshError(f"{spec}: {exc}") from None
     if name is None:
         return mesh
     return RenderMesh(mesh.positions, mesh.indices, mesh.normals, mesh.colors, mesh.uvs,

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 import trimesh
-from test_cli import assert_one_line_error, run_cli
+from helpers import assert_one_line_error, run_cli
 
 from reliefkit.io.rk import load
 from reliefkit.techniques.shellvolume.representation import TexturedShell

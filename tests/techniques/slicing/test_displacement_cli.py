@@ -10,7 +10,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from test_cli import assert_one_line_error, run_cli
+from helpers import assert_one_line_error, run_cli
 
 from reliefkit.errors import FormatError
 from reliefkit.io import rk
