@@ -16,7 +16,7 @@ from PIL import Image
 
 import reliefkit as rk
 from reliefkit.cli import main
-from reliefkit.errors import MeshError, UsageError
+from reliefkit.errors import MeshError
 from reliefkit.scene.assets import make_asset
 
 TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
