@@ -234,6 +234,32 @@ def test_box_with_a_mesh_is_refused_in_one_line(tmp_path, capsys, box):
     assert len(err.splitlines()) == 1 and err.startswith("error:") and "--box" in err
 
 
+@pytest.mark.parametrize("flags", [["--depth-res", "64"], ["--color-res", "32"],
+                                   ["--axis", "y"], ["--axis", "z", "--depth-res", "256"]])
+def test_mesh_options_with_a_heightmap_are_refused_in_one_line(tmp_path, capsys, flags):
+    """A heightmap keeps its own size and its y axis: these flags were silently ignored
+    (their defaults included)."""
+    from reliefkit import cli
+
+    heights = tmp_path / "h.npy"
+    np.save(heights, np.random.default_rng(0).random((12, 12)).astype(np.float32))
+    out = tmp_path / "h.rk"
+    code = cli.main(["bake", str(heights), "--as", "relief", "--no-safety", *flags,
+                     "-o", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and not out.exists()
+    assert len(err.splitlines()) == 1 and err.startswith("error:")
+    assert all(flag in err for flag in flags if flag.startswith("--")), err
+
+
+def test_a_mesh_relief_keeps_its_defaults_when_none_are_given(gl):
+    from reliefkit import bake
+    from reliefkit.scene.assets import make_asset
+
+    relief = bake(make_asset("blob"), "relief", safety=False)
+    assert max(relief.height.shape) == 256 and relief.params["axis"] == "y"
+
+
 @pytest.mark.parametrize("kind", ["relief", "relief-frustum", "relief-cube"])
 def test_default_bakes_leave_out_radii_that_the_default_render_never_reads(gl, kind):
     """Robust draws fields with W + H <= 256 with the exact walk: a default bake of such a

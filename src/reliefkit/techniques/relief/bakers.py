@@ -76,14 +76,20 @@ def _axis():
     return param("y", "projection axis (the heightfield's up direction)", choices=AXES)
 
 
+MESH_DEPTH_RES, MESH_AXIS = 256, "y"  # a mesh's orthographic relief when none are given
+
+
 @dataclass(frozen=True)
 class ReliefParams:
-    depth_res: int = _depth_res(256)
+    depth_res: int | None = param(None, "heightfield resolution (longest side, texels) (none: "
+                                  f"{MESH_DEPTH_RES}; a heightmap keeps its own size)",
+                                  kind="int", lo=8, hi=8192)
     color_res: int | None = _color_res()
     safety: bool | None = _safety()
     safety_tolerance: float = _tolerance()
     safety_octants: bool = _octants()
-    axis: str = _axis()
+    axis: str | None = param(None, "projection axis (the heightfield's up direction) (none: "
+                             f"{MESH_AXIS}; a heightmap's is y)", kind="str", choices=AXES)
     box: tuple | None = param(None, "heightmaps only: world size SX,SY,SZ of the box (none: "
                               f"{','.join(f'{s:g}' for s in HEIGHTMAP_BOX)}); a mesh keeps "
                               "its own size",
@@ -117,14 +123,21 @@ def bake_orthographic(source, p: ReliefParams, progress=None):
     if not heightmap and p.box is not None:
         raise UsageError("--box sets a heightmap's world size; a mesh's relief keeps the "
                          "mesh's own size: drop --box (or scale the mesh)")
+    given = [flag for flag, value in (("--depth-res", p.depth_res), ("--color-res", p.color_res),
+                                      ("--axis", p.axis)) if value is not None]
+    if heightmap and given:
+        raise UsageError(f"{' and '.join(given)} {'shapes' if len(given) == 1 else 'shape'} "
+                         "a mesh's relief; a heightmap keeps its own size and its y axis: "
+                         "drop them (or resample the heightmap)")
+    depth_res, axis = p.depth_res or MESH_DEPTH_RES, p.axis or MESH_AXIS
     if safety is not False:
-        side = max(source.shape) if heightmap else p.depth_res
+        side = max(source.shape) if heightmap else depth_res
         check_safety_work(side, side)
     if heightmap:
         return relief_from_heights(source, size=p.box or HEIGHTMAP_BOX, safety=safety,
                                    tolerance=p.safety_tolerance, progress=progress,
                                    octants=p.safety_octants)
-    return bake_relief(source, p.depth_res, p.color_res, p.axis, safety=safety,
+    return bake_relief(source, depth_res, p.color_res, axis, safety=safety,
                        tolerance=p.safety_tolerance, progress=progress,
                        octants=p.safety_octants)
 
