@@ -249,7 +249,8 @@ def texture_array(ctx, array: np.ndarray, *, what: str = "texture", srgb: bool =
     check_array_size(ctx, width, height, layers, what, nbytes=arr.size * itemsize)
     if srgb:
         arr = _srgb_to_linear_half(arr)
-    tex = ctx.texture_array((width, height, layers), comps, np.ascontiguousarray(arr).tobytes(),
+    # the array itself (buffer protocol): a bytes copy would double the host peak
+    tex = ctx.texture_array((width, height, layers), comps, np.ascontiguousarray(arr),
                             dtype=_DTYPES_ARRAY[arr.dtype])
     try:
         if filter == "nearest":

@@ -126,3 +126,21 @@ def test_a_mesh_too_small_for_float32_draws_is_refused(gl):
                       name="tiny box")
     with pytest.raises(UsageError, match="cube side must be within"):
         bake_depth_images(tiny, 8)
+
+
+def test_a_bake_over_the_host_memory_limit_is_refused_before_drawing(gl, monkeypatch):
+    """Res 32 needs 6 x 32² texels x 76 B = 456 KiB at its peak: with the host-memory limit
+    one byte below, it is refused with that estimate before any face is drawn; res 31 fits."""
+    import reliefkit.gl.targets as targets
+    import reliefkit.techniques.slicing.depth_images as depth_images
+
+    monkeypatch.setattr(targets, "host_limit", lambda: 6 * 32**2 * 76 - 1)
+    drawn = []
+    project = depth_images.project_mesh
+    monkeypatch.setattr(depth_images, "project_mesh",
+                        lambda *a, **k: drawn.append(1) or project(*a, **k))
+    with pytest.raises(UsageError, match=r"res 32: .*456\.0 KiB of host memory.* at most 31"):
+        bake_depth_images(box_mesh(), 32)
+    assert not drawn
+    assert bake_depth_images(box_mesh(), 31).resolution == 31
+    assert len(drawn) == 6

@@ -146,3 +146,22 @@ def test_images_too_large_to_hold_are_refused_with_their_estimate(tmp_path):
                          capture_output=True, text=True, timeout=300, preexec_fn=limit)
     assert_one_line_error(out, "res 8192", "12.4 GiB", "at most 4657", code=2)
     assert not (tmp_path / "x.rk").exists()
+
+
+def test_images_too_large_for_host_memory_are_refused_with_their_estimate(tmp_path):
+    """--res 4096 fits a .rk file but its bake peaks near 6 x 4096² x 76 B = 7.1 GiB, over
+    the host-memory limit (at most 4 GiB): refused before allocating, so a process limited
+    to 3 GiB of address space gets the estimate, not a crash."""
+    import subprocess
+    import sys
+
+    resource = pytest.importorskip("resource")
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+
+    out = subprocess.run([sys.executable, "-m", "reliefkit.cli", "bake", "demo:cup", "--as",
+                          "visual-hull", "--res", "4096", "-o", str(tmp_path / "x.rk")],
+                         capture_output=True, text=True, timeout=300, preexec_fn=limit)
+    assert_one_line_error(out, "res 4096", "7.1 GiB of host memory", "at most", code=2)
+    assert not (tmp_path / "x.rk").exists()

@@ -39,7 +39,7 @@ from ...gl.objects import GLObjects
 from ...gl.shaders import program
 from ...gl.textures import texture_array
 from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
-from .depth_images import FACE_INDEX
+from .depth_images import FACE_INDEX, check_memory
 from .representation import DepthObject
 from .slices import auto_slice_count, orthogonal_slices, screen_slices
 
@@ -131,18 +131,22 @@ class DepthObjectDrawable(GLObjects):
         self.cube_to_face = [np.linalg.inv(images.box_to_world[k]) @ images.cube_to_world
                              for k in range(6)]
         self.stats: dict = {}
+        check_memory(rep.resolution, "render")
         self._upload_owned(self._upload)
 
     def _upload(self) -> None:
         ctx, images, opts = self.ctx, self.rep.images, self.options
-        depth = np.where(images.mask, images.depth, EMPTY_DEPTH).astype(np.float32)
-        self.depth_tex = self.keep(texture_array(ctx, depth, what="depth images",
-                                                 filter="nearest"))
-        color = images.color.astype(np.float32)
-        premultiplied = np.concatenate([color[..., :3] * color[..., 3:], color[..., 3:]], -1)
-        self.color_tex = self.keep(texture_array(ctx, premultiplied.astype(np.float32),
+        # One host copy per upload at most, each freed before the next (`RENDER_TEXEL_BYTES`).
+        self.depth_tex = self.keep(texture_array(
+            ctx, np.where(images.mask, images.depth, np.float32(EMPTY_DEPTH)),
+            what="depth images", filter="nearest"))
+        premultiplied = images.color.astype(np.float32)
+        premultiplied[..., :3] *= premultiplied[..., 3:]
+        self.color_tex = self.keep(texture_array(ctx, premultiplied,
                                                  what="depth-image colours"))
-        self.normal_tex = self.keep(texture_array(ctx, images.normal.astype(np.float32),
+        del premultiplied
+        self.normal_tex = self.keep(texture_array(ctx, images.normal.astype(np.float32,
+                                                                            copy=False),
                                                   what="depth-image normals"))
         common = {"HULL": self.rep.hull, "TEXTURING_NEAREST": opts.texturing == "nearest",
                   "UNLIT": opts.unlit, "COUNT_ITERATIONS": bool(self.extra_attachments)}
