@@ -309,6 +309,29 @@ def test_shells_do_not_show_what_a_closed_model_hides(gl, variant):
     assert np.abs(frame.color[both, :3] - 0.5).max() < 0.02, f"red tint up to {tint.max():.3f}"
 
 
+@pytest.mark.parametrize("variant", ["shell", "thick-shell"])
+def test_shells_show_the_outward_surface_under_an_underside(gl, variant):
+    """A column along a wall: the underside of something closed beyond the box (the van's
+    window sill, facing -w, seen from the box on its belt line) above a surface facing +w
+    (the door's chamfer). From w = 1 the mesh shows the +w-facing one (the sill's top hides
+    the underside), and a thick shell seen from the side paints its one colour over the
+    whole interval: taking the underside's painted the glass down the van's doors."""
+    paint, glass = (0.1, 0.5, 0.2, 1.0), (0.02, 0.03, 0.05, 1.0)
+    mesh = quads(flat(0.0), flat(0.1, half=(0.9, 0.45), down=True), colours=[paint, glass])
+    (box,) = bake_boxes(mesh, variant, epsilon=0.05, texel_size=0.03).boxes
+    depth = box.resolution[2]
+    _, k_low = plane_w(box, flat(0.0)[:3])
+    _, k_high = plane_w(box, flat(0.1)[:3])
+    points = column_points(box)
+    both = (np.abs(points[..., 0]) < 0.85) & (np.abs(points[..., 1]) < 0.4)
+    assert (k_high > k_low + 1).all() and both.sum() > 100
+    assert np.abs(decoded_rgb(box.color[both]) - paint[:3]).max() < 0.01
+    assert (decoded_normal(box.normal[both])[:, 2] > 0.9).all()  # the +w-facing one's
+    if variant == "shell":
+        d = box.displacement[..., 0] / 65535
+        assert np.allclose(d[both], ((k_low + 0.5) / depth)[both], atol=1 / 65535)
+
+
 def test_a_thick_shell_of_stacked_quads_spans_both_cells(gl):
     mesh = stacked()
     boxes = bake_boxes(mesh, "thick-shell", epsilon=0.05, texel_size=0.03)

@@ -28,11 +28,14 @@ Choices (the paper leaves them open):
   surfaces that share a voxel. Solid-mode inside information is not used: a box holds a
   patch of the mesh, never closed.
 * The shells, with either choice, keep each column's outermost surface: the colour and
-  normal of its highest occupied voxel, the one seen first from the w = 1 side (the box's
-  outside), and, for the shell, the middle of the run of occupied voxels ending there as its
-  displacement. One colour and displacement per texel cannot show two surfaces, and those
-  below the outermost are hidden by it in the mesh (a roof's rafters, the far side of a
-  leg); averaging the whole column showed them through and put the shell between them.
+  normal of its highest occupied voxel facing +w (else of its highest), the one seen first
+  from the w = 1 side (the box's outside), and, for the shell, the middle of the run of
+  occupied voxels through it as its displacement. One colour and displacement per texel
+  cannot show two surfaces, and those below the outermost are hidden by it in the mesh (a
+  roof's rafters, the far side of a leg); averaging the whole column showed them through
+  and put the shell between them. A -w-facing voxel above it is the underside of something
+  closed beyond the box (from outside its top is seen, in another box): taking it painted a
+  van's window glass down its doors, where a box on the belt line runs along the wall.
 * Automatic shell thickness: the standard deviation of the acquired displacements over all
   covered texels of all boxes (the paper: "over all acquired texel positions"; one global
   value, as `BillboardBoxes` has one thickness), clamped to [1/D, 1] so a shell is at least
@@ -125,7 +128,7 @@ def bake_boxes(mesh: RenderMesh, variant: str = "volumetric", *, epsilon: float 
         box_to_world = plane_box(plane, plan.epsilon)
         voxels = _box_voxels(mesh, plane, box_to_world, depth, surfaces, ctx)
         transforms.append(box_to_world)
-        maps.append(_variant_maps(voxels, variant))
+        maps.append(_variant_maps(voxels, variant, plane.normal))
         report(faces + count + k + 1)
 
     shell = None
@@ -259,16 +262,20 @@ def _inside_box(mesh: RenderMesh, faces: np.ndarray, box_to_world: np.ndarray) -
 
 # -- the variants -----------------------------------------------------------------------
 
-def _variant_maps(voxels: _Voxels, variant: str) -> _Maps:
+def _variant_maps(voxels: _Voxels, variant: str, outward: np.ndarray) -> _Maps:
     if variant == "volumetric":
         return _Maps(_encode_color(voxels.color, voxels.occupied),
                      _encode_normal(voxels.normal), None)
     covered = voxels.occupied.any(axis=0)
     lowest, highest = _column_extremes(voxels.occupied)
-    color, normal = _outermost(voxels, highest)
+    outer = _outer_surface(voxels, highest, outward)
+    index = outer[None, ..., None]
+    color = np.take_along_axis(voxels.color, index, axis=0)[0]
+    normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
     d = voxels.depth
     if variant == "shell":
-        middle = (_outer_run_bottom(voxels.occupied, highest) + highest + 1) / 2 / d
+        bottom, top = _run_around(voxels.occupied, outer)
+        middle = (bottom + top + 1) / 2 / d
         displacement = _encode_w(np.where(covered, middle, 0.0))[..., None]
         return _Maps(_encode_color(color, covered), _encode_normal(normal), displacement)
     interval = np.stack([np.where(covered, lowest / d, 0.0),
@@ -284,24 +291,33 @@ def _column_extremes(occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return lowest, highest
 
 
-def _outer_run_bottom(occupied: np.ndarray, highest: np.ndarray) -> np.ndarray:
-    """(H, W) index of the lowest voxel of the run of occupied voxels that ends at
-    ``highest``: the outermost surface's extent in each column (a sloped sheet spans
-    several voxels; whatever lies below the first gap is another surface)."""
+def _outer_surface(voxels: _Voxels, highest: np.ndarray, outward: np.ndarray) -> np.ndarray:
+    """(H, W) index of each column's outermost surface seen from the box's outside: its
+    highest occupied voxel whose normal faces ``outward`` (+w), else its highest one.
+
+    A surface facing -w at the top of a column is the underside of something whose top
+    lies beyond the box (a window's sill, seen along a van's wall from a box on the belt
+    line); from w = 1 one sees the +w-facing surface below it, and a thick shell seen from
+    the side shows that colour over the whole interval (taking the sill's painted the glass
+    down the doors). Surfaces below the outermost are hidden by it in the mesh."""
+    d = voxels.depth
+    facing = voxels.occupied & (voxels.normal @ np.asarray(outward, np.float32) > 0)
+    faced = facing.any(axis=0)
+    top_facing = d - 1 - np.argmax(facing[::-1], axis=0)
+    return np.where(faced, top_facing, highest)
+
+
+def _run_around(occupied: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(H, W) lowest and highest voxel of the run of occupied voxels through ``index`` in
+    each column: one surface's extent (a sloped sheet spans several voxels; whatever lies
+    beyond a gap is another surface)."""
     d = occupied.shape[0]
-    gaps = ~occupied & (np.arange(d)[:, None, None] < highest[None])
-    return np.where(gaps.any(axis=0), d - np.argmax(gaps[::-1], axis=0), 0)
-
-
-def _outermost(voxels: _Voxels, highest: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(H, W, 4) colour and (H, W, 3) normal of each column's highest occupied voxel: the
-    surface seen from the box's outside. A shell stores one colour per texel, and the
-    surfaces below the outermost one are hidden behind it (a roof's rafters, a body's far
-    side); averaging them in would show what the mesh hides."""
-    index = highest[None, ..., None]
-    color = np.take_along_axis(voxels.color, index, axis=0)[0]
-    normal = np.take_along_axis(voxels.normal, index, axis=0)[0]
-    return color, normal
+    layer = np.arange(d)[:, None, None]
+    below = ~occupied & (layer < index[None])
+    above = ~occupied & (layer > index[None])
+    bottom = np.where(below.any(axis=0), d - np.argmax(below[::-1], axis=0), 0)
+    top = np.where(above.any(axis=0), np.argmax(above, axis=0) - 1, d - 1)
+    return bottom, top
 
 
 def _auto_thickness(maps: list[_Maps], depth: int) -> float:
