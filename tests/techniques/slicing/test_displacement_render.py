@@ -11,7 +11,11 @@ from reliefkit.render import render
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.slicing.displacement import DisplacementMap
 from reliefkit.techniques.slicing.displacement_bake import square_base
-from reliefkit.techniques.slicing.displacement_reference import reference_hits, wrong_hits
+from reliefkit.techniques.slicing.displacement_reference import (
+    reference_colors,
+    reference_hits,
+    wrong_hits,
+)
 from reliefkit.techniques.slicing.displacement_textures import terrain_colors, waves
 
 RES = 32
@@ -238,7 +242,7 @@ def baked_on(mesh, tmp_path):
 def test_the_surface_material_tints_every_slicing(gl, tmp_path):
     """Seen from above, each triangle's displacement is the texture's colour times that
     triangle's material factor, in every slicing, after a round trip through the .rk
-    file, and in the displaced mesh (the CPU ground truth)."""
+    file, in the exact CPU reference and in the displaced mesh (the CPU ground truth)."""
     from reliefkit.io.rk import load, save
     from reliefkit.scene.camera import Camera
 
@@ -261,6 +265,14 @@ def test_the_surface_material_tints_every_slicing(gl, tmp_path):
             np.testing.assert_allclose(frame.color[..., :3][side],
                                        np.broadcast_to(expected, (int(side.sum()), 3)),
                                        atol=5e-3, err_msg=mode)
+    ref = reference_colors(back, cam)  # the exact CPU reference, as the last slicing
+    both = frame.mask & ~np.isnan(ref[..., 0])
+    assert both.sum() > 0.9 * frame.mask.sum()
+    for side, factor in zip(sides, MATERIAL_COLORS, strict=True):
+        np.testing.assert_allclose(ref[side], np.broadcast_to(np.multiply(PAINT, factor),
+                                                              (int(side.sum()), 3)), atol=5e-3)
+    off_seam = both & (sides[0] | sides[1])  # on the seam a pixel may take either side
+    assert np.abs(frame.color[..., :3][off_seam] - ref[off_seam]).max() < 5e-3
     truth = rep.displaced_mesh(2)  # 6 lattice points per base triangle
     for k, factor in enumerate(MATERIAL_COLORS):
         np.testing.assert_allclose(truth.colors[6 * k:6 * (k + 1), :3],
