@@ -67,3 +67,45 @@ def material_atlas(mesh, size: int = ATLAS_SIZE, ctx=None) -> MaterialAtlas:
         layers[k] = to_rgba8(rgba)
     return MaterialAtlas(layers, (float(lo[0]), float(lo[1]), float(lo[0] + extent[0]),
                                   float(lo[1] + extent[1])))
+
+
+def kept_atlas(mesh) -> tuple[MaterialAtlas | None, int]:
+    """The atlas of ``mesh``'s materials when they are anything but plain white (None
+    otherwise), and how many materials were left out: all of them past `MAX_MATERIALS`."""
+    if not has_material(mesh):
+        return None, 0
+    if len(mesh.materials) > MAX_MATERIALS:
+        return None, len(mesh.materials)
+    return material_atlas(mesh), 0
+
+
+def atlas_uniforms(atlas: MaterialAtlas | None, unit: int) -> dict:
+    """The uniforms of core:include/surface_tint.glsl, its texture array bound to ``unit``."""
+    box = atlas.box if atlas is not None else (0.0, 0.0, 1.0, 1.0)
+    return {"u_surface": unit, "u_tinted": atlas is not None,
+            "u_surface_box": (box[0], box[1], 1.0 / (box[2] - box[0]),
+                              1.0 / (box[3] - box[1]))}
+
+
+def linear_tint(atlas: MaterialAtlas, uv, layer) -> np.ndarray:
+    """(..., 3) linear colour of ``atlas`` at base uvs ``uv`` (..., 2) in layers ``layer``
+    (...): bilinear between texel centres, clamped at the border, as surface_tint.glsl
+    samples it."""
+    from ..colorspace import srgb_decode
+
+    uv = np.asarray(uv, np.float64)
+    layer = np.asarray(layer, np.int64)
+    _, height, width, _ = atlas.rgba8.shape
+    u0, v0, u1, v1 = atlas.box
+    x = np.clip((uv[..., 0] - u0) / (u1 - u0) * width - 0.5, 0.0, width - 1.0)
+    y = np.clip((uv[..., 1] - v0) / (v1 - v0) * height - 0.5, 0.0, height - 1.0)
+    x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    x1, y1 = np.minimum(x0 + 1, width - 1), np.minimum(y0 + 1, height - 1)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+
+    def rgb(rows, cols):
+        return srgb_decode(atlas.rgba8[layer, rows, cols, :3] / 255.0)
+
+    top = rgb(y0, x0) * (1 - fx) + rgb(y0, x1) * fx
+    bottom = rgb(y1, x0) * (1 - fx) + rgb(y1, x1) * fx
+    return top * (1 - fy) + bottom * fy

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..bake.uv_atlas import ATLAS_SIZE, MAX_MATERIALS, MaterialAtlas
 from ..errors import FormatError
 from ..scene.mesh import ALPHA_MODES, Material, RenderMesh
 from .rk import ArraySpec, Codec, register
@@ -158,3 +159,48 @@ def check_base_arrays(arrays: dict, kind: str, per_vertex=("normals", "uvs")) ->
             raise FormatError(f"{kind} array '{key}' has {len(arrays[key])} rows, the base "
                               f"has {count} vertices")
     return count
+
+
+#: A base's own materials in its uv space (`reliefkit.bake.uv_atlas`), optional arrays of
+#: the kinds built on a base: ``surface`` uint8 (M, H, W, 4) sRGB, one layer per material,
+#: with ``material`` uint16 (F,) per triangle (absent: 0) and the param ``surface_box``
+#: [u0, v0, u1, v1]. Files without them load as before (no tint).
+SURFACE_ARRAYS = {
+    "surface": ArraySpec(("uint8",), ndim=4, trailing=(4,), required=False,
+                         max_size=4 * MAX_MATERIALS * ATLAS_SIZE ** 2),
+    "material": ArraySpec(("uint16",), ndim=1, required=False, max_size=MAX_BASE_TRIANGLES),
+}
+
+
+def surface_to_arrays(atlas: MaterialAtlas | None, base) -> tuple[dict, dict]:
+    """(arrays, params) storing ``atlas`` and ``base``'s per-triangle material (none: empty)."""
+    if atlas is None:
+        return {}, {}
+    return ({"surface": atlas.rgba8, "material": np.asarray(base.material, np.uint16)},
+            {"surface_box": list(atlas.box)})
+
+
+def surface_from_arrays(arrays: dict, params: dict, kind: str):
+    """The stored material atlas and the base's per-triangle material (None, None without
+    one); pops ``surface_box`` from ``params``."""
+    layers, material = arrays.get("surface"), arrays.get("material")
+    box = params.pop("surface_box", None)
+    if layers is None:
+        if material is not None or box is not None:
+            raise FormatError(f"a {kind}'s 'material' and 'surface_box' come with 'surface'")
+        return None, None
+    if not (isinstance(box, list) and len(box) == 4 and all(
+            isinstance(b, int | float) and not isinstance(b, bool) and np.isfinite(b)
+            for b in box) and box[2] > box[0] and box[3] > box[1]):
+        raise FormatError(f"{kind} param 'surface_box' must be [u0, v0, u1, v1] with "
+                          f"u1 > u0 and v1 > v0, got {box!r}")
+    triangles = len(arrays["indices"])
+    if material is None:
+        material = np.zeros(triangles, np.uint16)
+    if len(material) != triangles:
+        raise FormatError(f"{kind} array 'material' has {len(material)} entries, the "
+                          f"base has {triangles} triangles")
+    if min(layers.shape[:3]) < 1 or len(layers) > MAX_MATERIALS:
+        raise FormatError(f"{kind} array 'surface' has shape {layers.shape}; expected "
+                          f"1..{MAX_MATERIALS} layers of at least 1x1")
+    return MaterialAtlas(layers, tuple(float(b) for b in box)), material

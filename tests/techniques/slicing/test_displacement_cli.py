@@ -118,6 +118,7 @@ def _npy(arr) -> bytes:
 @pytest.mark.parametrize("field, value, words", [
     ("scale", -0.5, "scale"), ("scale", "big", "scale"), ("tile", [1.0], "tile"),
     ("tile", [0.0, 1.0], "tile"), ("wrap", 1, "wrap"),
+    ("surface_box", [0, 0, 1, 1], "come with 'surface'"),
 ])
 def test_forged_typed_fields_are_refused(baked, tmp_path, field, value, words):
     path = tmp_path / "f.rk"

@@ -11,7 +11,11 @@ from reliefkit.render import render
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.slicing.displacement import DisplacementMap
 from reliefkit.techniques.slicing.displacement_bake import square_base
-from reliefkit.techniques.slicing.displacement_reference import reference_hits, wrong_hits
+from reliefkit.techniques.slicing.displacement_reference import (
+    reference_colors,
+    reference_hits,
+    wrong_hits,
+)
 from reliefkit.techniques.slicing.displacement_textures import terrain_colors, waves
 
 RES = 32
@@ -202,3 +206,93 @@ def test_a_displacement_thinner_than_a_pixel_is_its_base(gl, mode):
     np.testing.assert_array_equal(frame.mask, render(thin.base, cam).mask)
     assert frame.stats["slice_polygons"] <= render(thick, cam, slicing=mode).stats[
         "slice_polygons"]
+
+
+MATERIAL_COLORS = ((1.0, 0.2, 0.2), (0.2, 0.3, 1.0))  # linear factors of the two triangles
+PAINT = (0.8, 0.7, 0.6)  # the displacement texture's colour
+
+
+def two_material_square(degenerate: bool = False):
+    """`square_base` with a red factor on its triangle x > z and a blue one on x < z (and,
+    with ``degenerate``, a third triangle of no area)."""
+    from reliefkit.scene.mesh import Material, RenderMesh
+
+    square = square_base()
+    faces = np.asarray(square.indices)
+    if degenerate:
+        faces = np.vstack([faces, [0, 1, 1]])
+    materials = [Material("red", (*MATERIAL_COLORS[0], 1.0)),
+                 Material("blue", (*MATERIAL_COLORS[1], 1.0))]
+    return RenderMesh(square.world_positions, faces, square.normals, square.colors,
+                      square.uvs, materials=materials,
+                      material=np.arange(len(faces)).clip(0, 1).astype(np.uint16))
+
+
+def baked_on(mesh, tmp_path):
+    """``mesh`` baked as a displacement of a flat PAINT texture at half height."""
+    from reliefkit.bake import bake
+
+    texture = np.empty((8, 8, 4), np.float32)
+    texture[..., :3], texture[..., 3] = PAINT, 0.5
+    np.save(tmp_path / "flat.npy", texture)
+    return bake(mesh, "displacement", displacement=str(tmp_path / "flat.npy"),
+                displacement_scale=0.2)
+
+
+def test_the_surface_material_tints_every_slicing(gl, tmp_path):
+    """Seen from above, each triangle's displacement is the texture's colour times that
+    triangle's material factor, in every slicing, after a round trip through the .rk
+    file, in the exact CPU reference and in the displaced mesh (the CPU ground truth)."""
+    from reliefkit.io.rk import load, save
+    from reliefkit.scene.camera import Camera
+
+    rep = baked_on(two_material_square(), tmp_path)
+    assert rep.surface is not None and len(rep.surface.rgba8) == 2
+    save(tmp_path / "tinted.rk", rep)
+    back = load(tmp_path / "tinted.rk")
+    assert np.array_equal(back.surface.rgba8, rep.surface.rgba8)
+    assert np.array_equal(back.base.material, [0, 1])
+    cam = Camera(eye=(0.0, 3.0, 0.0), target=(0.0, 0.0, 0.0), up=(0.0, 0.0, -1.0),
+                 size=(48, 48), near=0.5, far=10.0, ortho_height=1.2)
+    o, _ = cam.pixel_rays()
+    inside = (np.abs(o[..., 0]) < 0.8) & (np.abs(o[..., 2]) < 0.8)
+    sides = (inside & (o[..., 0] > o[..., 2] + 0.2), inside & (o[..., 0] < o[..., 2] - 0.2))
+    for mode in ("surface", "orthogonal", "screen"):
+        frame = render(back, cam, slicing=mode, slices=8, unlit=True)
+        for side, factor in zip(sides, MATERIAL_COLORS, strict=True):
+            assert side.sum() > 200
+            expected = np.multiply(PAINT, factor)
+            np.testing.assert_allclose(frame.color[..., :3][side],
+                                       np.broadcast_to(expected, (int(side.sum()), 3)),
+                                       atol=5e-3, err_msg=mode)
+    ref = reference_colors(back, cam)  # the exact CPU reference, as the last slicing
+    both = frame.mask & ~np.isnan(ref[..., 0])
+    assert both.sum() > 0.9 * frame.mask.sum()
+    for side, factor in zip(sides, MATERIAL_COLORS, strict=True):
+        np.testing.assert_allclose(ref[side], np.broadcast_to(np.multiply(PAINT, factor),
+                                                              (int(side.sum()), 3)), atol=5e-3)
+    off_seam = both & (sides[0] | sides[1])  # on the seam a pixel may take either side
+    assert np.abs(frame.color[..., :3][off_seam] - ref[off_seam]).max() < 5e-3
+    truth = rep.displaced_mesh(2)  # 6 lattice points per base triangle
+    for k, factor in enumerate(MATERIAL_COLORS):
+        np.testing.assert_allclose(truth.colors[6 * k:6 * (k + 1), :3],
+                                   np.broadcast_to(np.multiply(PAINT, factor), (6, 3)),
+                                   atol=5e-3)
+
+
+def test_plain_white_meshes_keep_the_texture_colours(gl, tmp_path):
+    rep = baked_on(square_base(), tmp_path)
+    assert rep.surface is None
+    cam = orbit_bounds(rep.bounds, 0.0, 89.0, 2.4, size=(32, 32))
+    frame = render(rep, cam, unlit=True)
+    np.testing.assert_allclose(frame.color[..., :3][frame.mask],
+                               np.broadcast_to(PAINT, (int(frame.mask.sum()), 3)), atol=2e-3)
+
+
+def test_the_bake_report_counts_the_triangles_left_out(tmp_path):
+    rep = baked_on(two_material_square(degenerate=True), tmp_path)
+    assert rep.triangle_count == 2
+    report = rep.bake_report()
+    assert "warning: 1 triangles were left out of the base (no area in space or in uv)" in \
+        report
+    assert np.array_equal(rep.base.material, [0, 1])  # the kept triangles keep theirs

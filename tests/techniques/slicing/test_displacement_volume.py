@@ -89,8 +89,8 @@ def test_cut_tetrahedron_cross_sections_integrate_to_its_volume():
     values = positions @ np.array([0.3, -0.5, 0.8])
     n = 400
     levels = values.min() + (values.max() - values.min()) * (np.arange(n) + 0.5) / n
-    pos, _, _, polygons, used = cut_tetrahedra(positions, positions, tets,
-                                               np.eye(3)[None], values, levels)
+    pos, _, _, polygons, used, _ = cut_tetrahedra(positions, positions, tets,
+                                                  np.eye(3)[None], values, levels)
     assert polygons == used == n
     t = pos.reshape(-1, 3, 3)
     area = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum()

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
-from ...bake.uv_atlas import MAX_MATERIALS, has_material, material_atlas
+from ...bake.uv_atlas import kept_atlas
 from ...core.params import param
 from ...errors import FormatError, UsageError
 from .representation import TexturedShell, check_tetrahedron_count
@@ -92,15 +92,12 @@ def bake_shell(source, p: ShellVolumeParams, progress=None) -> TexturedShell:
     base, dropped = usable_part(source)
     fitted = fitted_thickness(base, thickness)
     thinned = int((fitted < thickness).sum())
-    tinted = has_material(base)  # the surface's own look, kept under the volume's colours
-    kept = tinted and len(base.materials) <= MAX_MATERIALS
+    surface, left_out = kept_atlas(base)  # the surface's own look, under the volume's colours
     return TexturedShell(base, fitted, texture,
                          {"source": source.name, "thickness": thickness,
                           "dropped_triangles": dropped, "thinned_vertices": thinned,
-                          "materials_left_out": len(base.materials) if tinted and not kept
-                          else 0},
-                         source_bounds=source.bounds,
-                         surface=material_atlas(base) if kept else None)
+                          "materials_left_out": left_out},
+                         source_bounds=source.bounds, surface=surface)
 
 
 def usable_part(mesh):

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...bake.uv_atlas import atlas_uniforms
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...gl.context import check_gl_error
@@ -216,8 +217,6 @@ class TexturedShellDrawable(GLObjects):
         units |= {f"u_normal{k}": _NORMAL_UNITS[min(k, len(self.levels) - 1)]
                   for k in range(MAX_LEVELS)}
         animated = self.options.time is not None
-        surface = self.rep.surface
-        box = surface.box if surface is not None else (0.0, 0.0, 1.0, 1.0)
         return (camera_uniforms(camera) | model_offset(camera, self.origin) | light.uniforms()
                 | units | {"u_tets": _TETS_UNIT, "u_levels": len(self.levels),
                            "u_level_size": sizes, "u_mip": self.options.mip,
@@ -226,11 +225,9 @@ class TexturedShellDrawable(GLObjects):
                            "u_time": float(self.options.time or 0.0),
                            "u_sway": 0.04 if animated else 0.0,
                            "u_opaque_depth": _DEPTH_UNIT, "u_search": _SEARCH_UNIT,
-                           "u_shadow_map": _SHADOW_UNIT, "u_surface": _SURFACE_UNIT,
-                           "u_tinted": surface is not None,
-                           "u_surface_box": (box[0], box[1], 1.0 / (box[2] - box[0]),
-                                             1.0 / (box[3] - box[1])),
-                           "u_tile": tuple(float(t) for t in self.rep.texture.tile)})
+                           "u_shadow_map": _SHADOW_UNIT,
+                           "u_tile": tuple(float(t) for t in self.rep.texture.tile)}
+                | atlas_uniforms(self.rep.surface, _SURFACE_UNIT))
 
     def _bind(self) -> None:
         for k, (colour, normal) in enumerate(self.level_textures):

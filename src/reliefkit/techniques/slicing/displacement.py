@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas, linear_tint
 from ...errors import UsageError
 from ...scene.views import source_box
 
@@ -49,6 +50,9 @@ class DisplacementMap:
     params : bake provenance (never anything that changes rendering).
     source_bounds : the box of the mesh it was baked from (None for a heightmap): views
         frame the map by it, as they frame its mesh.
+    surface : the base's own materials in its uv space (`reliefkit.bake.uv_atlas`), one
+        layer per material of ``base.material``; the texture's colours are multiplied by it
+        at the base uv (the surface tints its displacement). None: the texture's colours.
     """
 
     base: object
@@ -59,6 +63,7 @@ class DisplacementMap:
     wrap: bool = False
     params: dict = field(default_factory=dict)
     source_bounds: np.ndarray | None = None
+    surface: MaterialAtlas | None = None
 
     def __post_init__(self) -> None:
         base = self.base
@@ -98,6 +103,10 @@ class DisplacementMap:
         n = np.asarray(base.normals, np.float64)
         if (np.linalg.norm(n, axis=1) < 1e-6).any():
             raise UsageError("the base mesh has zero-length vertex normals")
+        if self.surface is not None and len(self.surface.rgba8) <= int(
+                np.max(base.material, initial=0)):
+            raise UsageError(f"a displacement map's surface has {len(self.surface.rgba8)} "
+                             f"material layers, its base uses {int(np.max(base.material)) + 1}")
 
     # -- geometry --------------------------------------------------------------------------
     @property
@@ -149,6 +158,21 @@ class DisplacementMap:
         return bilinear(self.height, np.asarray(u, np.float64) * self.tile[0],
                         np.asarray(v, np.float64) * self.tile[1], self.wrap)
 
+    def surface_layers(self) -> np.ndarray:
+        """(F,) int64 the `surface` layer of each base triangle (its material; 0 without a
+        surface)."""
+        if self.surface is None:
+            return np.zeros(self.triangle_count, np.int64)
+        return np.asarray(self.base.material, np.int64)
+
+    def tint(self, uv, triangle) -> np.ndarray:
+        """(..., 3) the surface's linear colour at base uvs ``uv`` (..., 2) on base triangles
+        ``triangle`` (...), as the renderer samples it; 1 without a surface."""
+        uv = np.asarray(uv, np.float64)
+        if self.surface is None:
+            return np.ones((*uv.shape[:-1], 3))
+        return linear_tint(self.surface, uv, self.surface_layers()[triangle])
+
     def sample_color(self, u, v) -> np.ndarray:
         u = np.asarray(u, np.float64) * self.tile[0]
         v = np.asarray(v, np.float64) * self.tile[1]
@@ -189,7 +213,9 @@ class DisplacementMap:
         moved = (pts + (hgt * self.scale)[..., None] * nrm).reshape(-1, 3)
         count = len(bary)
         faces = (small[None, :, :] + count * np.arange(len(tris))[:, None, None]).reshape(-1, 3)
-        colors = np.clip(self.sample_color(uvs[..., 0], uvs[..., 1]).reshape(-1, 4), 0, 1)
+        colors = np.clip(self.sample_color(uvs[..., 0], uvs[..., 1]), 0, 1)
+        colors[..., :3] *= self.tint(uvs, np.arange(len(tris))[:, None])
+        colors = colors.reshape(-1, 4)
         colors[:, 3] = 1.0
         normals = vertex_normals(moved, faces)
         return RenderMesh(moved, faces, normals, colors.astype(np.float32),
@@ -197,9 +223,22 @@ class DisplacementMap:
 
     def bake_report(self) -> list[str]:
         h, w = self.height.shape
-        return [f"displacement map: {self.triangle_count} base triangles, texture {w}x{h} "
-                f"'{self.params.get('texture', '?')}', scale {self.scale:.4g}, tile "
-                f"{self.tile[0]:g}x{self.tile[1]:g}{', wrapped' if self.wrap else ''}"]
+        lines = [f"displacement map: {self.triangle_count} base triangles, texture {w}x{h} "
+                 f"'{self.params.get('texture', '?')}', scale {self.scale:.4g}, tile "
+                 f"{self.tile[0]:g}x{self.tile[1]:g}{', wrapped' if self.wrap else ''}"]
+        dropped, left_out = (self.params.get(k, 0) for k in ("dropped_triangles",
+                                                              "materials_left_out"))
+        if dropped:
+            lines.append(f"warning: {dropped} triangles were left out of the base (no area in "
+                         "space or in uv)")
+        if self.surface is not None:
+            lines.append(f"the surface's {len(self.surface.rgba8)} material(s) tint the "
+                         "displacement")
+        if left_out:
+            lines.append(f"warning: the surface's {left_out} materials are left out (at most "
+                         f"{MAX_MATERIALS} tint a displacement); it keeps the texture's "
+                         "colours")
+        return lines
 
 
 def bilinear(image: np.ndarray, s, t, wrap: bool) -> np.ndarray:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
+from ...bake.uv_atlas import kept_atlas
 from ...core.params import param
 from ...errors import UsageError
 from .displacement import DisplacementMap
@@ -184,14 +185,18 @@ def bake_displacement(source, p: DisplacementParams, progress=None) -> Displacem
     scale = _scale(p, layer_thickness(source))
     if p.tile is None and wrap:  # a periodic texture repeats at the mesh's own scale
         tile = tuple(float(t) for t in uv_tiling(source, TILE_PER_LAYER * scale))
-    base = _usable(source)
+    base, dropped = _usable(source)
+    surface, left_out = kept_atlas(base)  # the surface's own look, under the texture's colours
     return DisplacementMap(base, color, height, scale, tile, wrap,
-                           params={"source": source.name, "texture": p.displacement},
-                           source_bounds=source.bounds)
+                           params={"source": source.name, "texture": p.displacement,
+                                   "dropped_triangles": dropped,
+                                   "materials_left_out": left_out},
+                           source_bounds=source.bounds, surface=surface)
 
 
 def _usable(mesh):
-    """The mesh without triangles that have no area in space or in uv."""
+    """The mesh without triangles that have no area in space or in uv (its materials kept),
+    and how many were left out."""
     from ...scene.mesh import RenderMesh
 
     tris = np.asarray(mesh.indices, np.int64)
@@ -205,9 +210,10 @@ def _usable(mesh):
         raise UsageError(f"{mesh.name}: none of its triangles has an area in space and in "
                          "uv; there is nothing to displace")
     if good.all():
-        return mesh
+        return mesh, 0
     return RenderMesh(mesh.world_positions, tris[good], mesh.normals, mesh.colors, mesh.uvs,
-                      name=mesh.name)
+                      name=mesh.name, materials=mesh.materials,
+                      material=np.asarray(mesh.material)[good]), int((~good).sum())
 
 
 def _projected(mesh, p: DisplacementParams, tile) -> DisplacementMap:

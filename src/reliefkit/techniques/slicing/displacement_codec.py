@@ -5,7 +5,9 @@ Arrays: ``positions`` float64 (V, 3) world, ``indices`` int32 (F, 3), ``normals`
 float32 (H, W) in [0, 1]. Typed params (they change rendering, so they are checked here):
 ``scale`` (a positive number), ``tile`` [U, V] (positive numbers), ``wrap`` (a bool); the
 rest (``source``, ``texture``) is provenance. Optional ``source_bounds`` float64 (2, 3): the baked
-mesh's box, which views frame the map by. The volume's tetrahedra are rebuilt when drawn.
+mesh's box, which views frame the map by; the optional surface arrays
+(`reliefkit.io.mesh_codec.SURFACE_ARRAYS`: the base's materials in uv space, which tint the
+texture's colours). The volume's tetrahedra are rebuilt when drawn.
 """
 
 from __future__ import annotations
@@ -13,7 +15,13 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FormatError, MeshError, UsageError
-from ...io.mesh_codec import BASE_MESH_ARRAYS, check_base_arrays
+from ...io.mesh_codec import (
+    BASE_MESH_ARRAYS,
+    SURFACE_ARRAYS,
+    check_base_arrays,
+    surface_from_arrays,
+    surface_to_arrays,
+)
 from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
@@ -22,7 +30,7 @@ ARRAYS = BASE_MESH_ARRAYS | {
                        max_size=4 * MAX_TEXELS),
     "height": ArraySpec(("float32",), ndim=2, finite=True, max_size=MAX_TEXELS),
     "source_bounds": SOURCE_BOUNDS,
-}
+} | SURFACE_ARRAYS
 OWN = ("scale", "tile", "wrap")
 
 
@@ -31,8 +39,10 @@ def _to_arrays(rep: DisplacementMap) -> tuple[dict, dict]:
     arrays = {"positions": base.world_positions, "indices": base.indices.astype(np.int32),
               "normals": base.normals, "uvs": base.uvs, "color": rep.color,
               "height": rep.height, "source_bounds": rep.source_bounds}
-    params = {k: v for k, v in rep.params.items() if k not in OWN}
-    return arrays, params | {"scale": rep.scale, "tile": list(rep.tile), "wrap": rep.wrap}
+    params = {k: v for k, v in rep.params.items() if k not in (*OWN, "surface_box")}
+    surface_arrays, surface_params = surface_to_arrays(rep.surface, base)
+    return arrays | surface_arrays, params | surface_params | {
+        "scale": rep.scale, "tile": list(rep.tile), "wrap": rep.wrap}
 
 
 def _number(value) -> bool:
@@ -48,7 +58,7 @@ def _check_shapes(shapes: dict) -> None:
 
 
 def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
-    from ...scene.mesh import RenderMesh
+    from ...scene.mesh import Material, RenderMesh
 
     params = dict(params)
     scale, tile, wrap = (params.pop(k, None) for k in OWN)
@@ -68,13 +78,17 @@ def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
         raise FormatError("displacement array 'height' must lie in [0, 1]")
     if color.size and (color.min() < 0 or color.max() > 1):
         raise FormatError("displacement array 'color' must lie in [0, 1]")
+    surface, material = surface_from_arrays(arrays, params, "displacement")
     try:
         colors = np.broadcast_to(np.float32(1.0), (count, 4))
         base = RenderMesh(positions, arrays["indices"], arrays["normals"], colors,
-                          arrays["uvs"], name=str(params.get("source", "displacement base")))
+                          arrays["uvs"], name=str(params.get("source", "displacement base")),
+                          materials=[Material()] * (1 if surface is None
+                                                    else len(surface.rgba8)),
+                          material=material)
         return DisplacementMap(base, color, height, float(scale),
                                (float(tile[0]), float(tile[1])), wrap, params,
-                               arrays.get("source_bounds"))
+                               arrays.get("source_bounds"), surface)
     except (UsageError, MeshError, ValueError) as exc:
         raise FormatError(f"invalid displacement map: {exc}") from None
 

@@ -19,12 +19,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...bake.uv_atlas import atlas_uniforms
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...gl.context import check_gl_error
 from ...gl.objects import GLObjects
 from ...gl.shaders import program
-from ...gl.textures import texture2d
+from ...gl.textures import texture2d, texture_array
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .displacement import DisplacementMap
 from .displacement_slices import MODES, TooManyPolygons, slice_triangles
@@ -34,8 +35,7 @@ PROGRAM = "slicing:displacement.glsl"
 PROGRAMS = (ProgramVariant(PROGRAM, {}), ProgramVariant(PROGRAM, {"UNLIT": True}))
 ALPHA_TESTS = ("fill", "bound")
 AUTO_MIN, AUTO_MAX = 2, 512
-_HEIGHT_UNIT, _COLOR_UNIT = 0, 1
-_FLOATS = 15  # position, uvh, three Jacobian columns
+_HEIGHT_UNIT, _COLOR_UNIT, _SURFACE_UNIT = 0, 1, 2
 
 
 @dataclass(frozen=True)
@@ -84,11 +84,12 @@ def auto_slices(rep: DisplacementMap, camera) -> int:
                             maximum=AUTO_MAX)
 
 
-def vertex_data(tris, origin) -> np.ndarray:
-    """(3M, 15) float32: position relative to ``origin``, (u, v, h), d/du, d/dv, d/dh."""
+def vertex_data(tris, origin, layers) -> np.ndarray:
+    """(3M, 16) float32: position relative to ``origin``, (u, v, h), d/du, d/dv, d/dh, the
+    surface layer (``layers`` (F,) per base triangle: `DisplacementMap.surface_layers`)."""
     j = tris.jacobian
     out = np.concatenate([tris.positions - origin, tris.box, j[:, :, 0], j[:, :, 1],
-                          j[:, :, 2]], axis=1)
+                          j[:, :, 2], layers[tris.triangle][:, None]], axis=1)
     return np.ascontiguousarray(out, np.float32)
 
 
@@ -115,6 +116,9 @@ class DisplacementDrawable(GLObjects):
                                           filter="nearest"))
         self.color = self.keep(texture2d(ctx, rep.color, what="displacement colour",
                                          repeat=rep.wrap))
+        if rep.surface is not None:
+            self.surface = self.keep(texture_array(ctx, rep.surface.rgba8, srgb=True,
+                                                   what="displacement surface materials"))
         check_gl_error(ctx, "uploading a displacement texture")
 
     def draw(self, camera, light) -> None:
@@ -143,11 +147,12 @@ class DisplacementDrawable(GLObjects):
                       **{f"direction_{k}": v for k, v in tris.directions.items()}}
         if not tris.triangle_count:
             return
-        data = vertex_data(tris, self.origin)
+        data = vertex_data(tris, self.origin, rep.surface_layers())
         vbo = ctx.buffer(data.tobytes())
         try:
-            vao = ctx.vertex_array(self.prog, [(vbo, "3f 3f 3f 3f 3f", "in_position", "in_uvh",
-                                                "in_ju", "in_jv", "in_jh")])
+            vao = ctx.vertex_array(self.prog, [(vbo, "3f 3f 3f 3f 3f 1f", "in_position",
+                                                "in_uvh", "in_ju", "in_jv", "in_jh",
+                                                "in_layer")])
             try:
                 set_uniforms(self.prog, camera_uniforms(camera)
                              | model_offset(camera, self.origin) | light.uniforms()
@@ -155,9 +160,12 @@ class DisplacementDrawable(GLObjects):
                                 "u_hf_size": (w, h), "u_wrap": rep.wrap,
                                 "u_tile": tuple(rep.tile),
                                 "u_test": ALPHA_TESTS.index(test),
-                                "u_bound": float(bound)})
+                                "u_bound": float(bound)}
+                             | atlas_uniforms(rep.surface, _SURFACE_UNIT))
                 self.height.use(_HEIGHT_UNIT)
                 self.color.use(_COLOR_UNIT)
+                if rep.surface is not None:
+                    self.surface.use(_SURFACE_UNIT)
                 ctx.enable(moderngl.DEPTH_TEST)
                 ctx.disable(moderngl.CULL_FACE)
                 vao.render(moderngl.TRIANGLES)

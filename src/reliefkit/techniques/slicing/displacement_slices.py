@@ -84,6 +84,7 @@ class SliceTriangles:
     box : (3M, 3) float64 (u, v, h) of each vertex.
     jacobian : (3M, 3, 3) float64 d(world)/d(u, v, h) of the tetrahedron (or offset triangle)
         the vertex belongs to.
+    triangle : (3M,) int64 the base triangle whose prism (or offset) the vertex lies in.
     polygons : slice polygons (tetrahedron cuts, or offset triangles) drawn.
     slices : slicing planes / surfaces used (for orthogonal: the sum over the three
         directions of the levels that cut something), the base included.
@@ -96,6 +97,7 @@ class SliceTriangles:
     positions: np.ndarray
     box: np.ndarray
     jacobian: np.ndarray
+    triangle: np.ndarray
     polygons: int
     slices: int
     spacing: float
@@ -118,7 +120,8 @@ def cut_tetrahedra(positions, box, tets, jacobian, values, levels, reserved: int
     vertex, affine inside each tetrahedron) cut the tetrahedra ``tets``; refused before they
     are built when they and the ``reserved`` polygons of the same frame exceed `MAX_POLYGONS`.
 
-    Returns (positions (3M, 3), box (3M, 3), jacobian (3M, 3, 3), polygons, levels used).
+    Returns (positions (3M, 3), box (3M, 3), jacobian (3M, 3, 3), polygons, levels used,
+    tetrahedron (3M,): the row of ``tets`` each vertex's polygon cuts).
     """
     levels = np.asarray(levels, np.float64)
     s = values[tets]                                      # (T, 4)
@@ -129,7 +132,8 @@ def cut_tetrahedra(positions, box, tets, jacobian, values, levels, reserved: int
     if total + reserved > MAX_POLYGONS:
         raise TooManyPolygons(f"{total + reserved} slice polygons would be needed (at most "
                               f"{MAX_POLYGONS}); use fewer slices (--slices)")
-    empty = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3, 3)), 0, 0)
+    empty = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3, 3)), 0, 0,
+             np.zeros(0, np.int64))
     if total == 0:
         return empty
     tet = np.repeat(np.arange(len(tets)), n)
@@ -162,13 +166,14 @@ def cut_tetrahedra(positions, box, tets, jacobian, values, levels, reserved: int
     tri_pos = np.concatenate([pos[:, first], pos[quad][:, second]])
     tri_box = np.concatenate([uvh[:, first], uvh[quad][:, second]])
     jac = np.concatenate([jacobian[tet], jacobian[tet[quad]]])
+    source = np.concatenate([tet, tet[quad]])
     return (tri_pos.reshape(-1, 3), tri_box.reshape(-1, 3),
-            np.repeat(jac, 3, axis=0), int(len(tet)), used_levels)
+            np.repeat(jac, 3, axis=0), int(len(tet)), used_levels, np.repeat(source, 3))
 
 
 def _offset_surface(rep, h: float) -> tuple:
     """The base mesh moved by h * scale along its normals: (positions (3F, 3), box (3F, 3),
-    jacobian (3F, 3, 3), polygons F, 1 level)."""
+    jacobian (3F, 3, 3), polygons F, 1 level, triangle (3F,))."""
     base = rep.base
     tris = np.asarray(base.indices, np.int64)
     n = np.asarray(base.normals, np.float64)
@@ -183,7 +188,8 @@ def _offset_surface(rep, h: float) -> tuple:
     jh = rep.scale * n[tris]                                    # (F, 3 vertices, 3)
     j = np.concatenate([np.repeat(juv[:, None], 3, axis=1), jh[..., None]], axis=3)
     box = np.concatenate([tri_uv, np.full((*tris.shape, 1), h)], axis=2)
-    return tp.reshape(-1, 3), box.reshape(-1, 3), j.reshape(-1, 3, 3), len(tris), 1
+    return (tp.reshape(-1, 3), box.reshape(-1, 3), j.reshape(-1, 3, 3), len(tris), 1,
+            np.repeat(np.arange(len(tris)), 3))
 
 
 def _offset_surfaces(rep, count: int) -> SliceTriangles:
@@ -195,10 +201,12 @@ def _offset_surfaces(rep, count: int) -> SliceTriangles:
 
 def _joined(parts, spacing: float, mode: str, directions: dict,
             base: int = 0) -> SliceTriangles:
-    """One `SliceTriangles` of several (positions, box, jacobian, polygons, levels) parts."""
+    """One `SliceTriangles` of several (positions, box, jacobian, polygons, levels, base
+    triangle) parts."""
     return SliceTriangles(np.concatenate([c[0] for c in parts]),
                           np.concatenate([c[1] for c in parts]),
                           np.concatenate([c[2] for c in parts]),
+                          np.concatenate([c[5] for c in parts]),
                           sum(c[3] for c in parts), sum(c[4] for c in parts), spacing, mode,
                           directions, base)
 
@@ -305,9 +313,10 @@ def slice_triangles(rep, camera, mode: str, count: int, volume=None,
             directions[name] = int(np.count_nonzero(choice == k))
             if not len(tets) or not len(levels[k]):
                 continue
-            parts.append(cut_tetrahedra(vol.positions, vol.box, vol.tets[tets],
-                                        vol.jacobian[tets], vol.box[:, axis], levels[k],
-                                        sum(c[3] for c in parts)))
+            *cut, source = cut_tetrahedra(vol.positions, vol.box, vol.tets[tets],
+                                          vol.jacobian[tets], vol.box[:, axis], levels[k],
+                                          sum(c[3] for c in parts))
+            parts.append((*cut, vol.prism_of[tets][source]))
         return _joined(parts, rep.scale / count, "orthogonal", directions, parts[0][3])
     # screen
     spacing = max(rep.scale / count, min_spacing)
@@ -318,5 +327,7 @@ def slice_triangles(rep, camera, mode: str, count: int, volume=None,
     planes = min(max(1, math.ceil((far - near) / spacing - 1e-9)), MAX_PLANES)
     levels = near + (far - near) * (np.arange(planes) + 0.5) / planes
     base = _offset_surface(rep, 0.0)
-    cut = cut_tetrahedra(vol.positions, vol.box, vol.tets, vol.jacobian, depth, levels, base[3])
+    *cut, source = cut_tetrahedra(vol.positions, vol.box, vol.tets, vol.jacobian, depth, levels,
+                                  base[3])
+    cut = (*cut, vol.prism_of[source])
     return _joined([base, cut], (far - near) / planes, "screen", {"planes": planes}, base[3])

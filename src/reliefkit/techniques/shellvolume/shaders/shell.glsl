@@ -78,15 +78,13 @@ layout(location = 3) out vec4 f_bins3;
 #elif !defined SHADOW_MAP
 #include "core:include/transparency.glsl"
 #endif
+#include "core:include/surface_tint.glsl"
 uniform vec3 u_model_offset;
 uniform int u_samples;              // samples per segment (§5.1)
 uniform bool u_clip_opaque;         // stop segments at the opaque pass's surfaces
 uniform highp sampler2D u_opaque_depth;
 uniform float u_time;               // animation time (the texture sways with it)
 uniform float u_sway;               // sway amplitude in texture tiles (0: still)
-uniform mediump sampler2DArray u_surface;  // the base's materials in uv space, per layer
-uniform bool u_tinted;              // whether there is one
-uniform vec4 u_surface_box;         // its uv rectangle: u0, v0, 1 / (u1 - u0), 1 / (v1 - v0)
 uniform vec2 u_tile;                // the texture's repetitions over the uvs
 #if defined AOV_BINS || defined AOV_FINAL
 uniform highp sampler2D u_search;   // per pixel, see render.py (half_opacity_search)
@@ -142,14 +140,10 @@ float opaque_distance(vec3 dir) {
     return max(dot(p - v_local, dir), 0.0);
 }
 
-// The colour of the base surface's own material under lookup coordinate s (the tiling
-// undone: the base's uv), from the tetrahedron's material layer (render.py, uv_atlas.py);
-// white without one. The volume's colours are multiplied by it.
-vec3 surface_tint(vec3 s) {
-    if (!u_tinted) return vec3(1.0);
-    vec2 uv = (s.xy / u_tile - u_surface_box.xy) * u_surface_box.zw;
-    return textureLod(u_surface, vec3(uv, tet_surface_layer(v_tet)), 0.0).rgb;
-}
+// The base surface's own colour under lookup coordinate s (the tiling undone: the base's
+// uv), from the tetrahedron's material layer (render.py); the volume's colours are
+// multiplied by it.
+vec3 base_tint(vec3 s) { return surface_tint(s.xy / u_tile, tet_surface_layer(v_tet)); }
 
 // The texture moving over time: strands sway, more at the top of the shell.
 vec3 animated(vec3 s) {
@@ -221,7 +215,7 @@ void main() {
         float lambda = (float(k) + 0.5) / float(n);
         vec3 s_at = mix(s_in, s_out, lambda);
         VolumeSample v = volume_sample(animated(s_at), lod);
-        v.rgba.rgb *= surface_tint(s_at);
+        v.rgba.rgb *= base_tint(s_at);
 #if defined SHADOW_MAP
         if (sample_opacity(v.rgba.a, u_shadow_length) >= 0.5) {
             gl_FragDepth = window_depth(mix(v_local, p_out, lambda) + u_model_offset);

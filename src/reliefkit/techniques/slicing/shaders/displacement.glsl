@@ -7,7 +7,8 @@
 //             is surface)
 //   u_test 1  bound (Schaufler, §3.1): |height - h| <= u_bound (one slice spacing)
 // Where the height is 0 and the colour's alpha is below 0.5 there is nothing (a projected
-// mesh's background): no fragment is kept there.
+// mesh's background): no fragment is kept there. The colour is tinted by the base surface's
+// own material at (u, v) (core:include/surface_tint.glsl; the layer of the base triangle).
 // The normal is that of the displaced surface S(u, v) = X(u, v, height(u, v)) through the
 // slice's tangent frame (the tetrahedron's Jacobian d X / d(u, v, h)).
 //! defines: UNLIT
@@ -20,11 +21,13 @@ in vec3 in_uvh;
 in vec3 in_ju;
 in vec3 in_jv;
 in vec3 in_jh;
+in float in_layer;
 out vec3 v_world;
 out vec3 v_uvh;
 out vec3 v_ju;
 out vec3 v_jv;
 out vec3 v_jh;
+flat out float v_layer;
 
 void main() {
     v_world = in_position + u_model_offset;
@@ -32,6 +35,7 @@ void main() {
     v_ju = in_ju;
     v_jv = in_jv;
     v_jh = in_jh;
+    v_layer = in_layer;
     gl_Position = u_proj * u_view * vec4(v_world, 1.0);
 }
 #endif
@@ -41,6 +45,7 @@ void main() {
 #include "core:include/shading.glsl"
 #include "core:include/frame_outputs.glsl"
 #include "core:include/iterations.glsl"
+#include "core:include/surface_tint.glsl"
 #include "include/displacement_height.glsl"
 uniform sampler2D u_color;   // linear RGBA (repeat or clamp like the height)
 uniform vec2 u_tile;
@@ -51,6 +56,7 @@ in vec3 v_uvh;
 in vec3 v_ju;
 in vec3 v_jv;
 in vec3 v_jh;
+flat in float v_layer;
 
 bool keep(float height, float h) {
     if (u_test == 1) return abs(height - h) <= u_bound;
@@ -74,10 +80,11 @@ void main() {
     float len = length(n);
     n = len > 1e-20 ? n / len : normalize(v_jh);
     if (dot(n, v_jh) < 0.0) n = -n;  // away from the base, whatever the uv orientation
+    vec3 albedo = base.rgb * surface_tint(v_uvh.xy, v_layer);
 #if defined UNLIT
-    vec3 rgb = base.rgb;
+    vec3 rgb = albedo;
 #else
-    vec3 rgb = shade_phong(base.rgb, n, towards_eye(v_world), 1.0);
+    vec3 rgb = shade_phong(albedo, n, towards_eye(v_world), 1.0);
 #endif
     write_frame(vec4(rgb, 1.0), v_world, n);
     write_iterations(1, 0, true);
