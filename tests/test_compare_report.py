@@ -53,6 +53,20 @@ def test_a_score_without_a_measure_is_na_and_null():
     assert parsed["variants"]["sorted"]["position_mean_rel"] == 0.01
 
 
+def test_an_infinite_score_is_inf_in_the_table_and_null_in_the_json():
+    """Identical pictures have an infinite PSNR: the table says so, strict JSON cannot."""
+    result = {"columns": ("psnr", "bytes"), "bytes": {"mesh": 10, "representation": 20},
+              "metrics": {"same": {"psnr": math.inf, "bytes": 20}}}
+    header, rows = table(metrics_markdown(result, "x"))
+    assert dict(zip(header, rows[0], strict=True))["psnr"] == "inf"
+
+    def refuse(token):
+        pytest.fail(f"metrics.json holds {token}")
+
+    parsed = json.loads(metrics_json(result, "x"), parse_constant=refuse)
+    assert parsed["variants"]["same"]["psnr"] is None
+
+
 def test_a_shadowed_variant_is_scored_against_the_mesh_with_shadows(gl):
     """The shell volume's "shadows" variant is held to the mesh rendered with --shadows,
     every other variant to the plain mesh (one render per distinct set of options)."""

@@ -7,7 +7,6 @@ and the technique adds its own metrics (such as wrong hits against an exact refe
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -202,8 +201,9 @@ def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]
 
 
 def metrics_json(result: dict, title: str) -> str:
-    """``{"title", "bytes", "variants": {name: row}}``, a score not measured as null."""
-    variants = {name: {key: _measured(value) for key, value in row.items()}
-                for name, row in result["metrics"].items()}
-    return json.dumps({"title": title, "bytes": result["bytes"], "variants": variants},
-                      indent=2)
+    """``{"title", "bytes", "variants": {name: row}}`` as strict JSON: a score not measured,
+    or infinite (the PSNR of identical pictures), is null."""
+    from . import strict_json
+
+    return strict_json.dumps({"title": title, "bytes": result["bytes"],
+                              "variants": result["metrics"]}, indent=2)

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import itertools
 import json
-import math
 import sys
 from pathlib import Path
 
+from .. import strict_json
 from ..errors import FormatError, UsageError
 from .options import applicable, given_options
 
@@ -379,23 +379,11 @@ def cmd_info(args) -> int:
     if args.file:
         report["file"] = _describe_file(args.file)
     if args.json:
-        print(json.dumps(_finite_or_null(report), indent=2, allow_nan=False))
+        print(strict_json.dumps(report, indent=2))
     else:
         for section in report.values():
             _print_section(section)
     return 0
-
-
-def _finite_or_null(value):
-    """``value`` with every NaN and infinity as None: strict JSON has no such numbers (a
-    forged file's params may hold them)."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {key: _finite_or_null(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite_or_null(item) for item in value]
-    return value
 
 
 def _print_section(section: dict) -> None:
