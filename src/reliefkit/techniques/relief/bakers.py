@@ -126,9 +126,10 @@ def bake_orthographic(source, p: ReliefParams, progress=None):
     given = [flag for flag, value in (("--depth-res", p.depth_res), ("--color-res", p.color_res),
                                       ("--axis", p.axis)) if value is not None]
     if heightmap and given:
-        raise UsageError(f"{' and '.join(given)} {'shapes' if len(given) == 1 else 'shape'} "
-                         "a mesh's relief; a heightmap keeps its own size and its y axis: "
-                         "drop them (or resample the heightmap)")
+        one = len(given) == 1
+        raise UsageError(f"{' and '.join(given)} {'shapes' if one else 'shape'} a mesh's "
+                         "relief; a heightmap keeps its own size and its y axis: drop "
+                         f"{'it' if one else 'them'} (or resample the heightmap)")
     depth_res, axis = p.depth_res or MESH_DEPTH_RES, p.axis or MESH_AXIS
     if safety is not False:
         side = max(source.shape) if heightmap else depth_res
