@@ -130,38 +130,21 @@ def test_framed_views_draw_the_whole_object(flat_van, tmp_path, view):
     assert (masks["ray"] != masks["slab"]).sum() <= 2
 
 
-def test_images_too_large_to_hold_are_refused_with_their_estimate(tmp_path):
-    """--res 8192 needs 12.4 GiB of images: refused before anything is allocated, so even a
-    process limited to 3 GiB of address space gets the estimate, not a MemoryError."""
-    import subprocess
-    import sys
-
+@pytest.mark.parametrize(("kind", "res", "words"), [
+    ("depth-object", "8192", ("12.4 GiB", "at most 4657")),          # images a .rk cannot hold
+    ("visual-hull", "4096", ("7.1 GiB of host memory", "at most")),  # a bake past host_limit
+])
+def test_images_too_large_are_refused_with_their_estimate(tmp_path, kind, res, words):
+    """--res 8192 needs 12.4 GiB of images; --res 4096 fits a .rk file but its bake peaks near
+    6 x 4096² x 76 B = 7.1 GiB, over the host-memory limit (at most 4 GiB). Both are refused
+    before anything is allocated, so a process limited to 3 GiB of address space gets the
+    estimate, not a MemoryError or a crash."""
     resource = pytest.importorskip("resource")
 
     def limit():
         resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
 
-    out = subprocess.run([sys.executable, "-m", "reliefkit.cli", "bake", "demo:cup", "--as",
-                          "depth-object", "--res", "8192", "-o", str(tmp_path / "x.rk")],
-                         capture_output=True, text=True, timeout=300, preexec_fn=limit)
-    assert_one_line_error(out, "res 8192", "12.4 GiB", "at most 4657", code=2)
-    assert not (tmp_path / "x.rk").exists()
-
-
-def test_images_too_large_for_host_memory_are_refused_with_their_estimate(tmp_path):
-    """--res 4096 fits a .rk file but its bake peaks near 6 x 4096² x 76 B = 7.1 GiB, over
-    the host-memory limit (at most 4 GiB): refused before allocating, so a process limited
-    to 3 GiB of address space gets the estimate, not a crash."""
-    import subprocess
-    import sys
-
-    resource = pytest.importorskip("resource")
-
-    def limit():
-        resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
-
-    out = subprocess.run([sys.executable, "-m", "reliefkit.cli", "bake", "demo:cup", "--as",
-                          "visual-hull", "--res", "4096", "-o", str(tmp_path / "x.rk")],
-                         capture_output=True, text=True, timeout=300, preexec_fn=limit)
-    assert_one_line_error(out, "res 4096", "7.1 GiB of host memory", "at most", code=2)
+    out = run_cli("bake", "demo:cup", "--as", kind, "--res", res, "-o", tmp_path / "x.rk",
+                  preexec_fn=limit)
+    assert_one_line_error(out, f"res {res}", *words, code=2)
     assert not (tmp_path / "x.rk").exists()
