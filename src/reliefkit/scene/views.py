@@ -99,14 +99,15 @@ def framing_bounds(obj) -> np.ndarray:
     return np.asarray(source if source is not None else obj.bounds, dtype=np.float64)
 
 
-def source_box(value) -> np.ndarray | None:
-    """A representation's ``source_bounds`` checked: a finite (2, 3) float64 (min, max) box
-    with min <= max (flat meshes have flat boxes), or None when it was not baked from a mesh."""
+def source_box(value, name: str = "source_bounds") -> np.ndarray | None:
+    """A representation's world box (``source_bounds``, a relief's ``clip_bounds``) checked:
+    a finite (2, 3) float64 (min, max) box with min <= max (flat meshes have flat boxes), or
+    None when there is none (not baked from a mesh). Every representation checks it here."""
     if value is None:
         return None
     box = np.asarray(value, dtype=np.float64)
     if box.shape != (2, 3) or not np.isfinite(box).all() or (box[0] > box[1]).any():
-        raise UsageError("source_bounds must be finite (min, max) corners with min <= max")
+        raise UsageError(f"{name} must be finite (min, max) corners with min <= max")
     return box
 
 

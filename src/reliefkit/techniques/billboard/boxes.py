@@ -17,6 +17,7 @@ import numpy as np
 
 from ...core.transforms import MAX_COORDINATE
 from ...errors import UsageError
+from ...scene.views import source_box
 from .representation import BillboardCloud
 
 VARIANTS = ("volumetric", "shell", "thick-shell")
@@ -92,12 +93,7 @@ class BillboardBoxes:
             raise UsageError(f"only shells have a thickness, not a {self.variant}")
         if not any((b.color[..., 3] >= 128).any() for b in self.boxes):
             raise UsageError("every box is empty: nothing visible to render")
-        if self.source_bounds is not None:
-            bounds = np.asarray(self.source_bounds, dtype=np.float64)
-            if bounds.shape != (2, 3) or not np.isfinite(bounds).all() \
-                    or (bounds[0] > bounds[1]).any():
-                raise UsageError("source_bounds must be finite (min, max) corners")
-            self.source_bounds = bounds
+        self.source_bounds = source_box(self.source_bounds)
 
     @property
     def epsilon(self) -> float:

@@ -8,6 +8,7 @@ import numpy as np
 
 from ...core.transforms import MAX_COORDINATE
 from ...errors import UsageError
+from ...scene.views import source_box
 
 #: Texels left empty around every rectangle in the atlas, so that bilinear and mipmapped
 #: lookups near a rectangle's border never read its neighbour.
@@ -75,11 +76,7 @@ class BillboardCloud:
         if not (self.color[..., 3] >= 128).any():
             raise UsageError("every texel of the billboard cloud is empty (alpha below 0.5): "
                              "nothing visible to render")
-        if self.source_bounds is not None:
-            box = np.asarray(self.source_bounds, dtype=np.float64)
-            if box.shape != (2, 3) or not np.isfinite(box).all() or (box[0] > box[1]).any():
-                raise UsageError("source_bounds must be finite (min, max) corners")
-            self.source_bounds = box
+        self.source_bounds = source_box(self.source_bounds)
 
     @property
     def count(self) -> int:

@@ -15,6 +15,7 @@ from ...core.transforms import (
     unit_cube_corners,
 )
 from ...errors import UsageError
+from ...scene.views import source_box
 
 
 @dataclass(eq=False)
@@ -83,8 +84,8 @@ class ReliefTexture:
                 raise UsageError(f"safety radii up to {int(self.safety.max())} texels on a "
                                  f"{self.height.shape[1]}x{self.height.shape[0]} heightfield; "
                                  f"at most {limit} make sense")
-        self.clip_bounds = _box_or_none(self.clip_bounds, "clip_bounds")
-        self.source_bounds = _box_or_none(self.source_bounds, "source_bounds")
+        self.clip_bounds = source_box(self.clip_bounds, "clip_bounds")
+        self.source_bounds = source_box(self.source_bounds)
         if self.clip_bounds is not None:
             corners = self.corners
             lo = np.maximum(corners.min(axis=0), self.clip_bounds[0])
@@ -187,16 +188,6 @@ def _checked_box(matrix) -> np.ndarray:
     return m
 
 
-def _box_or_none(value, name: str) -> np.ndarray | None:
-    """A (2, 3) world box (min, max corner, min <= max: flat meshes have flat boxes), or None."""
-    if value is None:
-        return None
-    box = np.asarray(value, dtype=np.float64)
-    if box.shape != (2, 3) or not np.isfinite(box).all() or (box[0] > box[1]).any():
-        raise UsageError(f"{name} must be finite (min, max) corners with min <= max")
-    return box
-
-
 @dataclass(eq=False)
 class ReliefObject:
     """Several relief textures drawn together (the six frusta of a cube, §4.2)."""
@@ -208,7 +199,7 @@ class ReliefObject:
     def __post_init__(self) -> None:
         if not self.parts or not all(isinstance(p, ReliefTexture) for p in self.parts):
             raise UsageError("a relief object needs one or more ReliefTexture parts")
-        self.source_bounds = _box_or_none(self.source_bounds, "source_bounds")
+        self.source_bounds = source_box(self.source_bounds)
 
     @property
     def bounds(self) -> np.ndarray:
