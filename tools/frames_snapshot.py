@@ -3,6 +3,7 @@ change a pixel.
 
     python tools/frames_snapshot.py save DIR      # one .npz per sample and option set
     python tools/frames_snapshot.py compare DIR   # bit-compare against a saved DIR
+    python tools/frames_snapshot.py compare DIR relief:   # only names starting so
 
 Each sample is drawn from three views at 64x48 with its default options, with every choice
 of every declared option changed one at a time (so each code path of each drawable is
@@ -56,14 +57,18 @@ def _option_sets(rep) -> list[tuple[str, dict]]:
     return sets
 
 
-def _frames():
-    """(name, arrays) for every sample, option set and view; failures recorded as such."""
+def _frames(only: str = ""):
+    """(name, arrays) for every sample, option set and view whose name starts with
+    ``only``; failures recorded as such."""
     from reliefkit.render import render
     from reliefkit.scene.views import orbit_bounds
 
     samples = _samples()
-    yield from _list_frames(samples)
+    if "list:".startswith(only) or only.startswith("list:"):
+        yield from _list_frames(samples)
     for sample_name, rep in samples.items():
+        if not sample_name.startswith(only) and not only.startswith(sample_name):
+            continue
         for set_name, options in _option_sets(rep):
             for counted in (False, True) if set_name == "default" else (False,):
                 for v, view in enumerate(VIEWS):
@@ -113,10 +118,10 @@ def save(folder: Path) -> None:
     print(f"saved {count} frames to {folder}")
 
 
-def compare(folder: Path) -> int:
+def compare(folder: Path, only: str = "") -> int:
     differ, same, missing = [], 0, []
     seen = set()
-    for name, arrays in _frames():
+    for name, arrays in _frames(only):
         path = _file(folder, name)
         seen.add(path.name)
         if not path.exists():
@@ -130,7 +135,8 @@ def compare(folder: Path) -> int:
             differ.append(f"{name}: {', '.join(bad)}")
         else:
             same += 1
-    gone = sorted(p.name for p in folder.glob("*.npz") if p.name not in seen)
+    prefix = _file(folder, only).name[:-len(".npz")]
+    gone = sorted(p.name for p in folder.glob(prefix + "*.npz") if p.name not in seen)
     print(f"{same} identical, {len(differ)} differ, {len(missing)} new, {len(gone)} gone")
     for line in differ + [f"new: {m}" for m in missing] + [f"gone: {g}" for g in gone]:
         print("  " + line)
@@ -138,7 +144,8 @@ def compare(folder: Path) -> int:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3 or sys.argv[1] not in ("save", "compare"):
+    if len(sys.argv) not in (3, 4) or sys.argv[1] not in ("save", "compare"):
         sys.exit(__doc__)
     command, folder = sys.argv[1], Path(sys.argv[2])
-    sys.exit(save(folder) if command == "save" else compare(folder))
+    sys.exit(save(folder) if command == "save" else
+             compare(folder, sys.argv[3] if len(sys.argv) == 4 else ""))

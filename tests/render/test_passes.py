@@ -13,6 +13,7 @@ from helpers import toy_technique
 
 from reliefkit.errors import UsageError
 from reliefkit.render import render
+from reliefkit.render.executor import Executor
 from reliefkit.render.frame import window_depth
 from reliefkit.scene.camera import Camera
 from reliefkit.scene.mesh import RenderMesh
@@ -102,21 +103,22 @@ def test_opaque_drawables_hide_transparent_ones_behind_them(gl, toy):
 
 
 def test_gpu_objects_are_released_when_a_draw_fails(gl, toy, monkeypatch):
-    released = []
-    real_release = toy.ToyDrawable.release
+    made = []
+    real_release = Executor.release
 
-    def failing_draw(self, camera, light):
+    def failing_draw(self, *args, **kwargs):
         raise UsageError("draw failed on purpose")
 
-    def counted_release(self):
-        released.append(self)
+    def recorded_release(self):
+        made.extend(self._made)
         real_release(self)
 
-    monkeypatch.setattr(toy.ToyDrawable, "draw", failing_draw)
-    monkeypatch.setattr(toy.ToyDrawable, "release", counted_release)
+    monkeypatch.setattr(Executor, "draw_viewed", failing_draw)
+    monkeypatch.setattr(Executor, "release", recorded_release)
     with pytest.raises(UsageError, match="on purpose"):
         render([quad(toy, 0.0, 0.5, (1, 1, 1), 0.5), BACKDROP], CAMERA)
-    assert len(released) == 1
+    assert made, "the plans were uploaded before the draw failed"
+    assert all(type(obj.mglo).__name__ == "InvalidObject" for obj in made)
     monkeypatch.undo()
     assert render(BACKDROP, CAMERA).mask.any()  # the context still works
     assert gl.error == "GL_NO_ERROR"

@@ -26,10 +26,8 @@ from reliefkit.core.technique import (
     Technique,
 )
 from reliefkit.errors import FormatError, UsageError
-from reliefkit.gl.shaders import program
-from reliefkit.gl.targets import FRONT_OPACITY_UNIT
-from reliefkit.gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from reliefkit.io.rk import ArraySpec, Codec
+from reliefkit.render.plan import Attribute, DrawPlan, Geometry, Program, Raster
 
 PROGRAM = "toy:toy.glsl"
 
@@ -102,36 +100,31 @@ class ToyRenderOptions:
 
 
 class ToyDrawable:
-    """One quad; transparent when its opacity is below 1."""
+    """One quad as one draw plan; transparent when its opacity is below 1."""
 
-    def __init__(self, ctx, quad: ToyQuad, options: ToyRenderOptions, instrument: bool):
-        self.ctx, self.quad = ctx, quad
-        self.transparent = bool(quad.color[3] < 1.0)
-        self.extra_attachments = 1 if instrument and not self.transparent else 0
-        self.prog = program(ctx, PROGRAM, {
-            "TRANSPARENT": self.transparent, "CHECKER": options.method == "checker",
-            "COUNT_ITERATIONS": bool(self.extra_attachments)})
-        self.origin = quad.corners.mean(axis=0)  # geometry relative to it (camera-relative)
-        tris = (quad.corners[[0, 1, 2, 0, 2, 3]] - self.origin).astype(np.float32)
-        self.vbo = ctx.buffer(tris.tobytes())
-        self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f", "in_position")])
+    def __init__(self, quad: ToyQuad, options: ToyRenderOptions, instrument: bool):
+        self.quad = quad
+        transparent = bool(quad.color[3] < 1.0)
+        self.extra_attachments = 1 if instrument and not transparent else 0
+        origin = quad.corners.mean(axis=0)  # geometry relative to it (camera-relative)
+        tris = (quad.corners[[0, 1, 2, 0, 2, 3]] - origin).astype(np.float32)
+        self.plans = [DrawPlan(
+            name="toy quad",
+            program=Program(PROGRAM, {"TRANSPARENT": transparent,
+                                      "CHECKER": options.method == "checker",
+                                      "COUNT_ITERATIONS": bool(self.extra_attachments)}),
+            geometry=Geometry({"in_position": Attribute(tris)}),
+            uniforms={"u_color": tuple(float(c) for c in quad.color),
+                      "u_normal": tuple(float(c) for c in quad.normal)},
+            raster=Raster(depth_write=False, blend="under") if transparent else Raster(),
+            render_pass="transparent" if transparent else "opaque",
+            origin=tuple(float(x) for x in origin))]
 
     def sort_distance(self, camera) -> float:
         return float(np.linalg.norm(self.quad.corners.mean(axis=0) - np.asarray(camera.eye)))
 
-    def draw(self, camera, light) -> None:
-        set_uniforms(self.prog, camera_uniforms(camera) | model_offset(camera, self.origin) | {
-            "u_color": tuple(float(c) for c in self.quad.color),
-            "u_normal": tuple(float(c) for c in self.quad.normal),
-            "u_front_opacity": FRONT_OPACITY_UNIT})
-        self.vao.render()
-
-    def finish(self, frame) -> None:
+    def finish(self, frame, stats) -> None:
         frame.stats["toy_quads"] = frame.stats.get("toy_quads", 0) + 1
-
-    def release(self) -> None:
-        self.vao.release()
-        self.vbo.release()
 
 
 def _mean_alpha(frame, quad, camera):
@@ -163,7 +156,7 @@ TECHNIQUE = Technique(
     codecs=(CODEC,),
     representations=(ToyQuad,),
     bakers=(Baker("toy-quad", "the bounding rectangle of a mesh", ToyBakeParams, bake_quad),),
-    drawables=(DrawableSpec(ToyQuad, ToyDrawable, ToyRenderOptions),),
+    drawables=(DrawableSpec(ToyQuad, ToyDrawable, ToyRenderOptions, planned=True),),
     compare_variants=(CompareVariant("flat", {"method": "flat"}),
                       CompareVariant("checker", {"method": "checker"})),
     compare_metrics=(CompareMetric("alpha", _mean_alpha, ("mean_alpha",)),),

@@ -6,7 +6,7 @@ from ..gl.context import bind_home_framebuffer, get_context
 from ..gl.targets import FRAME_ATTACHMENTS
 from ..gl.textures import render_target
 from ..gl.timing import gpu_times_ms
-from ..render.registry import make_drawables, release_all
+from ..render.draw import Scene
 from ..scene.light import DirectionalLight
 
 
@@ -22,23 +22,28 @@ def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
     import moderngl
 
     ctx = get_context()
-    drawables = [make_drawables(ctx, [obj], options)[0] for options in variants]
+    scenes = []
     light = light or DirectionalLight()
-    fbo = render_target(ctx, *camera.size, FRAME_ATTACHMENTS)
-
-    def drawing(drawable):
-        def draw():
-            fbo.use()
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            ctx.enable_only(moderngl.DEPTH_TEST)
-            drawable.draw(camera, light)
-        return draw
-
+    fbo = None
     try:
-        return gpu_times_ms(ctx, [drawing(d) for d in drawables], repeats=repeats)
+        for options in variants:
+            scenes.append(Scene([obj], ctx=ctx, **options))
+        fbo = render_target(ctx, *camera.size, FRAME_ATTACHMENTS)
+
+        def drawing(scene):
+            def draw():
+                fbo.use()
+                fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+                ctx.enable_only(moderngl.DEPTH_TEST)
+                scene.draw_opaque(camera, light)
+            return draw
+
+        return gpu_times_ms(ctx, [drawing(s) for s in scenes], repeats=repeats)
     finally:
         bind_home_framebuffer(ctx)
-        for attachment in (*fbo.color_attachments, fbo.depth_attachment):
-            attachment.release()
-        fbo.release()
-        release_all(drawables)
+        if fbo is not None:
+            for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+                attachment.release()
+            fbo.release()
+        for scene in scenes:
+            scene.release()

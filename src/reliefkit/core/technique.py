@@ -59,6 +59,10 @@ class DrawableSpec:
     cls: type
     factory: Callable
     options: type | None = None
+    #: the factory takes ``(obj, options, instrument)``, no context, and returns a drawable
+    #: whose ``plans`` (`render.plan.DrawPlan`) the executor draws, with optionally
+    #: ``finish(frame, stats)``, ``sort_distance(camera)`` and ``extra_attachments``
+    planned: bool = False
 
     @property
     def option_list(self) -> tuple[Option, ...]:

@@ -15,15 +15,9 @@ import numpy as np
 
 from ..core.params import param
 from ..core.technique import DrawableSpec, ProgramVariant
-from ..gl.context import check_gl_error
-from ..gl.objects import GLObjects
-from ..gl.shaders import program
-from ..gl.textures import texture2d
-from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from ..scene.light import DirectionalLight
 from ..scene.mesh import Material, RenderMesh
+from .plan import Attribute, DrawPlan, Geometry, MultiPass, Program, Texture
 from .registry import register_core_drawable
-from .shadows import SHADOW_UNIT, render_shadow_map
 
 PROGRAM = "core:mesh.glsl"
 MESH_PROGRAMS = tuple(  # the draw-path variants (compiled as GLSL ES by the tests too)
@@ -37,7 +31,7 @@ SHADOW_MAP_SIZE = 2048  # texels on a side over the mesh's bounding sphere
 #: u_alpha_mode of shaders/mesh.glsl for each `Material.alpha_mode`.
 ALPHA_MODE_CODES = {"OPAQUE": 0, "MASK": 1, "BLEND": 2}
 
-_LAYOUT = (("in_position", 3), ("in_normal", 3), ("in_color", 4), ("in_uv", 2))
+_ATTRIBUTES = ("in_position", "in_normal", "in_color", "in_uv")
 
 
 @dataclass(frozen=True)
@@ -48,111 +42,58 @@ class MeshRenderOptions:
                                  "(2048² over the bounding sphere, filtered 3 x 3)")
 
 
-@dataclass(frozen=True)
-class _Draw:
-    """One material's triangles: indices [first, first + count) of the index buffer."""
+class MeshDrawable:
+    """A RenderMesh as draw plans: one vertex and index array, one plan per material (its
+    triangles are a contiguous range of the indices), one texture per distinct image."""
 
-    textured: bool
-    texture: object | None
-    uniforms: dict
-    first: int
-    count: int
-
-
-class MeshDrawable(GLObjects):
-    """GPU buffers of a RenderMesh, drawable many times (turntables, benchmarks)."""
-
-    def __init__(self, ctx, mesh: RenderMesh, options: MeshRenderOptions | None = None,
+    def __init__(self, mesh: RenderMesh, options: MeshRenderOptions | None = None,
                  instrument: bool = False):
-        self.ctx, self.mesh = ctx, mesh
+        self.mesh = mesh
         self.options = options or MeshRenderOptions()
         self.extra_attachments = 1 if instrument else 0
-        self._shadow_maps: dict[tuple, dict] = {}  # light direction -> its uniforms
-        self._upload_owned(lambda: self._upload(instrument))
+        self.plans = mesh_plans(mesh, self.options.shadows, instrument)
 
-    def _upload(self, instrument: bool) -> None:
-        ctx, mesh = self.ctx, self.mesh
-        groups = mesh.material_groups()
-        uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2))
-        interleaved = np.hstack([mesh.positions, mesh.normals, mesh.colors, uvs])
-        vbo = self.keep(ctx.buffer(interleaved.astype(np.float32).tobytes()))
-        ibo = self.keep(ctx.buffer(np.concatenate([c.ravel() for _, c in groups]).tobytes()))
-        # (pass, textured) -> (program, vertex array); pass "main", or "shadow_map" (depth
-        # from the light) with shadows
-        self.passes: dict[tuple[str, bool], tuple] = {}
-        textures: dict[int, object] = {}  # one upload per distinct image
-        self.draws: list[_Draw] = []
-        first = 0
-        for material, corners in groups:
-            textured = material.texture is not None
-            if ("main", textured) not in self.passes:
-                self._add_passes(textured, instrument, vbo, ibo)
-            texture = None
-            if textured:
-                key = id(material.texture)
-                if key not in textures:
-                    textures[key] = self.keep(texture2d(
-                        ctx, material.texture, what=f"{mesh.name} texture", srgb=True,
-                        mipmaps=True, repeat=True))
-                texture = textures[key]
-            self.draws.append(_Draw(textured, texture, material_uniforms(material), first,
-                                    corners.size))
-            first += corners.size
-        check_gl_error(ctx, f"uploading mesh {mesh.name}")
-
-    def _add_passes(self, textured: bool, instrument: bool, vbo, ibo) -> None:
-        shadows = self.options.shadows
-        defines = {"main": {"HAS_TEXTURE": textured, "COUNT_ITERATIONS": instrument,
-                            "SHADOWS": shadows}}
-        if shadows:
-            defines["shadow_map"] = {"HAS_TEXTURE": textured, "SHADOW_MAP": True}
-        for name, chosen in defines.items():
-            prog = program(self.ctx, PROGRAM, chosen)
-            self.passes[name, textured] = (prog, self._vertex_array(prog, vbo, ibo))
-
-    def _vertex_array(self, prog, vbo, ibo):
-        attributes = [name for name, _ in _LAYOUT if name in prog]
-        fmt = " ".join(f"{n}f" if name in prog else f"{n}x4" for name, n in _LAYOUT)
-        return self.keep(self.ctx.vertex_array(prog, [(vbo, fmt, *attributes)], ibo,
-                                               index_element_size=4))
-
-    def draw(self, camera, light: DirectionalLight) -> None:
-        shared = light.uniforms()
-        if self.options.shadows:
-            shared |= self._shadow_map(light)
-        self._draw_pass("main", camera, shared)
-
-    def _draw_pass(self, name: str, camera, shared: dict) -> None:
-        shared = camera_uniforms(camera) | model_offset(camera, self.mesh.origin) | shared
-        for (kind, _), (prog, _) in self.passes.items():
-            if kind == name:
-                set_uniforms(prog, shared)
-        for draw in self.draws:
-            prog, vao = self.passes[name, draw.textured]
-            set_uniforms(prog, draw.uniforms)
-            if draw.texture is not None:
-                draw.texture.use(0)
-            vao.render(first=draw.first, vertices=draw.count)
-
-    def _shadow_map(self, light: DirectionalLight) -> dict:
-        """The shadow map's uniforms for ``light``, drawn on first use (then bound)."""
-        key = tuple(light.unit_direction)
-        if key not in self._shadow_maps:
-            outer = self.ctx.fbo
-            try:
-                depth, uniforms = render_shadow_map(
-                    self.ctx, self.mesh.bounds, light, self.mesh.origin,
-                    lambda cam: self._draw_pass("shadow_map", cam, {}), SHADOW_MAP_SIZE)
-            finally:
-                outer.use()
-            self.keep(depth)
-            self._shadow_maps[key] = uniforms | {"texture": depth}
-        uniforms = dict(self._shadow_maps[key])
-        uniforms.pop("texture").use(SHADOW_UNIT)
-        return uniforms
-
-    def finish(self, frame) -> None:
+    def finish(self, frame, stats: dict) -> None:
         frame.stats["triangles"] = frame.stats.get("triangles", 0) + self.mesh.triangle_count
+
+
+def mesh_plans(mesh: RenderMesh, shadows: bool = False, instrument: bool = False) -> list:
+    """The draw plans of ``mesh``: per material its range of the shared index array, its
+    program variant, texture and uniforms; with ``shadows`` each also casts into the light's
+    shadow map (the "shadow-map" multi-pass kind)."""
+    groups = mesh.material_groups()
+    uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2))
+    arrays = (mesh.positions, mesh.normals, mesh.colors, uvs)
+    geometry = Geometry(
+        attributes={name: Attribute(np.ascontiguousarray(a, np.float32))
+                    for name, a in zip(_ATTRIBUTES, arrays, strict=True)},
+        indices=np.concatenate([c.ravel() for _, c in groups]).astype(np.uint32))
+    textures: dict[int, Texture] = {}  # one texture per distinct image
+    plans, first = [], 0
+    for material, corners in groups:
+        textured = material.texture is not None
+        sampled = {}
+        if textured:
+            key = id(material.texture)
+            if key not in textures:
+                textures[key] = Texture(material.texture, srgb=True, mipmaps=True,
+                                        wrap=("repeat", "repeat", "repeat"),
+                                        what=f"{mesh.name} texture")
+            sampled = {"u_texture": textures[key]}
+        multipass = None
+        if shadows:
+            multipass = MultiPass("shadow-map", {"caster": Program(
+                PROGRAM, {"HAS_TEXTURE": textured, "SHADOW_MAP": True})},
+                {"bounds": np.asarray(mesh.bounds, np.float64), "size": SHADOW_MAP_SIZE})
+        plans.append(DrawPlan(
+            name=f"{mesh.name} material {len(plans)}",
+            program=Program(PROGRAM, {"HAS_TEXTURE": textured,
+                                      "COUNT_ITERATIONS": instrument, "SHADOWS": shadows}),
+            geometry=geometry, textures=sampled, uniforms=material_uniforms(material),
+            origin=tuple(float(x) for x in mesh.origin), first=first, count=corners.size,
+            multipass=multipass))
+        first += corners.size
+    return plans
 
 
 def material_uniforms(material: Material) -> dict:
@@ -167,7 +108,8 @@ def material_uniforms(material: Material) -> dict:
 
 
 def _register() -> None:
-    register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions))
+    register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions,
+                                        planned=True))
 
 
 _register()

@@ -8,7 +8,7 @@ import pytest
 from slicing_scenes import CUP_FLOOR, CUP_TOP, box_mesh, cup_mesh, sphere_mesh
 
 from reliefkit.errors import UsageError
-from reliefkit.render.registry import render
+from reliefkit.render import render
 from reliefkit.scene.camera import Camera
 from reliefkit.techniques.slicing.depth_images import bake_depth_images
 from reliefkit.techniques.slicing.measure import against_reference

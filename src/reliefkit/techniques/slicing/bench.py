@@ -128,7 +128,7 @@ def _scores(frame, mesh_frame, rep, camera, reference) -> dict:
 # -- sections ----------------------------------------------------------------------------------
 
 def quality(cfg: BenchConfig, log) -> list[dict]:
-    from ...render.registry import render
+    from ...render.draw import render
     from .reference import exact_intersection
 
     rows = []
@@ -157,7 +157,7 @@ def quality(cfg: BenchConfig, log) -> list[dict]:
 
 def convergence(cfg: BenchConfig, log) -> list[dict]:
     """Wrong pixels against the exact reference as the slices grow (blob, first view)."""
-    from ...render.registry import render
+    from ...render.draw import render
     from .measure import against_reference
     from .reference import exact_intersection
 
@@ -184,7 +184,7 @@ def convergence(cfg: BenchConfig, log) -> list[dict]:
 def texturing(cfg: BenchConfig, log) -> dict:
     """§4.2 on the vehicle, ray cast (the geometry exact, so texturing alone differs)."""
     from ... import metrics
-    from ...render.registry import render
+    from ...render.draw import render
 
     mesh, rep, _ = _baked(replace(cfg, res=cfg.res), "vehicle")
     variants = {f"{t}{'' if v else ', no visibility'}": {"texturing": t, "visibility": v}
@@ -211,7 +211,7 @@ def texturing(cfg: BenchConfig, log) -> dict:
 def fig12(cfg: BenchConfig, log) -> dict:
     """Frame time vs coverage at fixed slices, vs slices at fixed coverage; ray cast beside."""
     from ...bench.timing import time_render
-    from ...render.registry import render
+    from ...render.draw import render
 
     _, rep, _ = _baked(cfg, cfg.assets[0])
     coverage_rows, slice_rows = [], []
@@ -244,7 +244,7 @@ def fig12(cfg: BenchConfig, log) -> dict:
 def passes(cfg: BenchConfig, log) -> list[dict]:
     """One pass testing every image vs the stencil multi-pass, same picture (§4.1)."""
     from ...bench.timing import time_render
-    from ...render.registry import render
+    from ...render.draw import render
 
     rows = []
     _, rep, hull = _baked(cfg, cfg.assets[0])
@@ -307,7 +307,7 @@ def displacement(cfg: BenchConfig, log) -> dict:
     """§3 on the demo terrain (one polygon: the exact reference applies) and the donut."""
     from ... import metrics
     from ...bench.timing import time_render
-    from ...render.registry import render
+    from ...render.draw import render
     from ...scene.assets import terrain_heights
     from ...scene.views import orbit_bounds
     from .displacement_bake import DisplacementParams, bake_displacement
