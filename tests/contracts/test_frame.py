@@ -76,3 +76,18 @@ def test_instrumented_pass_draws_the_plain_pixels(gl, tech_kind, view):
         its = counted.extra["iterations"]
         assert np.isfinite(its[plain.mask]).all()
         assert counted.stats["iterations_max"] >= counted.stats["iterations_mean"] >= 0
+
+
+@pytest.mark.parametrize("tech_kind", SAMPLES, ids=IDS)
+def test_a_list_of_cameras_gives_the_frames_of_single_renders(gl, tech_kind):
+    """`render(obj, [a, b])` uploads once and draws per camera: bit-identical to two calls."""
+    rep = sample(*tech_kind)
+    cameras = [orbit_bounds(rep.bounds, *view, size=(64, 48)) for view in VIEWS]
+    together = render(rep, cameras)
+    assert isinstance(together, list) and len(together) == len(cameras)
+    for camera, frame in zip(cameras, together, strict=True):
+        alone = render(rep, camera)
+        for name in ("color", "mask", "depth", "position", "normal"):
+            np.testing.assert_array_equal(getattr(frame, name), getattr(alone, name),
+                                          err_msg=name)
+        assert frame.warnings == alone.warnings

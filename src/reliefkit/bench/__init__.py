@@ -1,5 +1,5 @@
 """Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique, or one of the
-core's own (`loading`: the memory of loading meshes).
+core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper.
@@ -41,10 +41,12 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
 def suites() -> dict:
     """Every suite by name: the core's, then each technique's (`core.technique.BenchSuite`)."""
     from ..core.technique import BenchSuite, bench_suites
-    from . import loading
+    from . import loading, platform
 
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
-                                  loading.run_suite, takes_mesh=True)}
+                                  loading.run_suite, takes_mesh=True),
+            "platform": BenchSuite("platform", "a turntable in one render call against one "
+                                   "call per view, per demo tile", platform.run_suite)}
     return core | {name: suite for name, (_, suite) in bench_suites().items()}
 
 

@@ -159,7 +159,7 @@ def _print_frame_warnings(per_frame: list, noun: str = "") -> None:
 
 
 def cmd_render(args) -> int:
-    from ..render import render, render_options
+    from ..render import Scene, render, render_options
     from ..scene.views import check_fov, framing_bounds, orbit_bounds, parse_size, parse_view
 
     az, el, dist = parse_view(args.view)
@@ -177,7 +177,12 @@ def cmd_render(args) -> int:
         return render(obj, camera, light=light, msaa=msaa, **core, **options)
 
     if args.turntable is not None:
-        return _render_turntable(args, framing_bounds(obj), draw, el, dist, size, background)
+        def views(cameras):  # one upload for every view (`render.Scene`)
+            with Scene(obj, **options) as scene:
+                for camera in cameras:
+                    yield scene.frame(camera, light, msaa=args.msaa)
+
+        return _render_turntable(args, framing_bounds(obj), views, el, dist, size, background)
     camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
     if args.animate is not None:
         return _render_animation(args, obj, camera, draw, background)
@@ -249,14 +254,17 @@ def _check_render_outputs(args) -> None:
             check_writable(value, flag)
 
 
-def _render_turntable(args, bounds, draw, elevation, distance, size, background) -> int:
-    """``args.turntable`` views of ``draw(camera)`` into an animation, warning about empty
-    views."""
+def _render_turntable(args, bounds, views, elevation, distance, size, background) -> int:
+    """``args.turntable`` views (``views(cameras)`` yields their Frames) into an animation,
+    warning about empty views."""
+    from contextlib import closing
+
     from ..scene.views import turntable
 
     cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
-    empty, warned, written = _stream_frames(args.output, "turntable", map(draw, cameras),
-                                            len(cameras), background)
+    with closing(views(cameras)) as frames:
+        empty, warned, written = _stream_frames(args.output, "turntable", frames,
+                                                len(cameras), background)
     print(f"wrote {written} ({len(cameras)} views)")
     if empty:
         many = len(empty) > 1
