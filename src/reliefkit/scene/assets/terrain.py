@@ -59,7 +59,7 @@ def terrain_heights(resolution: int = 128, seed: int = 0) -> np.ndarray:
     -------
     numpy.ndarray
         (R, R) float32 heights in [0, 1]; ``heights[j, i]`` is the sample at
-        ``u = (i + 0.5) / R``, ``v = (j + 0.5) / R`` (the DESIGN.md heightfield convention).
+        ``u = (i + 0.5) / R``, ``v = (j + 0.5) / R`` (a `ReliefTexture`'s heightfield convention).
         Height 0 is the flat water of the river running along u near ``v = 0.22``.
     """
     r = check_int("resolution", resolution, 2)
