@@ -2,6 +2,7 @@
 an output name that points to the flag it needs."""
 
 import re
+from pathlib import Path
 
 from helpers import run_cli
 
@@ -32,18 +33,29 @@ def test_render_help_names_each_owner_once():
 
 
 def test_top_level_help_lists_every_demo_asset():
-    """Every demo:NAME the help's own examples use is among the listed assets, and every
-    listed asset builds."""
-    from reliefkit.scene.assets import make_asset
+    """The help lists exactly the registered assets, every demo:NAME its own examples use is
+    among them, and every listed asset builds."""
+    from reliefkit.scene.assets import DEMO_NAMES, make_asset
 
     out = run_cli("--help")
     assert out.returncode == 0, out.stderr
     text = " ".join(out.stdout.split())
     listed = re.search(r"\(demo assets: ([^)]*)\)", text).group(1).split(", ")
+    assert listed == list(DEMO_NAMES)
     used = set(re.findall(r"demo:([\w-]+)", text)) - {"NAME"}
     assert used and used <= set(listed), used - set(listed)
     for name in listed:
         assert make_asset(name).triangle_count > 0, name
+
+
+def test_cli_doc_lists_every_demo_asset():
+    """docs/cli.md's paragraph on demo:NAME names every registered asset and no other."""
+    from reliefkit.scene.assets import DEMO_NAMES
+
+    doc = (Path(__file__).parents[1] / "docs" / "cli.md").read_text()
+    paragraph = re.search(r"`demo:NAME` for a procedural asset:(.*?)\(`reliefkit --help`",
+                          doc, re.S).group(1)
+    assert re.findall(r"`([\w-]+)`", paragraph) == list(DEMO_NAMES)
 
 
 def test_bake_summarises_its_arrays(gl, tmp_path):

@@ -1,5 +1,6 @@
 """Every registered drawable (and the toy technique's) renders a Frame that meets the Frame
-contract of DESIGN.md, and its instrumented pass draws exactly the pixels of the plain one."""
+contract of docs/architecture.md, and its instrumented pass draws exactly the pixels of the
+plain one."""
 
 from __future__ import annotations
 

@@ -1,7 +1,8 @@
 """Render passes on an analytic scene: transparent quads of known opacity over an opaque mesh.
 
 Colour is composited front to back (straight alpha in the Frame); depth, position and normal
-belong to the point where the accumulated opacity first reaches 0.5 (DESIGN.md, Frame).
+belong to the point where the accumulated opacity first reaches 0.5 (docs/architecture.md,
+"Frame").
 The expected values come from the quads' analytic colours and the mesh rendered alone.
 """
 

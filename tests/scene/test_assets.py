@@ -122,6 +122,20 @@ def test_all_assets_names(meshes):
         assert mesh.name == name
 
 
+def test_listing_the_names_loads_no_scipy():
+    """The CLI's help lists the registered names: that imports none of the heavy libraries the
+    assets are built with (in a fresh interpreter, as the command runs)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from reliefkit.scene.assets import DEMO_NAMES; "
+            "print(len(DEMO_NAMES), sorted(m for m in ('scipy', 'skimage') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split(maxsplit=1) == [str(len(assets.DEMO_NAMES)), "[]\n"]
+
+
 @pytest.mark.parametrize("name", assets.ASSET_NAMES)
 def test_make_asset_matches_factory_and_is_deterministic(name, meshes):
     again = assets.make_asset(name)

@@ -5,7 +5,7 @@ written as OBJ, binary STL, binary PLY and GLB (``--mesh FILE``: that file inste
 loaded in a fresh process, which loads a small file of the same format first (the modules
 loading imports lazily), then resets its peak-memory mark (Linux ``/proc/self/clear_refs``)
 and reports the resident memory then and the peak after loading. The ratio (peak minus
-that baseline) / file size is the figure; the target is <= 5 (issue 8).
+that baseline) / file size is the figure; the target is <= 5.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Exact CPU ray vs bilinear-patch heightfield intersection (the reference for every walk).
 
-Conventions (DESIGN.md, "Heightfield"; Baboud & Decoret 2006, section 3.1)
---------------------------------------------------------------------------
+Conventions (docs/architecture.md, "Heightfields"; Baboud & Decoret 2006, section 3.1)
+--------------------------------------------------------------------------------------
 ``height`` is an (H, W) array of values in [0, 1]. A ray is ``o + t * d`` in box coordinates
 (u, v, h), restricted to the unit box ``[0, 1]^3`` and to ``t >= 0`` unless a function says
 otherwise. Texel coordinates are ``x = u * W`` and ``y = v * H``; ``height[j, i]`` is the

@@ -69,7 +69,7 @@ class Frame:
             image.save(tmp, format="PNG")
 
     def aovs(self) -> dict[str, np.ndarray]:
-        """Every AOV under the names of DESIGN.md."""
+        """Every AOV and matrix, keyed by its attribute name (`AOV_NAMES`)."""
         return {name: np.asarray(getattr(self, name)) for name in AOV_NAMES}
 
     def save_aovs(self, path) -> None:

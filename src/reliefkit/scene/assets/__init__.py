@@ -47,23 +47,26 @@ __all__ = [
     "vehicle",
 ]
 
-ASSET_NAMES = ("terrain", "blob", "tree", "vehicle")
-#: Further shapes `make_asset` knows that are not in the demo set (`all_assets`).
-SHAPE_NAMES = ("cup",)
-
-#: The textured demo surfaces `make_asset` also knows (see :mod:`.surfaces`).
-SURFACE_NAMES = tuple(SURFACES)
-
-#: Every name `make_asset` builds, which `demo:NAME` accepts.
-DEMO_NAMES = ASSET_NAMES + SHAPE_NAMES + SURFACE_NAMES
-
-_FACTORIES: dict[str, Callable[[], RenderMesh]] = {
+#: The demo set (`all_assets`).
+_ASSETS: dict[str, Callable[[], RenderMesh]] = {
     "terrain": terrain,
     "blob": blob,
     "tree": tree,
     "vehicle": vehicle,
-    "cup": cup,
 }
+#: Further shapes `make_asset` knows that are not in the demo set.
+_SHAPES: dict[str, Callable[[], RenderMesh]] = {"cup": cup}
+
+#: The registry: every asset, shape and textured surface (:mod:`.surfaces`) by the name
+#: `make_asset` and ``demo:NAME`` take. The asset modules import scipy only inside the
+#: functions that need it, so listing the names (the CLI's help) does not load it.
+_FACTORIES: dict[str, Callable[[], RenderMesh]] = {**_ASSETS, **_SHAPES, **SURFACES}
+
+ASSET_NAMES = tuple(_ASSETS)
+SHAPE_NAMES = tuple(_SHAPES)
+SURFACE_NAMES = tuple(SURFACES)
+#: Every name `make_asset` builds, which `demo:NAME` accepts.
+DEMO_NAMES = tuple(_FACTORIES)
 
 
 def make_asset(name: str) -> RenderMesh:
@@ -75,7 +78,7 @@ def make_asset(name: str) -> RenderMesh:
     UsageError
         If `name` is not a known asset.
     """
-    factory = (_FACTORIES.get(name) or SURFACES.get(name)) if isinstance(name, str) else None
+    factory = _FACTORIES.get(name) if isinstance(name, str) else None
     if factory is None:
         raise UsageError(f"unknown asset {name!r}; choose one of: "
                          f"{', '.join(ASSET_NAMES + SHAPE_NAMES)} "

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
 
 from ..mesh import RenderMesh, vertex_normals
 from .colors import mix, rgb, smoothstep
@@ -24,6 +23,8 @@ def _fbm(
     Octave k interpolates a random lattice of ``cells * 2**k`` cells with cubic splines; the
     random draws do not depend on the sampling, so every resolution samples the same noise.
     """
+    from scipy import ndimage  # heavy import, only needed here
+
     total = np.zeros(np.shape(u))
     amplitude, norm = 1.0, 0.0
     for k in range(octaves):
@@ -59,7 +60,7 @@ def terrain_heights(resolution: int = 128, seed: int = 0) -> np.ndarray:
     -------
     numpy.ndarray
         (R, R) float32 heights in [0, 1]; ``heights[j, i]`` is the sample at
-        ``u = (i + 0.5) / R``, ``v = (j + 0.5) / R`` (the DESIGN.md heightfield convention).
+        ``u = (i + 0.5) / R``, ``v = (j + 0.5) / R`` (a `ReliefTexture`'s heightfield convention).
         Height 0 is the flat water of the river running along u near ``v = 0.22``.
     """
     r = check_int("resolution", resolution, 2)

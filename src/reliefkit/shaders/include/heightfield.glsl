@@ -1,5 +1,5 @@
 // A heightfield in texel coordinates: texel (i, j) holds the height at (i + 0.5, j + 0.5);
-// bilinear between texel centres, clamped at the border (represent/relief.py).
+// bilinear between texel centres, clamped at the border (reference/heightfield.py).
 uniform sampler2D u_height;   // R32F, sampled with texelFetch only (exact interpolation)
 uniform ivec2 u_hf_size;      // (W, H)
 
@@ -50,7 +50,7 @@ vec2 hf_slope(vec2 p) {
 }
 
 // Signed height of a ray point above the surface; negative means inside the solid.
-// Height 0 is empty space: the box's bottom face is no surface (represent/relief.py).
+// Height 0 is empty space: the box's bottom face is no surface, so a ray reaching it misses.
 float hf_above(vec3 p) {
     float s = hf_height(p.xy);
     return s > 0.0 ? p.z - s : max(p.z, 1e-7);

@@ -450,7 +450,7 @@ def run(cfg: BenchConfig, log=print) -> dict:
 
 
 def check_targets(results: dict) -> list[dict]:
-    """The issue's four targets (the first per asset and distance), met or not, with the
+    """The bench's four targets (the first per asset and distance), met or not, with the
     figures they were decided on."""
     out = []
     switch = {r["asset"]: r["switch_radii"] for r in results["dolly"]}

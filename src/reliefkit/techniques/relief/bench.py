@@ -247,7 +247,7 @@ JUDGED_REPEATS = 3
 
 
 def check_targets(results: dict) -> list[dict]:
-    """The issue's targets, met or not, with the figures. Frame-time ratios of a run with
+    """The bench's targets, met or not, with the figures. Frame-time ratios of a run with
     fewer than `JUDGED_REPEATS` draws per median (``--quick``) are reported with ``met``
     None: a single draw on a busy machine says nothing about them."""
     out = []

@@ -1,7 +1,7 @@
 """The .rk kinds of relief textures (registered through the technique record).
 
-``relief``: one ReliefTexture, arrays named as DESIGN.md says. ``relief-object``: several
-parts (the six frusta of a cube), each part's arrays prefixed ``pK_``.
+``relief``: one ReliefTexture, arrays named as its fields (docs/format.md). ``relief-object``:
+several parts (the six frusta of a cube), each part's arrays prefixed ``pK_``.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Mipmap filtering of 3D textures (semi-transparent 3D texture paper, §5.2).
 
-Alpha is opacity per unit of object-space length (DESIGN.md): a layer of object-space
+Alpha is opacity per unit of object-space length (as every 3D texture's): a layer of object-space
 thickness ``dt`` lets through ``(1 - alpha)^dt``. ``thickness`` is the object-space length of
 the shell's w extent, so each of a level's D layers is ``thickness / D`` thick.
 

@@ -8,7 +8,7 @@ fragment "under" what is in front of it. Opaque textures are drawn in the opaque
 depth-tested, without sorting.
 
 The Frame's AOVs of a semi-transparent shell belong to the point where the accumulated
-opacity first reaches 0.5 (DESIGN.md). A fragment cannot read what lies in front of it inside
+opacity first reaches 0.5 (the Frame's rule). A fragment cannot read what lies in front of it inside
 one draw, so `half_opacity_search` finds that point exactly in extra passes: per pixel, a
 base-16 search over the rank of the tetrahedron where it lies (optical depths are summed
 order-independently with additive blending into 16 rank bins per pass, ceil(log16 T) passes),

@@ -1,10 +1,10 @@
 """Procedural 3D textures of the semi-transparent 3D texture paper's Figure 1 (Dufort,
 Leblanc & Poulin 2005): fur, clouds, ellipsoids, absorption, chain and rocks.
 
-Conventions (DESIGN.md, "3D textures"): ``rgba`` has shape (D, H, W, 4) indexed [w, v, u],
-float32, straight linear RGB, and its alpha is opacity per unit of object-space length: a
-segment of length L through a voxel has opacity ``1 - (1 - alpha)^L`` (the paper's §4.3
-correction). w = 0 is the base (the mesh surface), w = 1 the top of the shell.
+Conventions (docs/architecture.md, "3D textures"): ``rgba`` has shape (D, H, W, 4) indexed
+[w, v, u], float32, straight linear RGB, and its alpha is opacity per unit of object-space
+length: a segment of length L through a voxel has opacity ``1 - (1 - alpha)^L`` (the paper's
+§4.3 correction). w = 0 is the base (the mesh surface), w = 1 the top of the shell.
 
 The generators author alpha as the opacity of the shell's whole thickness (a medium of
 alpha 0.3 dims what is below it by 30% seen straight down, whatever the shell's size);
@@ -41,7 +41,7 @@ class VolumeTexture:
     """A 3D texture: ``rgba`` (D,H,W,4), ``normal`` (D,H,W,3), both float32; ``tile`` (U, V)
     repetitions over the base's uvs; optional ``glow`` (D,H,W) float32 >= 0, light emitted per
     unit of object-space length in units of the voxel's colour (the paper's glow, §5.3);
-    ``length``: the object-space length alpha is the opacity of (1, DESIGN.md's per unit
+    ``length``: the object-space length alpha is the opacity of (1, the default per unit
     length, unless the texture was authored over a shell's thickness: `over_length`; alpha
     stays the authored float32 value, so a dense medium keeps its precision)."""
 

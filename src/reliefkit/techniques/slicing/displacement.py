@@ -4,7 +4,7 @@ and its displacement volume as tetrahedra.
 Conventions
 -----------
 The displacement texture is ``color`` (H, W, 4) float32 linear straight alpha and ``height``
-(H, W) float32 in [0, 1], sampled as DESIGN.md's heightfields: ``height[j, i]`` at
+(H, W) float32 in [0, 1], sampled as the core's heightfields: ``height[j, i]`` at
 texture coordinates s = (i + 0.5) / W, t = (j + 0.5) / H, bilinear between texel centres,
 clamped at the border (or wrapped, ``wrap``, for periodic textures that tile). A base vertex
 with uv (u, v) reads the texture at (s, t) = (u * tile[0], v * tile[1]). Height 0 is no
@@ -243,7 +243,7 @@ class DisplacementMap:
 
 def bilinear(image: np.ndarray, s, t, wrap: bool) -> np.ndarray:
     """``image`` (H, W) at texture coordinates (s, t): bilinear between texel centres,
-    clamped at the border (DESIGN.md) or wrapped."""
+    clamped at the border (as `reference.heightfield`) or wrapped."""
     hh, ww = image.shape
     x = np.asarray(s, np.float64) * ww - 0.5
     y = np.asarray(t, np.float64) * hh - 0.5

@@ -196,8 +196,8 @@ vec4 robust_corners(ivec2 lo, ivec2 hi, int corner, int octant, out float radius
 // exactly (an exact hit); a shorter last jump keeps the guarantee. Rays shorter than
 // u_exact_below texels and vertical ones are walked exactly. With the jumps, bisections and
 // walks in nested loops (and a fetch of its own for the radius after each walk) a SIMD group
-// waited in each loop for its slowest ray: on llvmpipe that took 1.1-1.3x this loop's time
-// for the same hits and iterations (docs/benchmarks.md).
+// waited in each loop for its slowest ray: on llvmpipe that took up to 1.3x this loop's time
+// for the same hits and iterations (CHANGELOG.md, 2026-12-04).
 bool relief_intersect(vec3 o, vec3 d, float s0, float s1, out float s_hit, inout int iters) {
     s_hit = s0;
     if (hf_above(o + s0 * d) < 0.0) return true;
