@@ -25,8 +25,8 @@ from ..gl.textures import texture2d, texture3d, texture_array, texture_levels
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .multipass import shadow_map
 from .plan import DrawPlan, Geometry, Program, Texture
-from .proxy import GL_DEPTH_CLAMP
 
+GL_DEPTH_CLAMP = 0x864F  # moderngl has no flag for it: enabled through enable_direct
 _BLEND = {"under": (moderngl.ONE_MINUS_DST_ALPHA, moderngl.ONE),
           "add": (moderngl.ONE, moderngl.ONE)}
 _MODES = {"triangles": moderngl.TRIANGLES, "points": moderngl.POINTS,
