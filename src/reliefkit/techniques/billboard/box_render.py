@@ -252,9 +252,12 @@ class BillboardBoxesDrawable:
                                            boxes.thickness))
                 self.parts[-1].uniforms |= _atlas_uniforms(boxes.cloud, k)
             if opts.lod == "auto":
-                from .render import BillboardCloudDrawable
+                from ...render.executor import Executor
+                from .render import cloud_plan
 
-                self.cloud = BillboardCloudDrawable(ctx, boxes.cloud, instrument=instrument)
+                self.cloud_plan = cloud_plan(boxes.cloud, instrument)
+                self.cloud = Executor(ctx)
+                self.cloud.upload([self.cloud_plan])
         except BaseException:
             self.release()
             raise
@@ -268,7 +271,7 @@ class BillboardBoxesDrawable:
         self.drawn = {"lod": "boxes", "flatten": flatten}
         if self.cloud is not None and flatten <= 0.0:
             self.drawn["lod"] = "billboard cloud"
-            self.cloud.draw(camera, light)
+            self.cloud.draw(self.cloud_plan, camera, light)
             return
         self._draw_boxes(camera, light, flatten,
                          handoff=1.0 - flatten if self.cloud is not None else 0.0)
@@ -278,8 +281,9 @@ class BillboardBoxesDrawable:
         values = {"u_handoff": float(handoff), "u_bbc_color": _CLOUD_COLOR_UNIT,
                   "u_bbc_normal": _CLOUD_NORMAL_UNIT}
         if handoff > 0.0:
-            self.cloud.color.use(_CLOUD_COLOR_UNIT)
-            self.cloud.normal.use(_CLOUD_NORMAL_UNIT)
+            self.cloud.texture(self.cloud_plan.textures["u_color_atlas"]).use(_CLOUD_COLOR_UNIT)
+            self.cloud.texture(self.cloud_plan.textures["u_normal_atlas"]).use(
+                _CLOUD_NORMAL_UNIT)
         return values
 
     def _draw_boxes(self, camera, light, flatten: float, handoff: float = 0.0) -> None:
