@@ -21,7 +21,15 @@ import numpy as np
 from ..gl.context import check_gl_error
 from ..gl.shaders import program
 from ..gl.targets import FRONT_OPACITY_UNIT
-from ..gl.textures import texture2d, texture3d, texture_array, texture_levels
+from ..gl.textures import (
+    _check_2d,
+    check_3d_size,
+    check_array_size,
+    texture2d,
+    texture3d,
+    texture_array,
+    texture_levels,
+)
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from .multipass import shadow_map
 from .plan import DrawPlan, Geometry, Program, Texture
@@ -64,8 +72,13 @@ class Executor:
 
     # -- upload ---------------------------------------------------------------------------
     def upload(self, plans) -> None:
-        """Create the GL objects of ``plans`` not uploaded yet; on failure everything made
-        so far stays owned (and is freed by `release`)."""
+        """Create the GL objects of ``plans`` not uploaded yet, every texture's size checked
+        against the GL limits before any is allocated; on failure everything made so far
+        stays owned (and is freed by `release`)."""
+        for plan in plans:
+            for tex in plan.textures.values():
+                if id(tex) not in self._textures:
+                    _check_size(self.ctx, tex)
         for plan in plans:
             self._keep_alive.append(plan)
             for tex in plan.textures.values():
@@ -189,6 +202,8 @@ class Executor:
         plan goes to its kind. ``extra_uniforms``/``textures`` add to the plan's (a shadow
         map); ``program_override`` draws the geometry with another program (a caster)."""
         viewed, stats = self.view(plan, camera, light)
+        if viewed.count == 0:  # switched off from this view
+            return stats
         if viewed.multipass is not None and program_override is None:
             stats |= MULTIPASS[viewed.multipass.kind](self, viewed, camera, light,
                                                       extra_uniforms or {}, textures or {})
@@ -249,6 +264,21 @@ def _write(buffer: _Buffer, array: np.ndarray, dtype=None) -> None:
         buffer.buffer.orphan(len(data))
     buffer.buffer.write(data)
     buffer.source = array
+
+
+def _check_size(ctx, tex: Texture) -> None:
+    """Refuse ``tex`` over the GL limits as `reliefkit.gl.textures` would when creating it
+    (sRGB texture arrays are decoded to float16 there: two bytes a channel)."""
+    array = tex.levels[0] if tex.levels is not None else tex.array
+    shape = array.shape
+    if tex.target == "2d" and len(shape) >= 2:
+        _check_2d(ctx, shape[1], shape[0], tex.what)
+    elif tex.target == "3d" and len(shape) >= 3:
+        check_3d_size(ctx, shape[2], shape[1], shape[0], tex.what, nbytes=array.nbytes)
+    elif tex.target == "2d_array" and len(shape) >= 3:
+        itemsize = 2 if tex.srgb else array.itemsize
+        check_array_size(ctx, shape[2], shape[1], shape[0], tex.what,
+                         nbytes=array.size * itemsize)
 
 
 def _upload_texture(ctx, tex: Texture):

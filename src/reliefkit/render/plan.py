@@ -123,14 +123,16 @@ class ViewHook:
 @dataclass
 class ViewUpdate:
     """A hook's answer for one camera: uniforms to set, vertex arrays (by attribute name) or
-    indices to replace, a new vertex/instance count, the faces to cull, and statistics for
-    the drawable's `finish`. Empty fields leave the plan's own."""
+    indices to replace, a new vertex/instance count, a new ``count`` of the range drawn (0:
+    nothing from this view, a level of detail switched off), the faces to cull, and
+    statistics for the drawable's `finish`. Empty fields leave the plan's own."""
 
     uniforms: dict = field(default_factory=dict)
     attributes: dict = field(default_factory=dict)
     indices: np.ndarray | None = None
     vertices: int | None = None
     instances: int | None = None
+    count: int | None = None
     cull: str | None = None
     stats: dict = field(default_factory=dict)
 
@@ -190,7 +192,8 @@ class DrawPlan:
                 instances=geometry.instances if update.instances is None
                 else update.instances)
         raster = self.raster if update.cull is None else replace(self.raster, cull=update.cull)
-        return replace(self, geometry=geometry, raster=raster,
+        count = self.count if update.count is None else update.count
+        return replace(self, geometry=geometry, raster=raster, count=count,
                        uniforms={**self.uniforms, **update.uniforms}), update.stats
 
 

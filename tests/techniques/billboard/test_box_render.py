@@ -382,17 +382,21 @@ def test_instrumented_pass_draws_the_same_pixels(boxes_drawable, march):
 
 def test_textures_over_the_gl_limits_are_refused_before_allocating(gl, boxes_drawable,
                                                                    monkeypatch):
+    """Box 1 is wider than a 3D texture may be: nothing is allocated, box 0's textures
+    neither."""
     limit = int(gl.info["GL_MAX_3D_TEXTURE_SIZE"])
     occupied = np.zeros((1, 1, limit + 1), bool)
     occupied[0, 0, 0] = True
     wide = box_frame((-1.0, -0.01, 0.0), (2.0, 0, 0), (0, 0.02, 0), 0.02)
-    boxes = BillboardBoxes(variant="volumetric", boxes=[volumetric_box(wide, occupied)],
-                           cloud=cloud_for([wide], 0.02))
+    boxes = BillboardBoxes(variant="volumetric",
+                           boxes=[volumetric_box(TILTED, np.ones((2, 4, 4), bool)),
+                                  volumetric_box(wide, occupied)],
+                           cloud=cloud_for([TILTED, wide], 0.02))
     calls = []
     original = gl.texture3d
     monkeypatch.setattr(gl, "texture3d", lambda *a, **k: calls.append(a) or original(*a, **k))
-    with pytest.raises(GPUError, match="limit"):
-        box_render.BillboardBoxesDrawable(gl, boxes)
+    with pytest.raises(GPUError, match=f"box 1 distance: .* exceeds this GPU's limit of {limit}"):
+        render(boxes, cameras()["front-persp"], ctx=gl)
     assert not calls
 
 
@@ -401,7 +405,7 @@ def test_options_and_programs():
     assert (opts.march, opts.samples, opts.flatten, opts.max_iterations) == ("sphere", 2, 1.0, 0)
     defines = {tuple(sorted(v.defines)) for v in box_render.PROGRAMS}
     assert len(defines) == 18
-    assert box_render.drawn_box_to_world(volumetric_boxes().boxes[0], 0.0)[2, 2] != 0
+    assert box_render.drawn_box_to_world(volumetric_boxes().boxes[0].box_to_world, 0.0)[2, 2] != 0
 
 
 def test_every_program_compiles_as_glsl_and_glsl_es(gl, boxes_drawable):

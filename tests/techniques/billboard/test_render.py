@@ -370,9 +370,10 @@ class LimitedContext:
     ({"GL_MAX_ARRAY_TEXTURE_LAYERS": 1}, "2 texture array layers exceed this GPU's limit of 1"),
     ({"GL_MAX_TEXTURE_SIZE": 16}, "32x32 texture exceeds this GPU's limit of 16x16"),
 ])
-def test_atlases_beyond_the_gpu_limits_are_refused_before_allocation(gl, limits, match):
+def test_atlases_beyond_the_gpu_limits_are_refused_before_allocation(gl, billboard, limits,
+                                                                     match):
     with pytest.raises(GPUError, match=match):
-        billboard_render.BillboardCloudDrawable(LimitedContext(gl, **limits), two_page_cloud())
+        render(two_page_cloud(), cameras()["perspective"], ctx=LimitedContext(gl, **limits))
 
 
 @pytest.mark.parametrize("es", [False, True], ids=["glsl330", "es300"])

@@ -152,7 +152,7 @@ def reference_trace(boxes: BillboardBoxes, camera, flatten: float = 1.0) -> dict
            "point": np.full((count, 3), np.nan), "world": np.full((count, 3), np.nan),
            "cell": np.full((count, 3), -1, np.int64)}
     for index, box in enumerate(boxes.boxes):
-        to_world = drawn_box_to_world(box, flatten)
+        to_world = drawn_box_to_world(box.box_to_world, flatten)
         a, b, valid, lo, hi = clip_to_box(invert_box(to_world), near, far)
         rows = np.flatnonzero(valid)
         res = np.array(box.resolution, np.float64)
@@ -191,7 +191,7 @@ def wrong_hits(frame, boxes: BillboardBoxes, camera, *, flatten: float = 1.0,
         here = both & (ref.box == index)
         if not here.any():
             continue
-        world_to_box = invert_box(drawn_box_to_world(box, flatten))
+        world_to_box = invert_box(drawn_box_to_world(box.box_to_world, flatten))
         drawn = homogeneous(frame.position[here]) @ world_to_box[:3].T
         delta = (drawn - ref.point[here]) * np.array(box.resolution, np.float64)
         far[here] = np.linalg.norm(delta, axis=1) > tolerance_voxels

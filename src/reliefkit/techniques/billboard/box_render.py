@@ -36,18 +36,21 @@ give a 3D texture an sRGB internal format; with nearest fetches the decode is wh
 texture would return), normal RGB8 3D; shells colour SRGB8_ALPHA8 2D, normal RGB8 2D,
 displacement R16UI / RG16UI 2D (integer textures read with a ``usampler2D``: the uint16 value
 exactly, w = value / 65535); every variant its (D, H, W) uint8 distance 3D texture
-(normalised, times 255 in the shader). All sizes of all boxes are checked against the GL
-limits before anything is allocated.
+(normalised, times 255 in the shader). The executor checks all sizes of all boxes against
+the GL limits before anything is allocated.
 
-Camera-relative rendering: each proxy is stored in float32 relative to an interior point and
-placed with ``u_model_offset``; the box transforms are handed over relative to the camera's
-origin (``translation(-camera.origin) @ box_to_world`` and its `invert_box`).
+Each box is one draw plan (`render.plan`): its proxy relative to an interior point, the
+plan's ``origin`` (camera-relative rendering), its textures and fixed uniforms. Its view
+hook `box_view` gives what changes with the camera: the box transforms relative to the
+camera's origin (``translation(-camera.origin) @ box_to_world`` and its `invert_box`),
+flattened as the options or the distance say, and the proxy's faces to cull. With lod auto
+the cloud's own plan follows the boxes', and `view_lod` switches between them per view.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -55,14 +58,22 @@ from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...core.transforms import invert_box
 from ...errors import UsageError
-from ...gl.context import check_gl_error
-from ...gl.shaders import program
-from ...gl.textures import check_3d_size, texture2d, texture3d
-from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
-from ...render.proxy import box_planes, convex_proxy, cull_face, proxy_raster_state
+from ...gl.uniforms import box_uniforms
+from ...render.plan import (
+    Attribute,
+    DrawPlan,
+    Geometry,
+    Program,
+    Raster,
+    Texture,
+    ViewHook,
+    ViewUpdate,
+)
+from ...render.proxy import Proxy, box_planes, convex_proxy, cull_face
 from ...scene.camera import Camera
 from .boxes import BillboardBox, BillboardBoxes
 from .lod import flatten_factor
+from .render import cloud_plan
 
 PROGRAM = "billboard:boxes.glsl"
 MARCHES = ("sphere", "uniform", "exact")
@@ -117,10 +128,10 @@ def scale_w(factor: float) -> np.ndarray:
     return m
 
 
-def drawn_box_to_world(box: BillboardBox, flatten: float = 1.0) -> np.ndarray:
-    """The box as drawn: ``box_to_world @ scale_w(flatten)``, flatten clamped to
+def drawn_box_to_world(box_to_world, flatten: float = 1.0) -> np.ndarray:
+    """A box as drawn: ``box_to_world @ scale_w(flatten)``, flatten clamped to
     `MIN_FLATTEN`; the box coordinates of the data (u, v, w) are unchanged."""
-    return np.asarray(box.box_to_world, np.float64) @ scale_w(max(float(flatten), MIN_FLATTEN))
+    return np.asarray(box_to_world, np.float64) @ scale_w(max(float(flatten), MIN_FLATTEN))
 
 
 def distance_uniforms(box: BillboardBox) -> dict:
@@ -154,161 +165,127 @@ def _min_sphere_step(scale: float, margin: float) -> float:
     return math.floor(margin / scale + 1.0) * scale - margin
 
 
-def check_box_sizes(ctx, boxes: BillboardBoxes) -> None:
-    """Every texture of every box against the GL limits, before any is allocated."""
-    from ...gl.textures import _check_2d
-
-    for k, box in enumerate(boxes.boxes):
-        w, h, d = box.resolution
-        check_3d_size(ctx, w, h, d, f"box {k} distance", nbytes=box.distance.nbytes)
-        if boxes.variant == "volumetric":
-            check_3d_size(ctx, w, h, d, f"box {k} colour", nbytes=box.color.nbytes)
-        else:
-            _check_2d(ctx, w, h, f"box {k} colour")
+#: Proxies are drawn culled (`cull_face` per view) with depth clamped and tested with "<="
+#: (`render.proxy`).
+PROXY_RASTER = Raster(depth_func="<=", depth_clamp=True, cull="back")
+#: Where ``u_bbc_color`` and ``u_bbc_normal`` point without lod auto: units no texture of a
+#: box uses (the shader declares them, and two sampler types may not share a unit).
+_NO_CLOUD_UNITS = {"u_bbc_color": 4, "u_bbc_normal": 5}
 
 
-def box_textures(ctx, box: BillboardBox, variant: str) -> dict:
-    """The box's textures by sampler name (released by the caller, also on failure: they
-    are added to ``out`` one by one)."""
-    out = {}
-    try:
-        out["u_distance"] = texture3d(ctx, box.distance, what="distance", filter="nearest")
-        if variant == "volumetric":
-            out["u_color"] = texture3d(ctx, box.color, what="colour", filter="nearest")
-            out["u_normal"] = texture3d(ctx, box.normal, what="normal", filter="nearest")
-        else:
-            out["u_color"] = texture2d(ctx, box.color, what="colour", srgb=True,
-                                       filter="nearest")
-            out["u_normal"] = texture2d(ctx, box.normal, what="normal", filter="nearest")
-            out["u_displacement"] = texture2d(ctx, box.displacement, what="displacement",
-                                              filter="nearest")
-    except BaseException:
-        for tex in out.values():
-            tex.release()
-        raise
+def box_textures(box: BillboardBox, variant: str, k: int) -> dict:
+    """Box ``k``'s textures by sampler name, every one sampled with ``texelFetch``."""
+    out = {"u_distance": Texture(box.distance, target="3d", filter="nearest",
+                                 what=f"box {k} distance")}
+    if variant == "volumetric":
+        out["u_color"] = Texture(box.color, target="3d", filter="nearest",
+                                 what=f"box {k} colour")
+        out["u_normal"] = Texture(box.normal, target="3d", filter="nearest",
+                                  what=f"box {k} normal")
+    else:
+        out["u_color"] = Texture(box.color, srgb=True, filter="nearest", what=f"box {k} colour")
+        out["u_normal"] = Texture(box.normal, filter="nearest", what=f"box {k} normal")
+        out["u_displacement"] = Texture(box.displacement, filter="nearest",
+                                        what=f"box {k} displacement")
     return out
 
 
-class _BoxPart:
-    """One box's GL objects: textures, proxy buffers, its fixed uniforms."""
-
-    def __init__(self, ctx, prog, box: BillboardBox, variant: str, opts, thickness):
-        self.box = box
-        full = np.asarray(box.box_to_world, np.float64)  # contains every flattening of it
-        self.proxy = convex_proxy(box_planes(invert_box(full)),
-                                  near=full[:3, 3] + full[:3, :3] @ [0.5, 0.5, 0.5])
-        self.textures, self.vao, self.vbo, self.ibo = {}, None, None, None
-        try:
-            self.textures = box_textures(ctx, box, variant)
-            self.vbo = ctx.buffer(self.proxy.positions.tobytes())
-            self.ibo = ctx.buffer(self.proxy.triangles.tobytes())
-            self.vao = ctx.vertex_array(prog, [(self.vbo, "3f", "in_position")], self.ibo,
-                                        index_element_size=4)
-        except BaseException:
-            self.release()
-            raise
-        distance = distance_uniforms(box)
-        min_step = _min_sphere_step(distance["u_distance_scale"], distance["u_distance_margin"])
-        self.uniforms = distance | {
-            "u_res": box.resolution, "u_samples": opts.samples,
-            "u_half_thickness": 0.5 * float(thickness or 0.0),
-            "u_max_iterations": opts.max_iterations or automatic_iterations(
-                box.resolution, opts.march, variant, opts.samples, min_step)}
-
-    def box_uniforms(self, camera, flatten: float) -> dict:
-        """The box transforms, flattened, in the camera's relative world space."""
-        return box_uniforms(camera, drawn_box_to_world(self.box, flatten))
-
-    def release(self) -> None:
-        for obj in (self.vao, self.vbo, self.ibo, *self.textures.values()):
-            if obj is not None:
-                obj.release()
-        self.vao = self.vbo = self.ibo = None
-        self.textures = {}
-
-
 class BillboardBoxesDrawable:
-    """Every box of a `BillboardBoxes`, drawn one after another with the depth test on; each
-    fragment writes its hit's depth, so overlapping boxes and other objects resolve."""
+    """Every box of a `BillboardBoxes` as one draw plan, drawn one after another with the
+    depth test on; each fragment writes its hit's depth, so overlapping boxes and other
+    objects resolve. With lod auto the flat cloud's plan comes last, drawn instead of the
+    boxes beyond the switch distance."""
 
-    def __init__(self, ctx, boxes: BillboardBoxes, options: BoxRenderOptions | None = None,
+    def __init__(self, boxes: BillboardBoxes, options: BoxRenderOptions | None = None,
                  instrument: bool = False):
         opts = options or BoxRenderOptions()
         if opts.march not in MARCHES:
             raise UsageError(f"march must be one of {', '.join(MARCHES)}, got {opts.march!r}")
         _check_applicable(opts)
-        self.ctx, self.boxes, self.options = ctx, boxes, opts
+        self.boxes, self.options = boxes, opts
         self.extra_attachments = 1 if instrument else 0
-        check_box_sizes(ctx, boxes)
-        self.prog = program(ctx, PROGRAM, {
-            VARIANT_DEFINES[boxes.variant]: True, f"MARCH_{opts.march.upper()}": True,
-            "COUNT_ITERATIONS": instrument})
-        self.parts: list[_BoxPart] = []
-        self.cloud = None  # the flat cloud, drawn beyond the switch distance (lod auto)
-        self.drawn = {}
-        try:
-            for k, box in enumerate(boxes.boxes):
-                self.parts.append(_BoxPart(ctx, self.prog, box, boxes.variant, opts,
-                                           boxes.thickness))
-                self.parts[-1].uniforms |= _atlas_uniforms(boxes.cloud, k)
-            if opts.lod == "auto":
-                from .render import BillboardCloudDrawable
+        program = Program(PROGRAM, {VARIANT_DEFINES[boxes.variant]: True,
+                                    f"MARCH_{opts.march.upper()}": True,
+                                    "COUNT_ITERATIONS": instrument})
+        lod = None if opts.lod != "auto" else {
+            "epsilon": float(boxes.epsilon), "center": tuple(float(x) for x in boxes.center),
+            "transition": float(opts.transition)}
+        cloud = cloud_plan(boxes.cloud, instrument) if lod else None
+        self.plans = [box_plan(boxes, k, program, opts, lod, cloud)
+                      for k in range(len(boxes.boxes))]
+        if cloud is not None:
+            self.plans.append(replace(cloud, per_view=ViewHook(
+                f"{__name__}:cloud_view", {"flatten": opts.flatten, "lod": lod})))
 
-                self.cloud = BillboardCloudDrawable(ctx, boxes.cloud, instrument=instrument)
-        except BaseException:
-            self.release()
-            raise
-        check_gl_error(ctx, "uploading billboard boxes")
-
-    def draw(self, camera, light) -> None:
-        flatten = self.options.flatten  # lod auto's own where it applies (not both)
-        if self.cloud is not None and isinstance(camera, Camera):
-            flatten = flatten_factor(camera, self.boxes.epsilon, self.boxes.center,
-                                     self.options.transition)
-        self.drawn = {"lod": "boxes", "flatten": flatten}
-        if self.cloud is not None and flatten <= 0.0:
-            self.drawn["lod"] = "billboard cloud"
-            self.cloud.draw(camera, light)
-            return
-        self._draw_boxes(camera, light, flatten,
-                         handoff=1.0 - flatten if self.cloud is not None else 0.0)
-
-    def _handoff_uniforms(self, camera, handoff: float) -> dict:
-        """What the shader needs to fade into the cloud's own filtered colour and normal."""
-        values = {"u_handoff": float(handoff), "u_bbc_color": _CLOUD_COLOR_UNIT,
-                  "u_bbc_normal": _CLOUD_NORMAL_UNIT}
-        if handoff > 0.0:
-            self.cloud.color.use(_CLOUD_COLOR_UNIT)
-            self.cloud.normal.use(_CLOUD_NORMAL_UNIT)
-        return values
-
-    def _draw_boxes(self, camera, light, flatten: float, handoff: float = 0.0) -> None:
-        set_uniforms(self.prog, camera_uniforms(camera) | light.uniforms()
-                     | self._handoff_uniforms(camera, handoff))
-        with proxy_raster_state(self.ctx):
-            for part in self.parts:
-                set_uniforms(self.prog, part.uniforms | part.box_uniforms(camera, flatten)
-                             | model_offset(camera, part.proxy.origin))
-                for unit, (name, tex) in enumerate(part.textures.items()):
-                    tex.use(unit)
-                    set_uniforms(self.prog, {name: unit})
-                self.ctx.cull_face = cull_face(part.proxy, camera)
-                part.vao.render()
-
-    def finish(self, frame) -> None:
-        frame.stats["boxes"] = len(self.parts)
-        frame.stats |= self.drawn
-
-    def release(self) -> None:
-        for part in self.parts:
-            part.release()
-        self.parts = []
-        if self.cloud is not None:
-            self.cloud.release()
-            self.cloud = None
+    def finish(self, frame, stats: dict) -> None:
+        frame.stats["boxes"] = len(self.boxes.boxes)
+        frame.stats |= stats
 
 
-_CLOUD_COLOR_UNIT, _CLOUD_NORMAL_UNIT = 4, 5  # after a box's own (at most 4) textures
+def box_plan(boxes: BillboardBoxes, k: int, program: Program, opts: BoxRenderOptions,
+             lod: dict | None, cloud: DrawPlan | None) -> DrawPlan:
+    """Box ``k``'s draw: the proxy of the whole box (it contains every flattening of it),
+    its textures and, with lod auto, the cloud's atlases to hand over to."""
+    box = boxes.boxes[k]
+    full = np.asarray(box.box_to_world, np.float64)
+    proxy = convex_proxy(box_planes(invert_box(full)),
+                         near=full[:3, 3] + full[:3, :3] @ [0.5, 0.5, 0.5])
+    distance = distance_uniforms(box)
+    min_step = _min_sphere_step(distance["u_distance_scale"], distance["u_distance_margin"])
+    uniforms = distance | {
+        "u_res": box.resolution, "u_samples": opts.samples,
+        "u_half_thickness": 0.5 * float(boxes.thickness or 0.0),
+        "u_max_iterations": opts.max_iterations or automatic_iterations(
+            box.resolution, opts.march, boxes.variant, opts.samples, min_step),
+    } | _atlas_uniforms(boxes.cloud, k)
+    textures = box_textures(box, boxes.variant, k)
+    if cloud is None:
+        uniforms |= _NO_CLOUD_UNITS
+    else:
+        textures |= {"u_bbc_color": cloud.textures["u_color_atlas"],
+                     "u_bbc_normal": cloud.textures["u_normal_atlas"]}
+    return DrawPlan(
+        name=f"box {k}", program=program,
+        geometry=Geometry({"in_position": Attribute(proxy.positions)},
+                          indices=proxy.triangles),
+        textures=textures, uniforms=uniforms, raster=PROXY_RASTER,
+        origin=tuple(float(x) for x in proxy.origin),
+        per_view=ViewHook(f"{__name__}:box_view", {
+            "box_to_world": full, "planes": proxy.planes, "flatten": opts.flatten,
+            "lod": lod}))
+
+
+def view_lod(camera, flatten: float, lod: dict | None) -> dict:
+    """What the boxes draw from ``camera``: ``lod`` "boxes" or "billboard cloud" and the
+    boxes' ``flatten``; with lod auto (``lod``: epsilon, center, transition) the flattening
+    comes from the distance (§3.4.2) and the cloud is drawn where it reaches 0."""
+    if lod is not None and isinstance(camera, Camera):
+        flatten = flatten_factor(camera, lod["epsilon"], lod["center"], lod["transition"])
+    cloud = lod is not None and flatten <= 0.0
+    return {"lod": "billboard cloud" if cloud else "boxes", "flatten": flatten}
+
+
+def box_view(plan: DrawPlan, camera, light, *, box_to_world, planes, flatten: float,
+             lod: dict | None) -> ViewUpdate:
+    """A box from ``camera``: its transforms flattened, in the camera's relative world
+    space, the hand-over to the cloud (lod auto), the proxy's faces to cull; nothing
+    beyond the switch distance."""
+    drawn = view_lod(camera, flatten, lod)
+    if drawn["lod"] != "boxes":
+        return ViewUpdate(count=0, stats=drawn)
+    geometry = plan.geometry
+    proxy = Proxy(geometry.attributes["in_position"].array, geometry.indices, planes,
+                  np.asarray(plan.origin, np.float64))
+    handoff = 1.0 - drawn["flatten"] if lod is not None else 0.0
+    uniforms = {"u_handoff": float(handoff)} | box_uniforms(
+        camera, drawn_box_to_world(box_to_world, drawn["flatten"]))
+    return ViewUpdate(uniforms=uniforms, cull=cull_face(proxy, camera), stats=drawn)
+
+
+def cloud_view(plan: DrawPlan, camera, light, *, flatten: float, lod: dict) -> ViewUpdate:
+    """The flat cloud of lod auto from ``camera``: drawn only beyond the switch distance."""
+    drawn = view_lod(camera, flatten, lod)
+    return ViewUpdate(count=None if drawn["lod"] == "billboard cloud" else 0, stats=drawn)
 
 
 def _atlas_uniforms(cloud, k: int) -> dict:
@@ -321,4 +298,4 @@ def _atlas_uniforms(cloud, k: int) -> dict:
 
 def drawable_spec() -> DrawableSpec:
     """The `DrawableSpec` of `BillboardBoxes` for the package's Technique."""
-    return DrawableSpec(BillboardBoxes, BillboardBoxesDrawable, BoxRenderOptions)
+    return DrawableSpec(BillboardBoxes, BillboardBoxesDrawable, BoxRenderOptions, planned=True)
