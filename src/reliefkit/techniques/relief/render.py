@@ -101,7 +101,7 @@ def drawn_method(relief: ReliefTexture, options: ReliefRenderOptions) -> str:
 
 
 def relief_plan(relief: ReliefTexture, options: ReliefRenderOptions,
-                instrument: bool = False) -> DrawPlan:
+                instrument: bool = False, name: str = "relief texture") -> DrawPlan:
     """The draw plan of one relief texture with ``options``: its proxy, the textures of the
     method that draws it (`drawn_method`) and its uniforms. Refuses robust jumps without
     safety radii."""
@@ -135,7 +135,7 @@ def relief_plan(relief: ReliefTexture, options: ReliefRenderOptions,
         top_level = len(levels) - 1
     proxy = relief_proxy(relief)
     return DrawPlan(
-        name="relief texture",
+        name=name,
         program=Program(PROGRAM, {
             f"METHOD_{method.upper()}": True, "SAFETY_OCTANTS": octants,
             "WRITE_DEPTH": options.depth_mode == "exact", "SHADOWS": options.shadows,
@@ -186,9 +186,8 @@ class ReliefDrawable:
 
     def __init__(self, relief: ReliefTexture, options: ReliefRenderOptions | None = None,
                  instrument: bool = False):
-        self.relief, self.options = relief, options or ReliefRenderOptions()
         self.extra_attachments = 1 if instrument else 0
-        self.plans = [relief_plan(relief, self.options, instrument)]
+        self.plans = [relief_plan(relief, options or ReliefRenderOptions(), instrument)]
 
     def finish(self, frame, stats: dict) -> None:
         finish_depth(frame)
@@ -206,7 +205,8 @@ class ReliefObjectDrawable:
                  instrument: bool = False):
         opts = replace(options or ReliefRenderOptions(), depth_mode="exact")
         self.extra_attachments = 1 if instrument else 0
-        self.plans = [relief_plan(part, opts, instrument) for part in obj.parts]
+        self.plans = [relief_plan(part, opts, instrument, f"relief part {k}")
+                      for k, part in enumerate(obj.parts)]
 
     def finish(self, frame, stats: dict) -> None:
         finish_depth(frame)
