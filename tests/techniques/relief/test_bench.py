@@ -24,7 +24,7 @@ def test_every_method_is_measured(tiny):
     for row in tiny["table1"]:
         for method in METHODS:
             assert row[f"{method}_ms"] > 0 and row[f"{method}_it_mean"] > 0
-        assert row["pyramid_s"] >= 0 and row["safety_s"] >= 0 and row["pyramid_gpu_ms"] > 0
+        assert row["pyramid_s"] >= 0 and row["safety_s"] >= 0
     assert {r["model"] for r in tiny["correctness"]} == {"terrain", "blob", "vehicle",
                                                          "vehicle frustum", "blob cube"}
     for corr in tiny["correctness"]:
@@ -35,7 +35,7 @@ def test_targets_name_each_method_and_render(tiny):
     names = " ".join(t["target"] for t in tiny["targets"])
     assert "maxmip" in names and "robust with every field jumping" in names
     text = bench.markdown(tiny)
-    assert "maxmip ms" in text and "max pyramid GPU ms" in text and "scanned pieces" in text
+    assert "maxmip ms" in text and "max pyramid s" in text and "scanned pieces" in text
     assert "Fig. 12" in text and "terrain 16², view elevation 20°" in text  # its resolution
     # a quick run times single draws: its frame-time ratios are shown, not judged
     timed = [t for t in tiny["targets"] if "slower than exact" in t["target"]]

@@ -111,12 +111,11 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
             start = time.perf_counter()
             max_pyramid(relief.height)
             pyramid_s = time.perf_counter() - start
-            pyramid_gpu_ms = gpu_pyramid_ms(relief.height)
             start = time.perf_counter()
             relaxed_cone_ratios(relief.height)
             row = {"model": model_label(name), "res": res, "mesh_ms": mesh_ms,
                    "triangles": mesh.triangle_count, "safety_s": safety_s,
-                   "pyramid_s": pyramid_s, "pyramid_gpu_ms": pyramid_gpu_ms,
+                   "pyramid_s": pyramid_s,
                    "cone_s": time.perf_counter() - start,
                    **{f"safety_{k}": v for k, v in work.items()},
                    "mean_radius": float(relief.safety.mean()),
@@ -139,31 +138,6 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
             log(f"table 1: {model_label(name)} {res}^2: " + ", ".join(
                 f"{m} {row[m + '_ms']:.0f} ms / {row[m + '_it_mean']:.1f} it" for m in METHODS))
     return rows
-
-
-def gpu_pyramid_ms(height, repeats: int = 3) -> float:
-    """Median wall milliseconds (to glFinish) of building the max pyramid on the GPU from the
-    uploaded height texture, its texture allocation included; the first build compiles."""
-    import statistics
-
-    from ...gl.context import get_context
-    from ...gl.textures import texture2d
-    from .maxmip import max_pyramid_texture
-
-    ctx = get_context()
-    tex = texture2d(ctx, height, what="height", filter="nearest")
-    times = []
-    try:
-        for _ in range(repeats + 1):
-            ctx.finish()
-            start = time.perf_counter()
-            pyramid, _ = max_pyramid_texture(ctx, height, tex)
-            ctx.finish()
-            times.append((time.perf_counter() - start) * 1e3)
-            pyramid.release()
-    finally:
-        tex.release()
-    return statistics.median(times[1:])
 
 
 def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
@@ -306,10 +280,6 @@ def check_targets(results: dict) -> list[dict]:
                         "value": row["safety_s"], "met": row["safety_s"] <= 10})
             out.append({"target": "max pyramid for 1024^2 in < 1 s (CPU)",
                         "value": row["pyramid_s"], "met": row["pyramid_s"] < 1})
-            if "pyramid_gpu_ms" in row:
-                out.append({"target": "max pyramid for 1024^2 in < 1 s (GPU, seconds)",
-                            "value": row["pyramid_gpu_ms"] / 1e3,
-                            "met": row["pyramid_gpu_ms"] < 1e3})
     return out
 
 
@@ -358,14 +328,14 @@ def markdown(results: dict) -> str:
               "The safety sweep's work per texel: walk positions visited, profile pieces "
               "built, forward scans and the pieces they visited.", "",
               "| model | resolution | safety radii s | mean radius | visits | pieces | scans | "
-              "scanned pieces | max pyramid s | max pyramid GPU ms | cone map s |",
-              "|---" * 11 + "|"]
+              "scanned pieces | max pyramid s | cone map s |",
+              "|---" * 10 + "|"]
     nan = float("nan")
     for r in results["table1"]:
         work = " | ".join(f"{r.get(f'safety_{k}', nan):.0f}" for k in WORK_COUNTERS)
         lines.append(f"| {r['model']} | {r['res']}² | {r['safety_s']:.2f} | "
                      f"{r['mean_radius']:.2f} | {work} | {r.get('pyramid_s', nan):.3f} | "
-                     f"{r.get('pyramid_gpu_ms', nan):.2f} | {r.get('cone_s', nan):.2f} |")
+                     f"{r.get('cone_s', nan):.2f} |")
     lines += ["", "#### Memory (arrays as stored, uncompressed)", "",
               "| model | resolution | relief texture | its mesh |", "|---" * 4 + "|"]
     for r in results["table1"]:

@@ -1,31 +1,42 @@
-"""Relief textures: draw the box (or frustum) and intersect each pixel's ray in the shader."""
+"""Relief textures: draw the box (or frustum) and intersect each pixel's ray in the shader.
+
+A relief texture is one draw plan (`render.plan`): its proxy, its textures (the max pyramid
+and the cone map computed here, on the CPU) and its uniforms; `proxy_view` gives per camera
+the faces to cull and the box matrices relative to the camera. A ReliefObject is one plan
+per part.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...core.params import param
 from ...errors import UsageError
-from ...gl.context import check_gl_error
-from ...gl.shaders import program
-from ...gl.textures import texture2d, texture_array
-from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
+from ...gl.uniforms import box_uniforms
 from ...render.frame import window_depth
-from ...render.proxy import (
-    aabb_planes,
-    box_planes,
-    convex_proxy,
-    cull_face,
-    proxy_raster_state,
+from ...render.plan import (
+    Attribute,
+    DrawPlan,
+    Geometry,
+    Program,
+    Raster,
+    Texture,
+    ViewHook,
+    ViewUpdate,
 )
+from ...render.proxy import Proxy, aabb_planes, box_planes, convex_proxy, cull_face
 from .cone import relaxed_cone_ratios
-from .maxmip import max_pyramid_texture
+from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
 METHODS = ("binary", "exact", "robust", "maxmip", "cone")
 PROGRAM = "relief:relief.glsl"
+#: how proxies are drawn (`render.proxy`): depth clamped, not clipped, and tested with
+#: "<=" (a face clamped to the far plane has the cleared depth); `proxy_view` picks the
+#: faces to cull per camera
+PROXY_RASTER = Raster(depth_func="<=", depth_clamp=True, cull="back")
 
 
 @dataclass(frozen=True)
@@ -89,8 +100,83 @@ def drawn_method(relief: ReliefTexture, options: ReliefRenderOptions) -> str:
     return options.method
 
 
+def relief_plan(relief: ReliefTexture, options: ReliefRenderOptions,
+                instrument: bool = False, name: str = "relief texture") -> DrawPlan:
+    """The draw plan of one relief texture with ``options``: its proxy, the textures of the
+    method that draws it (`drawn_method`) and its uniforms. Refuses robust jumps without
+    safety radii."""
+    w, h = relief.depth_resolution
+    method = drawn_method(relief, options)
+    if method == "robust" and relief.safety is None:
+        raise UsageError(f"this {w}x{h} relief texture has no safety radii, which robust "
+                         "jumps by here (bakes leave them out where robust's default "
+                         "draws the exact walk): bake it with --safety, or render with "
+                         "--method maxmip (exact, needs no radii)")
+    octants = method == "robust" and relief.safety.ndim == 3
+    textures = {"u_height": Texture(relief.height, filter="nearest", what="height"),
+                "u_color": Texture(relief.color, srgb=True, mipmaps=True, what="color"),
+                "u_normal": Texture(relief.normal, what="normal")}
+    if octants:
+        textures["u_safety_octants"] = Texture(relief.safety.astype(np.float32),
+                                               target="2d_array", filter="nearest",
+                                               what="safety octants")
+    elif method == "robust":
+        packed = np.stack([relief.height, relief.safety.astype(np.float32)], axis=-1)
+        textures["u_height_safety"] = Texture(packed, filter="nearest",
+                                              what="height and safety")
+    if method == "cone":
+        textures["u_cone"] = Texture(relaxed_cone_ratios(relief.height), filter="nearest",
+                                     what="cone ratios")
+    top_level = 0
+    if method == "maxmip":
+        levels = tuple(max_pyramid(relief.height))
+        textures["u_maxmip"] = Texture(levels[0], filter="nearest", levels=levels,
+                                       what="max pyramid")
+        top_level = len(levels) - 1
+    proxy = relief_proxy(relief)
+    return DrawPlan(
+        name=name,
+        program=Program(PROGRAM, {
+            f"METHOD_{method.upper()}": True, "SAFETY_OCTANTS": octants,
+            "WRITE_DEPTH": options.depth_mode == "exact", "SHADOWS": options.shadows,
+            "COUNT_ITERATIONS": instrument}),
+        geometry=Geometry({"in_position": Attribute(proxy.positions)},
+                          indices=proxy.triangles.ravel()),
+        textures=textures,
+        uniforms={
+            "u_hf_size": (w, h), "u_linear_steps": options.linear_steps,
+            "u_binary_steps": options.binary_steps,
+            "u_max_iterations": options.max_iterations or 4 * (w + h) + 64,
+            "u_zero_exact": options.zero_radius == "exact",
+            "u_exact_below": float(options.exact_below),
+            "u_quadratic_cells": options.cell_test == "quadratic",
+            "u_top_level": top_level, "u_cone_steps": options.cone_steps,
+            "u_leaf_level": min(options.maxmip_leaf, top_level)},
+        raster=PROXY_RASTER,
+        origin=tuple(float(x) for x in proxy.origin),
+        per_view=ViewHook(f"{__name__}:proxy_view",
+                          {"box_to_world": np.asarray(relief.box_to_world, np.float64),
+                           "planes": proxy.planes}))
+
+
+def proxy_view(plan: DrawPlan, camera, light, *, box_to_world: np.ndarray,
+               planes: np.ndarray) -> ViewUpdate:
+    """A proxy's view hook: the faces to cull from ``camera`` (`render.proxy.cull_face`)
+    and the box matrices relative to it (`gl.uniforms.box_uniforms`)."""
+    geometry = plan.geometry
+    proxy = Proxy(geometry.attributes["in_position"].array, geometry.indices.reshape(-1, 3),
+                  planes, np.asarray(plan.origin, np.float64))
+    return ViewUpdate(uniforms=box_uniforms(camera, box_to_world),
+                      cull=cull_face(proxy, camera))
+
+
+def finish_depth(frame) -> None:
+    """Depth AOV from the hit positions (in conservative mode the Z-buffer holds the box)."""
+    frame.depth = window_depth(frame.position, frame.view, frame.proj, frame.depth)
+
+
 class ReliefDrawable:
-    """GPU textures and proxy of one ReliefTexture, drawn with one intersection method.
+    """One ReliefTexture drawn with one intersection method, as one draw plan.
 
     The exact walk takes one bilinear cell per step (its four corners, the ray's exact
     quadratic in it, the exact root). ``cell_test="linear"`` is the paper's walk (a cell is
@@ -98,117 +184,29 @@ class ReliefDrawable:
     saddle grazes inside a cell (Fig. 3).
     """
 
-    def __init__(self, ctx, relief: ReliefTexture, options: ReliefRenderOptions | None = None,
+    def __init__(self, relief: ReliefTexture, options: ReliefRenderOptions | None = None,
                  instrument: bool = False):
-        opts = options or ReliefRenderOptions()
-        self.ctx, self.relief, self.options = ctx, relief, opts
         self.extra_attachments = 1 if instrument else 0
-        w, h = relief.depth_resolution
-        self.method = drawn_method(relief, opts)
-        if self.method == "robust" and relief.safety is None:
-            raise UsageError(f"this {w}x{h} relief texture has no safety radii, which robust "
-                             "jumps by here (bakes leave them out where robust's default "
-                             "draws the exact walk): bake it with --safety, or render with "
-                             "--method maxmip (exact, needs no radii)")
-        self.prog = program(ctx, PROGRAM, {
-            f"METHOD_{self.method.upper()}": True,
-            "SAFETY_OCTANTS": self.method == "robust" and relief.safety.ndim == 3,
-            "WRITE_DEPTH": opts.depth_mode == "exact",
-            "SHADOWS": opts.shadows, "COUNT_ITERATIONS": instrument})
-        self.textures = {}
-        self.vao = self.vbo = self.ibo = None
-        try:
-            self.textures["u_height"] = texture2d(ctx, relief.height, what="height",
-                                                  filter="nearest")
-            self.textures["u_color"] = texture2d(ctx, relief.color, what="color", srgb=True,
-                                                 mipmaps=True)
-            self.textures["u_normal"] = texture2d(ctx, relief.normal, what="normal")
-            if self.method == "robust" and relief.safety.ndim == 3:
-                self.textures["u_safety_octants"] = texture_array(
-                    ctx, relief.safety.astype(np.float32), what="safety octants",
-                    filter="nearest")
-            elif self.method == "robust":
-                packed = np.stack([relief.height, relief.safety.astype(np.float32)], axis=-1)
-                self.textures["u_height_safety"] = texture2d(ctx, packed, what="height and safety",
-                                                             filter="nearest")
-            if self.method == "cone":
-                self.textures["u_cone"] = texture2d(ctx, relaxed_cone_ratios(relief.height),
-                                                    what="cone ratios", filter="nearest")
-            if self.method == "maxmip":
-                self.textures["u_maxmip"], self.top_level = max_pyramid_texture(
-                    ctx, relief.height, self.textures["u_height"])
-            self.proxy = relief_proxy(relief)
-            self.vbo = ctx.buffer(self.proxy.positions.tobytes())
-            self.ibo = ctx.buffer(self.proxy.triangles.tobytes())
-            self.vao = ctx.vertex_array(self.prog, [(self.vbo, "3f", "in_position")], self.ibo,
-                                        index_element_size=4)
-        except BaseException:
-            self.release()
-            raise
-        self.uniforms = {
-            "u_hf_size": (w, h), "u_linear_steps": opts.linear_steps,
-            "u_binary_steps": opts.binary_steps,
-            "u_max_iterations": opts.max_iterations or 4 * (w + h) + 64,
-            "u_zero_exact": opts.zero_radius == "exact",
-            "u_exact_below": float(opts.exact_below),
-            "u_quadratic_cells": opts.cell_test == "quadratic",
-            "u_top_level": getattr(self, "top_level", 0),
-            "u_cone_steps": opts.cone_steps,
-            "u_leaf_level": min(opts.maxmip_leaf, getattr(self, "top_level", 0)),
-        }
-        check_gl_error(ctx, "uploading a relief texture")
+        self.plans = [relief_plan(relief, options or ReliefRenderOptions(), instrument)]
 
-    def draw(self, camera, light) -> None:
-        set_uniforms(self.prog, self.uniforms | box_uniforms(camera, self.relief.box_to_world)
-                     | camera_uniforms(camera) | model_offset(camera, self.proxy.origin)
-                     | light.uniforms())
-        for unit, (name, tex) in enumerate(self.textures.items()):
-            tex.use(unit)
-            set_uniforms(self.prog, {name: unit})
-        with proxy_raster_state(self.ctx):
-            self.ctx.cull_face = cull_face(self.proxy, camera)
-            self.vao.render()
-
-    def finish(self, frame) -> None:
-        """Depth AOV from the hit positions (in conservative mode the Z-buffer holds the box)."""
-        frame.depth = window_depth(frame.position, frame.view, frame.proj, frame.depth)
-
-    def release(self) -> None:
-        for obj in (self.vao, self.vbo, self.ibo, *self.textures.values()):
-            if obj is not None:
-                obj.release()
-        self.vao = self.vbo = self.ibo = None
-        self.textures = {}
+    def finish(self, frame, stats: dict) -> None:
+        finish_depth(frame)
 
 
 class ReliefObjectDrawable:
-    """Every part of a ReliefObject (six frusta of a cube) with the same options.
+    """Every part of a ReliefObject (six frusta of a cube) with the same options, one plan
+    per part.
 
     The parts always write their hit depth: a part whose proxy reaches the near plane is
     drawn by its back faces, and box depths of front and back faces would not order parts.
     """
 
-    def __init__(self, ctx, obj: ReliefObject, options: ReliefRenderOptions | None = None,
+    def __init__(self, obj: ReliefObject, options: ReliefRenderOptions | None = None,
                  instrument: bool = False):
-        from dataclasses import replace
-
         opts = replace(options or ReliefRenderOptions(), depth_mode="exact")
-        self.parts = []
-        try:
-            for part in obj.parts:
-                self.parts.append(ReliefDrawable(ctx, part, opts, instrument))
-        except BaseException:
-            self.release()
-            raise
-        self.extra_attachments = self.parts[0].extra_attachments
+        self.extra_attachments = 1 if instrument else 0
+        self.plans = [relief_plan(part, opts, instrument, f"relief part {k}")
+                      for k, part in enumerate(obj.parts)]
 
-    def draw(self, camera, light) -> None:
-        for part in self.parts:
-            part.draw(camera, light)
-
-    def finish(self, frame) -> None:
-        self.parts[0].finish(frame)
-
-    def release(self) -> None:
-        for part in self.parts:
-            part.release()
+    def finish(self, frame, stats: dict) -> None:
+        finish_depth(frame)
