@@ -23,7 +23,7 @@ from ..gl.shaders import program
 from ..gl.targets import FRONT_OPACITY_UNIT
 from ..gl.textures import texture2d, texture3d, texture_array, texture_levels
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from .multipass import shadow_map
+from .multipass import depth_peel, half_opacity_search, opaque_depth, shadow_map
 from .plan import DrawPlan, Geometry, Program, Texture
 from .proxy import GL_DEPTH_CLAMP
 
@@ -292,4 +292,7 @@ def _upload_texture(ctx, tex: Texture):
 
 #: Multi-pass kinds: ``kind(executor, viewed_plan, camera, light, extra_uniforms,
 #: textures) -> stats``.
-MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped}
+MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped,
+             "opaque-depth": opaque_depth.draw_with_opaque_depth,
+             "half-opacity-search": half_opacity_search.draw_half_opacity_search,
+             "depth-peel": depth_peel.draw_depth_peeled}
