@@ -191,26 +191,7 @@ def shell_plan(rep: TexturedShell, shell, options: ShellRenderOptions) -> DrawPl
         main = {"LIT": lit, "SHADOWS": shadows, "EXIT_VERTEX": exit_vertex, "PEEL": peel}
     else:
         main = {"OPAQUE": True, "LIT": lit, "SHADOWS": shadows, "EXIT_VERTEX": exit_vertex}
-    shadow_map = {"bounds": np.asarray(rep.bounds, np.float64), "size": SHADOW_SIZE,
-                  "cull": "back", "sampler": "depth", "bias": SHADOW_DEPTH_BIAS,
-                  "caster_hooks": False} if shadows else None
-    programs = {"caster": Program(PROGRAM, {"SHADOW_MAP": True})} if shadows else {}
-    multipass = None
-    if not transparent:
-        if shadows:
-            multipass = MultiPass("shadow-map", programs, shadow_map)
-    else:
-        params = {"shadow_map": shadow_map} if shadows else {}
-        if peel:
-            multipass = MultiPass("depth-peel", programs | {"layer": Program(LAYER_PROGRAM)},
-                                  params | {"max_layers": MAX_PEELS})
-        elif options.half_opacity:
-            multipass = MultiPass("half-opacity-search", programs | {
-                "bins": Program(PROGRAM, {"AOV_BINS": True, "EXIT_VERTEX": exit_vertex}),
-                "final": Program(PROGRAM, {"AOV_FINAL": True, "EXIT_VERTEX": exit_vertex})},
-                params)
-        else:
-            multipass = MultiPass("opaque-depth", programs, params)
+    multipass = _multipass(options, transparent, peel, shadows, rep.bounds)
     hook = None
     if transparent and not peel:
         # the A-buffer samples the frame's own pixel rays: the order is exact on them
@@ -237,6 +218,31 @@ def shell_plan(rep: TexturedShell, shell, options: ShellRenderOptions) -> DrawPl
         render_pass="transparent" if transparent else "opaque",
         origin=tuple(float(x) for x in origin),
         per_view=hook, multipass=multipass)
+
+
+def _multipass(options, transparent: bool, peel: bool, shadows: bool,
+               bounds) -> MultiPass | None:
+    """The multi-pass kind that draws the shell, its extra programs and params: shadows
+    from a map of the first dense sample seen from the light (back faces culled, the nearest
+    depth compared in shell.glsl, a window-depth bias, no order needed); transparent: the
+    opaque depth copied, then depth peeling or the half-opacity search, or a single draw."""
+    exit_vertex = options.exit == "vertex"
+    shadow_map = {"bounds": np.asarray(bounds, np.float64), "size": SHADOW_SIZE,
+                  "cull": "back", "sampler": "depth", "bias": SHADOW_DEPTH_BIAS,
+                  "caster_hooks": False}
+    programs = {"caster": Program(PROGRAM, {"SHADOW_MAP": True})} if shadows else {}
+    if not transparent:
+        return MultiPass("shadow-map", programs, shadow_map) if shadows else None
+    params = {"shadow_map": shadow_map} if shadows else {}
+    if peel:
+        return MultiPass("depth-peel", programs | {"layer": Program(LAYER_PROGRAM)},
+                         params | {"max_layers": MAX_PEELS})
+    if options.half_opacity:
+        return MultiPass("half-opacity-search", programs | {
+            "bins": Program(PROGRAM, {"AOV_BINS": True, "EXIT_VERTEX": exit_vertex}),
+            "final": Program(PROGRAM, {"AOV_FINAL": True, "EXIT_VERTEX": exit_vertex})},
+            params)
+    return MultiPass("opaque-depth", programs, params)
 
 
 def shell_textures(rep: TexturedShell, shell, origin) -> tuple[dict, dict]:
