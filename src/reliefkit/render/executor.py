@@ -31,7 +31,7 @@ from ..gl.textures import (
     texture_levels,
 )
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from .multipass import shadow_map
+from .multipass import depth_peel, half_opacity_search, opaque_depth, shadow_map
 from .plan import DrawPlan, Geometry, Program, Texture
 
 GL_DEPTH_CLAMP = 0x864F  # moderngl has no flag for it: enabled through enable_direct
@@ -69,6 +69,7 @@ class Executor:
         self._keep_alive: list = []             # plan objects whose ids key the tables
         self.groups: dict[int, list] = {}        # id(geometry) -> its multi-pass plans
         self.cache: dict = {}                    # a multi-pass kind's per-light products
+        self._full_screen: dict = {}             # vertex arrays of `draw_full_screen`
 
     # -- upload ---------------------------------------------------------------------------
     def upload(self, plans) -> None:
@@ -227,12 +228,26 @@ class Executor:
         finally:
             self.reset_raster()
 
+    def draw_full_screen(self, prog: Program, textures: dict, raster) -> None:
+        """One full-screen triangle (core:include/fullscreen.glsl) drawn with ``prog``: a
+        pass of a multi-pass kind that composites ``textures`` into the bound framebuffer."""
+        compiled = self.program(prog)
+        key = compiled.glo
+        if key not in self._full_screen:
+            self._full_screen[key] = self.keep(self.ctx.vertex_array(compiled, []))
+        set_uniforms(compiled, self.bind_textures(compiled, textures))
+        self.set_raster(raster)
+        try:
+            self._full_screen[key].render(moderngl.TRIANGLES, vertices=3)
+        finally:
+            self.reset_raster()
+
     def release(self) -> None:
         """Free every GL object, newest first."""
         for obj in reversed(self._made):
             obj.release()
         self._made, self._textures, self._geometry, self._keep_alive = [], {}, {}, []
-        self.groups, self.cache = {}, {}
+        self.groups, self.cache, self._full_screen = {}, {}, {}
 
 
 def _counts(plan: DrawPlan) -> dict:
@@ -307,4 +322,7 @@ def _upload_texture(ctx, tex: Texture):
 
 #: Multi-pass kinds: ``kind(executor, viewed_plan, camera, light, extra_uniforms,
 #: textures) -> stats``.
-MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped}
+MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped,
+             "opaque-depth": opaque_depth.draw_with_opaque_depth,
+             "half-opacity-search": half_opacity_search.draw_half_opacity_search,
+             "depth-peel": depth_peel.draw_depth_peeled}

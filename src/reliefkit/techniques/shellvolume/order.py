@@ -30,7 +30,7 @@ int32 arrays, without numpy temporaries of the size of the A-buffer or the graph
 
 - what does not depend on the camera (the interior face pairs with their planes, the
   boundary faces with their vertices, planes and tetrahedra, the shell's size) is gathered
-  once per shell (`_topology`, cached on the shell object);
+  once per shell (`order_cells`, cached on the shell object);
 - shell vertices are projected once, not once per face corner; the A-buffer is a
   counting-sort layout (per-pixel lists in one array), each list sorted in place;
 - the graph is built in *rank space* (nodes numbered by centroid depth): a counting sort
@@ -94,7 +94,8 @@ class VisibilityOrder:
 
 def visibility_order(shell, camera, method: str = "sxmpvo",
                      resolution: int = RESOLUTION) -> VisibilityOrder:
-    """Sort `shell`'s tetrahedra front to back as seen by `camera` (Camera or MatrixCamera).
+    """Sort `shell`'s tetrahedra (a shell or its `OrderCells`) front to back as seen by
+    `camera` (Camera or MatrixCamera).
 
     resolution: A-buffer samples along the longer image side (SXMPVO only).
     """
@@ -128,10 +129,12 @@ def _worker() -> ThreadPoolExecutor:
 # --------------------------------------------------------------------------- per shell
 
 
-@dataclass(frozen=True)
-class _Topology:
-    """What SXMPVO needs of a shell that does not depend on the camera.
+@dataclass(frozen=True, eq=False)
+class OrderCells:
+    """What SXMPVO needs of a shell, as plain arrays: the same for every camera, gathered
+    once per shell (`order_cells`); a draw plan's view hook holds them.
 
+    positions : (V, 3) float64 shell vertices; tets : (T, 4) int32 their tetrahedra.
     pair_tet, pair_other : (K,) int32 the two tetrahedra of each interior face, once.
     pair_plane : (K, 4) float64 that face's plane as seen from pair_tet (outward normal).
     face_tet : (N,) int32 tetrahedron of each boundary face.
@@ -140,6 +143,8 @@ class _Topology:
     scale : the shell's size (bounding-box diagonal), for tolerances.
     """
 
+    positions: np.ndarray
+    tets: np.ndarray
     pair_tet: np.ndarray
     pair_other: np.ndarray
     pair_plane: np.ndarray
@@ -149,17 +154,19 @@ class _Topology:
     scale: float
 
 
-_TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_CELLS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 # the three vertices of face f (the ones other than f) of a tetrahedron
 _FACE_CORNERS = np.array([[v for v in range(4) if v != f] for f in range(4)])
 
 
-def _topology(shell) -> _Topology:
-    """The shell's `_Topology`, gathered on the first call for that shell object (shells
-    are frozen; the cache holds no reference to the shell)."""
-    topo = _TOPOLOGY.get(shell)
-    if topo is None:
+def order_cells(shell) -> OrderCells:
+    """The shell's `OrderCells`, gathered on the first call for that shell object (shells
+    are frozen; the cache holds no reference to the shell); cells are their own."""
+    if isinstance(shell, OrderCells):
+        return shell
+    cells = _CELLS.get(shell)
+    if cells is None:
         tet, face = np.nonzero(shell.neighbors >= 0)
         other = shell.neighbors[tet, face]
         once = tet < other
@@ -167,15 +174,17 @@ def _topology(shell) -> _Topology:
         b_tet, b_face = np.nonzero(shell.neighbors < 0)
         corners = np.take_along_axis(shell.tets[b_tet], _FACE_CORNERS[b_face], axis=1)
         p = shell.positions
-        topo = _Topology(
+        cells = OrderCells(
+            positions=np.ascontiguousarray(p, dtype=np.float64),
+            tets=np.ascontiguousarray(shell.tets, dtype=np.int32),
             pair_tet=tet.astype(np.int32), pair_other=other.astype(np.int32),
             pair_plane=np.ascontiguousarray(shell.planes[tet, face]),
             face_tet=b_tet.astype(np.int32),
             face_vertices=np.ascontiguousarray(corners, dtype=np.int32),
             face_plane=np.ascontiguousarray(shell.planes[b_tet, b_face]),
             scale=float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) or 1.0)
-        _TOPOLOGY[shell] = topo
-    return topo
+        _CELLS[shell] = cells
+    return cells
 
 
 # --------------------------------------------------------------------------- depths
@@ -248,14 +257,14 @@ def adjacent_relations(shell, camera) -> tuple[np.ndarray, np.ndarray]:
     """(src, dst) int32: order every pair of face neighbours (step 1): the cell whose copy
     of the shared face is back-facing is in front. Edge-on faces (no ray crosses them) give
     nothing."""
-    topo = _topology(shell)
+    cells = order_cells(shell)
     if camera.orthographic:
         point, tol = _forward(camera), 1e-12
     else:
-        point, tol = np.asarray(camera.eye, dtype=np.float64), 1e-12 * topo.scale
-    src = np.empty(len(topo.pair_tet), np.int32)
-    dst = np.empty(len(topo.pair_tet), np.int32)
-    n = _adjacent(topo.pair_tet, topo.pair_other, topo.pair_plane, point,
+        point, tol = np.asarray(camera.eye, dtype=np.float64), 1e-12 * cells.scale
+    src = np.empty(len(cells.pair_tet), np.int32)
+    dst = np.empty(len(cells.pair_tet), np.int32)
+    n = _adjacent(cells.pair_tet, cells.pair_other, cells.pair_plane, point,
                   bool(camera.orthographic), tol, src, dst)
     return src[:n], dst[:n]
 
@@ -294,16 +303,16 @@ def abuffer_relations(shell, camera, resolution: int) -> tuple[np.ndarray, np.nd
     """(src, dst) int32 relations along the A-buffer's sample rays between consecutive
     boundary faces (step 2), which link cells across the gaps of a non-convex shell.
     A relation may come more than once (from several rays)."""
-    topo = _topology(shell)
+    cells = order_cells(shell)
     width, height = abuffer_size(camera, resolution)
     mvp = np.asarray(camera.proj, dtype=np.float64) @ np.asarray(camera.view, dtype=np.float64)
     screen, front = _project(np.ascontiguousarray(shell.positions, dtype=np.float64), mvp,
                              width, height)
     origins, dirs, shortest = _pixel_rays(np.linalg.inv(mvp), width, height)
-    starts, faces, t = _rasterize(screen, front, topo.face_vertices, topo.face_plane,
+    starts, faces, t = _rasterize(screen, front, cells.face_vertices, cells.face_plane,
                                   origins, dirs, width, height)
-    tie = TIE * topo.scale / max(shortest, 1e-300)
-    return _ray_edges(starts, faces, t, topo.face_tet, tie)
+    tie = TIE * cells.scale / max(shortest, 1e-300)
+    return _ray_edges(starts, faces, t, cells.face_tet, tie)
 
 
 @njit(**_JIT)

@@ -1,50 +1,54 @@
-"""Drawing a `TexturedShell` (semi-transparent 3D texture paper, §4-§5).
+"""Drawing a `TexturedShell` (semi-transparent 3D texture paper, §4-§5) as one draw plan.
 
 Every frame: the tetrahedra are sorted front to back (SXMPVO, order.py, its A-buffer at the
 frame's resolution so that the order is exact on every pixel's ray; or the centroid
-baseline), written to an instance buffer, and drawn in that order in one instanced call of 12
-vertices per tetrahedron (shaders/shell.glsl); the transparent pass composites each
-fragment "under" what is in front of it. Opaque textures are drawn in the opaque pass,
-depth-tested, without sorting.
+baseline) by the plan's view hook, which gives the instance order, and drawn in that order
+in one instanced call of 12 vertices per tetrahedron (shaders/shell.glsl); the transparent
+pass composites each fragment "under" what is in front of it. Opaque textures are drawn in
+the opaque pass, depth-tested, without sorting.
 
-The Frame's AOVs of a semi-transparent shell belong to the point where the accumulated
-opacity first reaches 0.5 (the Frame's rule). A fragment cannot read what lies in front of it inside
-one draw, so `half_opacity_search` finds that point exactly in extra passes: per pixel, a
-base-16 search over the rank of the tetrahedron where it lies (optical depths are summed
-order-independently with additive blending into 16 rank bins per pass, ceil(log16 T) passes),
-then that tetrahedron's fragment marches its segment and writes the point.
+What is not one draw is a multi-pass kind of the executor (`render.multipass`): the copy of
+the opaque depth the segments stop at ("opaque-depth"); the Frame's AOVs of a
+semi-transparent shell, which belong to the point where the accumulated opacity first
+reaches 0.5, found in extra passes per pixel by a base-16 search over the rank of the
+tetrahedron where it lies ("half-opacity-search"); depth peeling ("depth-peel"); and the
+shadow map from the light ("shadow-map", nearest depth, compared in the shader).
 """
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
 from ...bake.uv_atlas import atlas_uniforms
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
-from ...gl.context import check_gl_error
-from ...gl.objects import GLObjects
-from ...gl.shaders import program
-from ...gl.targets import use_transparent_blending
-from ...gl.textures import read_depth, read_rgba, texture2d, texture3d, texture_array
-from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from ...render.shadows import light_camera
+from ...render.plan import (
+    Attribute,
+    DrawPlan,
+    Geometry,
+    MultiPass,
+    Program,
+    Raster,
+    Texture,
+    ViewHook,
+    ViewUpdate,
+)
 from .filtering import mip_pyramid, naive_pyramid
-from .order import METHODS, visibility_order
+from .order import METHODS, OrderCells, order_cells, visibility_order
 from .representation import TET_TEXELS, TETS_PER_ROW, TexturedShell
 from .textures import density_floor, density_normals, marched_volume
 
 PROGRAM = "shellvolume:shell.glsl"
 TET_ROW_TEXELS = TET_TEXELS * TETS_PER_ROW  # 2048, shaders/include/tets.glsl
 MAX_LEVELS = 4                          # shaders/include/volume.glsl
-SEARCH_BINS = 16
 SHADOW_SIZE = 1024
 SHADOW_DEPTH_BIAS = 2.0 ** -16  # window depth: the shadow map's rounding, not its texels
-_COLOR_UNITS, _NORMAL_UNITS = range(0, 4), range(4, 8)
-_TETS_UNIT, _SHADOW_UNIT, _DEPTH_UNIT, _SEARCH_UNIT, _SURFACE_UNIT = 8, 9, 10, 11, 13
+# units of the samplers a draw may leave unbound (the opaque depth in the opaque pass, the
+# surface materials of a shell without them): above the ones the executor binds, one per
+# sampler type
+_SPARE_ARRAY_UNIT, _SPARE_2D_UNIT = 13, 14
 EXITS = ("fragment", "vertex")
 SORTS = (*METHODS, "peel")  # peel: depth peeling, the baseline the paper measured against
 MAX_PEELS = 1024
@@ -145,283 +149,141 @@ def texture_levels(texture, thickness: float) -> list[tuple[np.ndarray, np.ndarr
     return out
 
 
-class TexturedShellDrawable(GLObjects):
-    """GPU textures of one TexturedShell at one animation time, sorted and drawn per frame."""
+class TexturedShellDrawable:
+    """One TexturedShell at one animation time as one draw plan: 12 vertices per
+    tetrahedron, instanced; sorted per view by its hook (transparent), and drawn by a
+    multi-pass kind where it needs more than one draw."""
 
-    def __init__(self, ctx, rep: TexturedShell, options: ShellRenderOptions | None = None,
+    def __init__(self, rep: TexturedShell, options: ShellRenderOptions | None = None,
                  instrument: bool = False):
-        self.ctx, self.rep = ctx, rep
-        self.options = options = options or ShellRenderOptions()
-        self.shell = rep.shell_at(options.time)
-        self.transparent = options.composite == "sorted" or (
-            options.composite == "auto" and not rep.opaque)
-        lo, hi = rep.bounds
-        self.origin = 0.5 * (lo + hi)  # float64: the tetrahedra are stored relative to it
+        self.rep = rep
+        self.options = options or ShellRenderOptions()
+        self.shell = rep.shell_at(self.options.time)
         self.extra_attachments = 0
-        self.stats: dict = {}
-        self._upload_owned(self._upload)
+        self.plans = [shell_plan(rep, self.shell, self.options)]
 
-    # -- upload ---------------------------------------------------------------------------
-    def _upload(self) -> None:
-        ctx, rep, shell = self.ctx, self.rep, self.shell
-        mean_thickness = float(np.mean(rep.thickness))
-        self.levels = texture_levels(rep.texture, mean_thickness)
-        self.level_textures = []
-        for k, (rgba, normal) in enumerate(self.levels):
-            pair = []
-            for array, what in ((rgba, "colour"), (normal, "normal")):
-                tex = self.keep(texture3d(ctx, array, what=f"shell {what} level {k}",
-                                          repeat=True))
-                tex.repeat_z = False  # w is clamped: the shell ends at its base and top
-                pair.append(tex)
-            self.level_textures.append(pair)
-        if rep.surface is not None:
-            self.surface = self.keep(texture_array(ctx, rep.surface.rgba8, srgb=True,
-                                                   what="shell surface materials"))
-        texels = tet_texels(shell, self.origin, rep.texture.tile, rep.surface_layers())
-        self.tets = self.keep(texture2d(ctx, texels, what="shell tetrahedra",
-                                        filter="nearest"))
-        count = len(shell.tets)
-        self.instances = self.keep(ctx.buffer(np.arange(count, dtype=np.int32).tobytes()))
-        lit = not self.options.unlit
-        exit_vertex = self.options.exit == "vertex"
-        self.peel = self.transparent and self.options.sort == "peel"
-        if self.transparent:
-            main = {"LIT": lit, "SHADOWS": lit and self.options.shadows,
-                    "EXIT_VERTEX": exit_vertex, "PEEL": self.peel}
-        else:
-            main = {"OPAQUE": True, "LIT": lit, "SHADOWS": lit and self.options.shadows,
-                    "EXIT_VERTEX": exit_vertex}
-        self.programs = {"main": program(ctx, PROGRAM, main)}
-        if self.peel:
-            self.layer_program = program(ctx, LAYER_PROGRAM)
-            self.layer_vao = self.keep(ctx.vertex_array(self.layer_program, []))
-        if self.transparent and self.options.half_opacity and not self.peel:
-            self.programs["bins"] = program(ctx, PROGRAM, {"AOV_BINS": True,
-                                                            "EXIT_VERTEX": exit_vertex})
-            self.programs["final"] = program(ctx, PROGRAM, {"AOV_FINAL": True,
-                                                             "EXIT_VERTEX": exit_vertex})
-        if self.options.shadows and lit:
-            self.programs["shadow"] = program(ctx, PROGRAM, {"SHADOW_MAP": True})
-        self.vaos = {name: self.keep(ctx.vertex_array(prog, [(self.instances, "1i/i",
-                                                              "in_tet")]))
-                     for name, prog in self.programs.items()}
-        check_gl_error(ctx, f"uploading a shell of {count} tetrahedra")
-
-    # -- drawing --------------------------------------------------------------------------
-    def _uniforms(self, camera, light) -> dict:
-        sizes = [(a.shape[2], a.shape[1], a.shape[0]) for a, _ in self.levels]
-        sizes += [sizes[-1]] * (MAX_LEVELS - len(sizes))
-        units = {f"u_color{k}": _COLOR_UNITS[min(k, len(self.levels) - 1)]
-                 for k in range(MAX_LEVELS)}
-        units |= {f"u_normal{k}": _NORMAL_UNITS[min(k, len(self.levels) - 1)]
-                  for k in range(MAX_LEVELS)}
-        animated = self.options.time is not None
-        return (camera_uniforms(camera) | model_offset(camera, self.origin) | light.uniforms()
-                | units | {"u_tets": _TETS_UNIT, "u_levels": len(self.levels),
-                           "u_level_size": sizes, "u_mip": self.options.mip,
-                           "u_density_floor": density_floor(float(np.mean(self.rep.thickness))),
-                           "u_samples": self.options.samples,
-                           "u_time": float(self.options.time or 0.0),
-                           "u_sway": 0.04 if animated else 0.0,
-                           "u_opaque_depth": _DEPTH_UNIT, "u_search": _SEARCH_UNIT,
-                           "u_shadow_map": _SHADOW_UNIT,
-                           "u_tile": tuple(float(t) for t in self.rep.texture.tile)}
-                | atlas_uniforms(self.rep.surface, _SURFACE_UNIT))
-
-    def _bind(self) -> None:
-        for k, (colour, normal) in enumerate(self.level_textures):
-            colour.use(_COLOR_UNITS[k])
-            normal.use(_NORMAL_UNITS[k])
-        self.tets.use(_TETS_UNIT)
-        if self.rep.surface is not None:
-            self.surface.use(_SURFACE_UNIT)
-
-    def _draw(self, name: str, uniforms: dict) -> None:
-        set_uniforms(self.programs[name], uniforms)
-        self.vaos[name].render(vertices=12, instances=len(self.shell.tets))
-
-    def draw(self, camera, light) -> None:
-        import moderngl
-
-        ctx = self.ctx
-        start = time.perf_counter()
-        if self.transparent and not self.peel:
-            # the A-buffer samples the frame's own pixel rays: the order is exact on them
-            order = visibility_order(self.shell, camera, method=self.options.sort,
-                                     resolution=max(camera.size))
-            self.instances.write(order.order.astype(np.int32).tobytes())
-            self.stats.update(sort=order.method, sort_seconds=order.seconds,
-                              cycles=order.cycles)
-        uniforms = self._uniforms(camera, light)
-        made = []
-        outer = ctx.fbo
-        enabled = moderngl.DEPTH_TEST | (moderngl.BLEND if self.transparent else 0)
-        try:
-            self._bind()
-            if "shadow" in self.programs:
-                uniforms |= self._shadow_map(light, made)
-                outer.use()
-            if self.transparent:
-                uniforms |= self._opaque_depth(outer, made)
-            search = "bins" in self.programs
-            front = _read_alpha(outer) if search else None
-            ctx.cull_face, ctx.front_face = "back", "ccw"
-            if self.peel:
-                self._draw_peeled(outer, uniforms, made)
-            elif self.transparent:
-                use_transparent_blending(ctx, moderngl.CULL_FACE)
-                self._draw("main", uniforms)
-            else:
-                ctx.enable_only(enabled | moderngl.CULL_FACE)
-                self._draw("main", uniforms)
-            if search:
-                self._half_opacity_point(outer, front, uniforms, made)
-            check_gl_error(ctx, f"drawing a shell of {len(self.shell.tets)} tetrahedra")
-        finally:
-            for obj in reversed(made):
-                obj.release()
-            outer.use()
-            ctx.enable_only(enabled)
-        self.stats["draw_seconds"] = time.perf_counter() - start
-
-    def _shadow_map(self, light, made) -> dict:
-        """Render the shadow map (depth of the first dense sample seen from the light)."""
-        import moderngl
-
-        ctx = self.ctx
-        cam = light_camera(self.rep.bounds, light)
-        depth = ctx.depth_texture(cam.size)
-        made.append(depth)
-        fbo = ctx.framebuffer(depth_attachment=depth)
-        made.append(fbo)
-        fbo.use()
-        fbo.viewport = (0, 0, *cam.size)
-        fbo.clear(depth=1.0)
-        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        ctx.cull_face, ctx.front_face = "back", "ccw"
-        shadow_uniforms = self._uniforms(cam, light) | {
-            "u_clip_opaque": False,
-            "u_shadow_length": float(np.mean(self.rep.thickness))}
-        self._draw("shadow", shadow_uniforms)
-        depth.compare_func = ""
-        depth.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        depth.use(_SHADOW_UNIT)
-        from ...core.transforms import translation
-
-        light_matrix = np.asarray(cam.proj) @ np.asarray(cam.view) @ translation(self.origin)
-        return {"u_light_matrix": light_matrix, "u_shadow_bias": SHADOW_DEPTH_BIAS,
-                "u_shadow_texel": 2.0 * cam.ortho_height / cam.size[0]}
-
-    def _opaque_depth(self, outer, made) -> dict:
-        """A copy of the opaque pass's depth to sample (the attached one cannot be)."""
-        width, height = outer.size
-        depth = read_depth(outer, top_row_first=False)  # GL rows: texelFetch(gl_FragCoord)
-        tex = self.ctx.texture((width, height), 1, depth.tobytes(), dtype="f4")
-        made.append(tex)
-        import moderngl
-
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        tex.use(_DEPTH_UNIT)
-        return {"u_clip_opaque": bool((depth < 1.0).any())}
-
-    def _half_opacity_point(self, outer, front, uniforms, made) -> None:
-        """Find, per pixel, the rank of the tetrahedron where the opacity accumulated over
-        the drawables in front and this shell first reaches 0.5, and draw that point's
-        position and normal (AOV_FINAL) into the transparent pass."""
-        import moderngl
-
-        ctx = self.ctx
-        width, height = outer.size
-        count = len(self.shell.tets)
-        need = _needed_optical_depth(front)
-        bins = [ctx.texture((width, height), 4, dtype="f4") for _ in range(4)]
-        made.extend(bins)
-        fbo = ctx.framebuffer(color_attachments=bins, depth_attachment=outer.depth_attachment)
-        made.append(fbo)
-        search = ctx.texture((width, height), 2, dtype="f4")
-        made.append(search)
-        search.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        lo = np.zeros((height, width))
-        hi = np.where(np.isfinite(need), float(count), 0.0)
-        passes = 0
-        while (hi - lo > 1).any():
-            search.write(np.stack([lo, hi], axis=-1).astype(np.float32).tobytes())
-            search.use(_SEARCH_UNIT)
-            fbo.use()
-            fbo.depth_mask = False
-            fbo.viewport = (0, 0, width, height)
-            for tex in bins:
-                tex.write(np.zeros((height, width, 4), np.float32).tobytes())
-            ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
-            ctx.blend_func = moderngl.ONE, moderngl.ONE
-            self._draw("bins", uniforms)
-            sums = np.concatenate([read_rgba(fbo, k, top_row_first=False)
-                                   for k in range(4)], axis=-1)
-            lo, hi, need = _narrow(lo, hi, need, sums.astype(np.float64))
-            passes += 1
-        self.stats["half_opacity_passes"] = passes + 1
-        found = (hi - lo == 1) & np.isfinite(need)
-        rank = np.where(found, lo, -1.0)
-        search.write(np.stack([rank, np.where(found, need, 0.0)], axis=-1)
-                     .astype(np.float32).tobytes())
-        search.use(_SEARCH_UNIT)
-        outer.use()
-        use_transparent_blending(ctx, moderngl.CULL_FACE)
-        self._draw("final", uniforms)
-
-    def _draw_peeled(self, outer, uniforms, made) -> None:
-        """Depth peeling: pass k draws every tetrahedron, keeps the nearest fragment behind
-        layer k - 1 (depth test), and adds it under the layers in front; until a pass draws
-        nothing (an occlusion query) or `MAX_PEELS` passes."""
-        import moderngl
-
-        ctx = self.ctx
-        width, height = outer.size
-        color = ctx.texture((width, height), 4, dtype="f4")
-        made.append(color)
-        # the depth test picks the nearest fragment; its exact z goes to a float attachment
-        # (a 24-bit depth texture would round it, and the layer would be peeled again)
-        peeled = [ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
-        depth = ctx.depth_texture((width, height))
-        made.extend([*peeled, depth])
-        for tex in peeled:
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        fbos = [ctx.framebuffer(color_attachments=[color, z], depth_attachment=depth)
-                for z in peeled]
-        made.extend(fbos)
-        # a pixel no fragment reaches keeps "beyond everything", so nothing comes back
-        beyond = np.full((height, width, 4), 2.0, np.float32).tobytes()
-        peeled[1].write(np.full((height, width, 4), -1.0, np.float32).tobytes())  # none yet
-        self.layer_program["u_layer"].value = _SEARCH_UNIT
-        layers = 0
-        for k in range(MAX_PEELS):
-            fbo, before = fbos[k % 2], peeled[(k + 1) % 2]
-            fbo.use()
-            fbo.viewport = (0, 0, width, height)
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            peeled[k % 2].write(beyond)
-            ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-            before.use(_SEARCH_UNIT + 1)
-            query = ctx.query(samples=True)
-            with query:
-                self._draw("main", uniforms | {"u_peel_depth": _SEARCH_UNIT + 1})
-            if query.samples == 0:
-                break
-            layers += 1
-            outer.use()
-            use_transparent_blending(ctx)
-            ctx.disable(moderngl.DEPTH_TEST)
-            color.use(_SEARCH_UNIT)
-            self.layer_vao.render(moderngl.TRIANGLES, vertices=3)
-        self.stats["peeled_layers"] = layers
-
-    def finish(self, frame) -> None:
+    def finish(self, frame, stats: dict) -> None:
+        stats = dict(stats)
+        if "passes_seconds" in stats:  # the sort and the passes, as one draw's time
+            stats["draw_seconds"] = stats.pop("passes_seconds") + stats.get("sort_seconds", 0.0)
         frame.stats.update({"tetrahedra": len(self.shell.tets),
                             "samples": self.options.samples, "unlit": self.options.unlit,
-                            "mip": self.options.mip, **self.stats})
-        if self.stats.get("cycles"):
-            frame.warnings.append(cycles_warning(self.stats["cycles"]))
+                            "mip": self.options.mip, **stats})
+        if stats.get("cycles"):
+            frame.warnings.append(cycles_warning(stats["cycles"]))
+
+
+def shell_plan(rep: TexturedShell, shell, options: ShellRenderOptions) -> DrawPlan:
+    """The draw plan of ``shell`` (``rep``'s at the options' time): its textures, the
+    tetrahedra's block, the uniforms; transparent: the visibility order as a view hook and
+    the multi-pass kind that draws it ("opaque-depth", "half-opacity-search" or
+    "depth-peel"); opaque: depth-tested, unsorted, shadowed by the "shadow-map" kind."""
+    transparent = options.composite == "sorted" or (
+        options.composite == "auto" and not rep.opaque)
+    lit = not options.unlit
+    shadows = lit and options.shadows
+    exit_vertex = options.exit == "vertex"
+    peel = transparent and options.sort == "peel"
+    lo, hi = rep.bounds
+    origin = 0.5 * (lo + hi)  # float64: the tetrahedra are stored relative to it
+    count = len(shell.tets)
+    if transparent:
+        main = {"LIT": lit, "SHADOWS": shadows, "EXIT_VERTEX": exit_vertex, "PEEL": peel}
+    else:
+        main = {"OPAQUE": True, "LIT": lit, "SHADOWS": shadows, "EXIT_VERTEX": exit_vertex}
+    multipass = _multipass(options, transparent, peel, shadows, rep.bounds)
+    hook = None
+    if transparent and not peel:
+        # the A-buffer samples the frame's own pixel rays: the order is exact on them
+        cells = order_cells(shell)
+        hook = ViewHook(f"{__name__}:visibility_hook", {
+            "cells": {f.name: getattr(cells, f.name) for f in fields(cells)},
+            "method": options.sort})
+    textures, uniforms = shell_textures(rep, shell, origin)
+    return DrawPlan(
+        name=f"a shell of {count} tetrahedra",
+        program=Program(PROGRAM, main),
+        geometry=Geometry({"in_tet": Attribute(np.arange(count, dtype=np.int32),
+                                               per_instance=True)},
+                          vertices=12, instances=count),
+        textures=textures,
+        uniforms=uniforms | {
+            "u_mip": options.mip, "u_samples": options.samples,
+            "u_time": float(options.time or 0.0),
+            "u_sway": 0.04 if options.time is not None else 0.0,
+            "u_clip_opaque": False,  # the kinds that copy the opaque depth say otherwise
+            "u_shadow_length": float(np.mean(rep.thickness))},
+        raster=Raster(depth_write=not transparent, cull="back",
+                      blend="under" if transparent else "none"),
+        render_pass="transparent" if transparent else "opaque",
+        origin=tuple(float(x) for x in origin),
+        per_view=hook, multipass=multipass)
+
+
+def _multipass(options, transparent: bool, peel: bool, shadows: bool,
+               bounds) -> MultiPass | None:
+    """The multi-pass kind that draws the shell, its extra programs and params: shadows
+    from a map of the first dense sample seen from the light (back faces culled, the nearest
+    depth compared in shell.glsl, a window-depth bias, no order needed); transparent: the
+    opaque depth copied, then depth peeling or the half-opacity search, or a single draw."""
+    exit_vertex = options.exit == "vertex"
+    shadow_map = {"bounds": np.asarray(bounds, np.float64), "size": SHADOW_SIZE,
+                  "cull": "back", "sampler": "depth", "bias": SHADOW_DEPTH_BIAS,
+                  "caster_hooks": False}
+    programs = {"caster": Program(PROGRAM, {"SHADOW_MAP": True})} if shadows else {}
+    if not transparent:
+        return MultiPass("shadow-map", programs, shadow_map) if shadows else None
+    params = {"shadow_map": shadow_map} if shadows else {}
+    if peel:
+        return MultiPass("depth-peel", programs | {"layer": Program(LAYER_PROGRAM)},
+                         params | {"max_layers": MAX_PEELS})
+    if options.half_opacity:
+        return MultiPass("half-opacity-search", programs | {
+            "bins": Program(PROGRAM, {"AOV_BINS": True, "EXIT_VERTEX": exit_vertex}),
+            "final": Program(PROGRAM, {"AOV_FINAL": True, "EXIT_VERTEX": exit_vertex})},
+            params)
+    return MultiPass("opaque-depth", programs, params)
+
+
+def shell_textures(rep: TexturedShell, shell, origin) -> tuple[dict, dict]:
+    """The textures of shaders/include/volume.glsl and tets.glsl (the 3D texture's levels,
+    the tetrahedra's block, the surface's materials) and the uniforms that describe them."""
+    mean_thickness = float(np.mean(rep.thickness))
+    levels = texture_levels(rep.texture, mean_thickness)
+    textures = {}
+    for k in range(MAX_LEVELS):  # missing levels repeat the last
+        level = min(k, len(levels) - 1)
+        for index, (name, what) in enumerate((("color", "colour"), ("normal", "normal"))):
+            if k == level:  # w is clamped: the shell ends at its base and top
+                textures[f"u_{name}{k}"] = Texture(
+                    levels[level][index], target="3d",
+                    wrap=("repeat", "repeat", "clamp"), what=f"shell {what} level {k}")
+            else:
+                textures[f"u_{name}{k}"] = textures[f"u_{name}{level}"]
+    texels = tet_texels(shell, origin, rep.texture.tile, rep.surface_layers())
+    textures["u_tets"] = Texture(texels, filter="nearest", what="shell tetrahedra")
+    if rep.surface is not None:
+        textures["u_surface"] = Texture(rep.surface.rgba8, target="2d_array", srgb=True,
+                                        what="shell surface materials")
+    sizes = [(a.shape[2], a.shape[1], a.shape[0]) for a, _ in levels]
+    sizes += [sizes[-1]] * (MAX_LEVELS - len(sizes))
+    uniforms = {"u_levels": len(levels), "u_level_size": sizes,
+                "u_density_floor": density_floor(mean_thickness),
+                "u_tile": tuple(float(t) for t in rep.texture.tile)}
+    # samplers a draw may leave unbound (never sampled then) stay off the bound units
+    uniforms |= atlas_uniforms(rep.surface, _SPARE_ARRAY_UNIT) | {
+        "u_opaque_depth": _SPARE_2D_UNIT}
+    return textures, uniforms
+
+
+def visibility_hook(plan, camera, light, *, cells: dict, method: str) -> ViewUpdate:
+    """The view hook of a sorted shell: its tetrahedra front to back from ``camera`` as the
+    instance order, and the sort's statistics."""
+    order = visibility_order(OrderCells(**cells), camera, method=method,
+                             resolution=max(camera.size))
+    return ViewUpdate(attributes={"in_tet": order.order.astype(np.int32)},
+                      stats={"sort": order.method, "sort_seconds": order.seconds,
+                             "cycles": order.cycles})
 
 
 def cycles_warning(cycles: int) -> str:
@@ -434,40 +296,7 @@ def cycles_warning(cycles: int) -> str:
             "layer, slower)")
 
 
-def _needed_optical_depth(front: np.ndarray) -> np.ndarray:
-    """Per pixel, the optical depth a shell behind opacity ``front`` must accumulate to bring
-    the total to 0.5: -ln(1 - a) with front + (1 - front) a = 0.5 (inf where front >= 0.5)."""
-    safe = np.minimum(front, 0.5)
-    target = (0.5 - safe) / (1.0 - safe)
-    return np.where(front < 0.5, -np.log1p(-np.minimum(target, 1.0 - 1e-12)), np.inf)
-
-
-def _narrow(lo, hi, need, sums):
-    """One step of the base-16 rank search: ``sums[..., k]`` is the optical depth of the
-    ranks in [lo, t_k), t_k = lo + ceil((hi - lo)(k + 1) / 16); keep the first bin whose
-    sum reaches ``need`` (the optical depth still needed), or give up where none does."""
-    k = np.arange(1, SEARCH_BINS + 1)
-    thresholds = lo[..., None] + np.ceil((hi - lo)[..., None] * k / SEARCH_BINS)
-    active = hi - lo > 1
-    reached = sums >= need[..., None]
-    first = np.argmax(reached, axis=-1)
-    some = reached.any(axis=-1)
-    below = np.take_along_axis(sums, np.maximum(first - 1, 0)[..., None], -1)[..., 0]
-    prev = np.take_along_axis(thresholds, np.maximum(first - 1, 0)[..., None], -1)[..., 0]
-    new_lo = np.where(first > 0, prev, lo)
-    new_hi = np.take_along_axis(thresholds, first[..., None], -1)[..., 0]
-    new_need = need - np.where(first > 0, below, 0.0)
-    lo = np.where(active & some, new_lo, np.where(active, 0.0, lo))
-    hi = np.where(active & some, new_hi, np.where(active, 0.0, hi))
-    need = np.where(active & ~some, np.inf, np.where(active, new_need, need))
-    return lo, hi, need
-
-
-def _read_alpha(fbo) -> np.ndarray:
-    """(H, W) float64 alpha of colour attachment 0 (GL row order, bottom row first)."""
-    return read_rgba(fbo, 0, top_row_first=False)[..., 3].astype(np.float64)
-
-
 def drawable_spec() -> DrawableSpec:
     """How the technique draws its shells (the package's `Technique` declares it)."""
-    return DrawableSpec(TexturedShell, TexturedShellDrawable, ShellRenderOptions)
+    return DrawableSpec(TexturedShell, TexturedShellDrawable, ShellRenderOptions,
+                        planned=True)
