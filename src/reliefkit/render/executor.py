@@ -201,16 +201,25 @@ class Executor:
                     textures=None, program_override: Program | None = None,
                     raster=None) -> None:
         """One draw of a plan already seen from ``camera`` (`view`)."""
-        prog = self.program(program_override or viewed.program)
-        vao = self._vertex_array(prog, viewed.geometry)
-        samplers = self.bind_textures(prog, {**viewed.textures, **(textures or {})})
-        set_uniforms(prog, self.uniforms(viewed, camera, light) | (extra_uniforms or {})
-                     | samplers)
+        vao = self.bind(viewed, camera, light, extra_uniforms=extra_uniforms,
+                        textures=textures, program_override=program_override)
         self.set_raster(raster or viewed.raster)
         try:
             vao.render(_MODES[viewed.geometry.primitive], **_counts(viewed))
         finally:
             self.reset_raster()
+
+    def bind(self, viewed: DrawPlan, camera, light, *, extra_uniforms=None, textures=None,
+             program_override: Program | None = None):
+        """Bind the textures and set the uniforms of a draw of ``viewed`` (as `draw_viewed`
+        does) and return its vertex array: for multi-pass kinds that draw ranges of it
+        themselves, under their own raster state."""
+        prog = self.program(program_override or viewed.program)
+        vao = self._vertex_array(prog, viewed.geometry)
+        samplers = self.bind_textures(prog, {**viewed.textures, **(textures or {})})
+        set_uniforms(prog, self.uniforms(viewed, camera, light) | (extra_uniforms or {})
+                     | samplers)
+        return vao
 
     def release(self) -> None:
         """Free every GL object, newest first."""

@@ -123,8 +123,9 @@ class ViewHook:
 @dataclass
 class ViewUpdate:
     """A hook's answer for one camera: uniforms to set, vertex arrays (by attribute name) or
-    indices to replace, a new vertex/instance count, the faces to cull, and statistics for
-    the drawable's `finish`. Empty fields leave the plan's own."""
+    indices to replace, a new vertex/instance count, the faces to cull, parameters of the
+    plan's multi-pass kind (added to ``MultiPass.params``) and statistics for the
+    drawable's `finish`. Empty fields leave the plan's own."""
 
     uniforms: dict = field(default_factory=dict)
     attributes: dict = field(default_factory=dict)
@@ -132,6 +133,7 @@ class ViewUpdate:
     vertices: int | None = None
     instances: int | None = None
     cull: str | None = None
+    params: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
 
 
@@ -190,7 +192,9 @@ class DrawPlan:
                 instances=geometry.instances if update.instances is None
                 else update.instances)
         raster = self.raster if update.cull is None else replace(self.raster, cull=update.cull)
-        return replace(self, geometry=geometry, raster=raster,
+        multipass = self.multipass if not update.params else replace(
+            self.multipass, params={**self.multipass.params, **update.params})
+        return replace(self, geometry=geometry, raster=raster, multipass=multipass,
                        uniforms={**self.uniforms, **update.uniforms}), update.stats
 
 
