@@ -23,7 +23,7 @@ from ..gl.shaders import program
 from ..gl.targets import FRONT_OPACITY_UNIT
 from ..gl.textures import texture2d, texture3d, texture_array, texture_levels
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from .multipass import shadow_map
+from .multipass import shadow_map, stencil_count
 from .plan import DrawPlan, Geometry, Program, Texture
 from .proxy import GL_DEPTH_CLAMP
 
@@ -286,4 +286,5 @@ def _upload_texture(ctx, tex: Texture):
 
 #: Multi-pass kinds: ``kind(executor, viewed_plan, camera, light, extra_uniforms,
 #: textures) -> stats``.
-MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped}
+MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped,
+             "stencil-count": stencil_count.draw_stencil_counted}
