@@ -216,7 +216,7 @@ def test_bake_report_warns_when_a_sheet_is_carved_away(gl):
 
 def test_a_render_over_the_host_memory_limit_is_refused_before_uploading(objects,
                                                                          monkeypatch):
-    """Drawing N = 32 images needs 6 x 32² texels x 72 B = 432 KiB at its peak: with the
+    """Drawing N = 32 images needs 6 x 32² texels x 88 B = 528 KiB at its peak: with the
     host-memory limit below that it is refused with the estimate before any texture is
     made; above it (and above the 16² frame's read-back) it renders."""
     import reliefkit.gl.targets as targets
@@ -229,11 +229,11 @@ def test_a_render_over_the_host_memory_limit_is_refused_before_uploading(objects
     upload = executor.texture_array
     monkeypatch.setattr(executor, "texture_array",
                         lambda *a, **k: uploads.append(1) or upload(*a, **k))
-    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 72 - 1)
-    with pytest.raises(UsageError, match=r"res 32: to render .*432\.0 KiB of host memory"):
+    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 88 - 1)
+    with pytest.raises(UsageError, match=r"res 32: to render .*528\.0 KiB of host memory"):
         render(rep, cam)
     assert not uploads
-    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 72)
+    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 88)
     assert render(rep, cam).mask.any()
     assert len(uploads) == 3
 
