@@ -146,42 +146,54 @@ class DepthObjectDrawable:
                     "u_max_steps": 3 * rep.resolution + 3,
                     "u_check_visibility": opts.visibility,
                     "u_cube_to_face": _mat4_list(cube_to_face)}
-        common = {"HULL": rep.hull, "TEXTURING_NEAREST": opts.texturing == "nearest",
-                  "UNLIT": opts.unlit, "COUNT_ITERATIONS": bool(self.extra_attachments)}
-        name = "visual hull" if rep.hull else "depth object"
-        if opts.slicing == "raycast":
-            lo, hi = rep.bounds
-            box = np.diag([*(hi - lo), 1.0])
-            box[:3, 3] = lo
-            proxy, cube = _box_proxy(box, images.cube_to_world, 0.5 * (lo + hi))
-            return DrawPlan(
-                name, Program(PROGRAM, common | {"RAYCAST": True}),
-                _geometry(proxy.positions, cube, proxy.triangles), _textures(images),
-                uniforms | {"u_visible_depth": visible_depth(rep.resolution)},
-                raster=Raster(depth_func="<=", depth_clamp=True, cull="back"),
-                origin=tuple(float(x) for x in proxy.origin),
-                per_view=ViewHook(f"{__name__}:ray_cast_view", {
-                    "cube_to_world": images.cube_to_world, "planes": proxy.planes,
-                    "texturing": opts.texturing}))
-        centre = images.cube_to_world[:3, 3] + 0.5 * images.side
-        proxy, cube = _box_proxy(images.cube_to_world, images.cube_to_world, centre)
+        defines = {"HULL": rep.hull, "TEXTURING_NEAREST": opts.texturing == "nearest",
+                   "UNLIT": opts.unlit, "COUNT_ITERATIONS": bool(self.extra_attachments)}
+        make = self._ray_cast_plan if opts.slicing == "raycast" else self._slices_plan
+        return make(defines, uniforms, name="visual hull" if rep.hull else "depth object",
+                    textures=_textures(images))
+
+    def _ray_cast_plan(self, defines: dict, uniforms: dict, **shared) -> DrawPlan:
+        """The object's box (its `bounds`), not the whole cube: views hug the bounds with
+        their near and far planes, which would clip the cube's corners."""
+        rep = self.rep
+        lo, hi = rep.bounds
+        box = np.diag([*(hi - lo), 1.0])
+        box[:3, 3] = lo
+        proxy, cube = _box_proxy(box, rep.images.cube_to_world, 0.5 * (lo + hi))
+        return DrawPlan(
+            program=Program(PROGRAM, defines | {"RAYCAST": True}),
+            geometry=_geometry(proxy.positions, cube, proxy.triangles),
+            uniforms=uniforms | {"u_visible_depth": visible_depth(rep.resolution)},
+            raster=Raster(depth_func="<=", depth_clamp=True, cull="back"),
+            origin=tuple(float(x) for x in proxy.origin),
+            per_view=ViewHook(f"{__name__}:ray_cast_view", {
+                "cube_to_world": rep.images.cube_to_world, "planes": proxy.planes,
+                "texturing": self.options.texturing}), **shared)
+
+    def _slices_plan(self, defines: dict, uniforms: dict, **shared) -> DrawPlan:
+        """The cube, which the view hook replaces by each frame's slices; the stencil
+        passes are the "stencil-count" kind, one test per tested image."""
+        rep, opts = self.rep, self.options
+        cube_to_world = rep.images.cube_to_world
+        centre = cube_to_world[:3, 3] + 0.5 * rep.images.side
+        proxy, cube = _box_proxy(cube_to_world, cube_to_world, centre)
         multipass = None
         if opts.passes == "stencil":
-            program = Program(PROGRAM, common | {"COLOR_ONLY": True})
+            program = Program(PROGRAM, defines | {"COLOR_ONLY": True})
             multipass = MultiPass("stencil-count", {
-                "test": Program(PROGRAM, common | {"TEST_ONE": True}), "color": program,
+                "test": Program(PROGRAM, defines | {"TEST_ONE": True}), "color": program,
                 "copy": Program(COPY_PROGRAM)}, {"uniform": "u_face",
                                                  "values": rep.tested_faces})
         else:
-            program = Program(PROGRAM, common | {"SLAB": self.alpha_test == "slab"})
+            program = Program(PROGRAM, defines | {"SLAB": self.alpha_test == "slab"})
         return DrawPlan(
-            name, program, _geometry(proxy.world_positions - centre, cube, proxy.triangles),
-            _textures(images), uniforms, origin=tuple(float(x) for x in centre),
-            multipass=multipass,
+            program=program,
+            geometry=_geometry(proxy.world_positions - centre, cube, proxy.triangles),
+            uniforms=uniforms, origin=tuple(float(x) for x in centre), multipass=multipass,
             per_view=ViewHook(f"{__name__}:slices_view", {
-                "cube_to_world": images.cube_to_world, "resolution": rep.resolution,
+                "cube_to_world": cube_to_world, "resolution": rep.resolution,
                 "slicing": opts.slicing, "slices": opts.slices, "passes": opts.passes,
-                "alpha_test": self.alpha_test, "texturing": opts.texturing}))
+                "alpha_test": self.alpha_test, "texturing": opts.texturing}), **shared)
 
     def finish(self, frame, stats: dict) -> None:
         covered = int(frame.mask.sum())
@@ -205,9 +217,7 @@ def _textures(images) -> dict:
 
 def _box_proxy(box, cube_to_world, near) -> tuple[Proxy, np.ndarray]:
     """A box's proxy (`render.proxy`, solved around ``near``) and its corners' cube
-    coordinates. Ray casting draws the object's box (its `bounds`), not the whole cube:
-    views hug the bounds with their near and far planes, which would clip the cube's
-    corners. Slicing starts from the cube (its hook replaces it by the slices)."""
+    coordinates."""
     proxy = convex_proxy(box_planes(np.linalg.inv(box)), near=near)
     corners = proxy.world_positions
     return proxy, (np.c_[corners, np.ones(len(corners))] @ np.linalg.inv(cube_to_world).T)[:, :3]
@@ -267,13 +277,13 @@ def slices_view(plan, camera, light, *, cube_to_world, resolution, slicing, slic
     stack = slice_stack(cube_to_world, resolution, slicing, slices, camera)
     side = float(np.linalg.norm(cube_to_world[:3, 0]))
     slack = stack.spacing / side if alpha_test == "point" else 0.0
-    sizes = np.diff(stack.first_triangle)[stack.front_to_back]
     stats = {"slicing": slicing, "slices": stack.slice_count, "passes": passes,
              "texturing": texturing, "alpha_test": alpha_test,
              "slice_polygons": int(np.count_nonzero(np.diff(stack.first_triangle))),
              "fill_pixels": stack.area_pixels(camera)}
     params = {}
     if passes == "stencil":
+        sizes = np.diff(stack.first_triangle)[stack.front_to_back]  # triangles, draw order
         starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
         drawn = sizes > 0
         params["ranges"] = 3 * np.stack([starts[drawn], sizes[drawn]], axis=1)
