@@ -59,6 +59,7 @@ class Executor:
         self._textures: dict[int, object] = {}  # id(Texture) -> GL texture
         self._geometry: dict[int, _Uploaded] = {}
         self._keep_alive: list = []             # plan objects whose ids key the tables
+        self._viewed: dict[int, Geometry] = {}  # id(geometry) -> its latest view's
         self.groups: dict[int, list] = {}        # id(geometry) -> its multi-pass plans
         self.cache: dict = {}                    # a multi-pass kind's per-light products
 
@@ -127,7 +128,9 @@ class Executor:
     # -- drawing --------------------------------------------------------------------------
     def view(self, plan: DrawPlan, camera, light) -> tuple[DrawPlan, dict]:
         """``plan`` as seen from ``camera`` (`DrawPlan.with_view`), its new arrays written
-        into the uploaded buffers; and the hook's statistics."""
+        into the uploaded buffers; and the hook's statistics. Only the latest view of a
+        geometry is kept (its arrays are what the buffers hold): the views of a list of
+        cameras are not all held until the scene is released."""
         viewed, stats = plan.with_view(camera, light)
         if viewed is not plan:
             uploaded = self._buffers(plan.geometry)
@@ -135,8 +138,12 @@ class Executor:
                 _write(uploaded.attributes[name], attr.array)
             if viewed.geometry.indices is not None:
                 _write(uploaded.indices, viewed.geometry.indices, np.uint32)
-            self._geometry[id(viewed.geometry)] = uploaded
-            self._keep_alive.append(viewed.geometry)
+            if viewed.geometry is not plan.geometry:
+                previous = self._viewed.pop(id(plan.geometry), None)
+                if previous is not None:
+                    del self._geometry[id(previous)]
+                self._viewed[id(plan.geometry)] = viewed.geometry
+                self._geometry[id(viewed.geometry)] = uploaded
         return viewed, stats
 
     def uniforms(self, plan: DrawPlan, camera, light) -> dict:
@@ -226,6 +233,7 @@ class Executor:
         for obj in reversed(self._made):
             obj.release()
         self._made, self._textures, self._geometry, self._keep_alive = [], {}, {}, []
+        self._viewed = {}
         self.groups, self.cache = {}, {}
 
 

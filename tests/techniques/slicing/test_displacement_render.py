@@ -326,3 +326,28 @@ def test_plans_read_back_from_json_draw_the_same_frame(gl, rep, tinted, options)
         cam = camera(drawn, 120.0, 30.0, 48)
         assert_same_frames(frame_from_json_plans(drawn, cam, **options),
                            render(drawn, cam, **options))
+
+
+def test_a_list_of_cameras_holds_one_view_of_slices_at_a_time(gl, rep, monkeypatch):
+    """The upload is kept across views, the slices are not: each view's vertex arrays are
+    freed once the next view's replace them (24 views of 2M slice triangles would
+    otherwise hold 10 GiB)."""
+    import gc
+    import weakref
+
+    from reliefkit.render.draw import Scene
+    from reliefkit.techniques.slicing import displacement_render
+
+    hook, views = displacement_render.slices_view, []
+
+    def recording(*args, **kwargs):
+        update = hook(*args, **kwargs)
+        views.append(weakref.ref(update.attributes["in_position"]))
+        return update
+
+    monkeypatch.setattr(displacement_render, "slices_view", recording)
+    with Scene(rep, slicing="screen", slices=8) as scene:
+        for az in (30.0, 120.0, 210.0):
+            scene.frame(camera(rep, az, 40.0, 32))
+            gc.collect()
+            assert [v() is not None for v in views] == [False] * (len(views) - 1) + [True]
