@@ -31,7 +31,13 @@ from ..gl.textures import (
     texture_levels,
 )
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from .multipass import depth_peel, half_opacity_search, opaque_depth, shadow_map
+from .multipass import (
+    depth_peel,
+    half_opacity_search,
+    opaque_depth,
+    shadow_map,
+    stencil_count,
+)
 from .plan import DrawPlan, Geometry, Program, Texture
 
 GL_DEPTH_CLAMP = 0x864F  # moderngl has no flag for it: enabled through enable_direct
@@ -67,6 +73,7 @@ class Executor:
         self._textures: dict[int, object] = {}  # id(Texture) -> GL texture
         self._geometry: dict[int, _Uploaded] = {}
         self._keep_alive: list = []             # plan objects whose ids key the tables
+        self._viewed: dict[int, Geometry] = {}  # id(geometry) -> its latest view's
         self.groups: dict[int, list] = {}        # id(geometry) -> its multi-pass plans
         self.cache: dict = {}                    # a multi-pass kind's per-light products
         self._full_screen: dict = {}             # vertex arrays of `draw_full_screen`
@@ -141,7 +148,9 @@ class Executor:
     # -- drawing --------------------------------------------------------------------------
     def view(self, plan: DrawPlan, camera, light) -> tuple[DrawPlan, dict]:
         """``plan`` as seen from ``camera`` (`DrawPlan.with_view`), its new arrays written
-        into the uploaded buffers; and the hook's statistics."""
+        into the uploaded buffers; and the hook's statistics. Only the latest view of a
+        geometry is kept (its arrays are what the buffers hold): the views of a list of
+        cameras are not all held until the scene is released."""
         viewed, stats = plan.with_view(camera, light)
         if viewed is not plan:
             uploaded = self._buffers(plan.geometry)
@@ -149,8 +158,12 @@ class Executor:
                 _write(uploaded.attributes[name], attr.array)
             if viewed.geometry.indices is not None:
                 _write(uploaded.indices, viewed.geometry.indices, np.uint32)
-            self._geometry[id(viewed.geometry)] = uploaded
-            self._keep_alive.append(viewed.geometry)
+            if viewed.geometry is not plan.geometry:
+                previous = self._viewed.pop(id(plan.geometry), None)
+                if previous is not None:
+                    del self._geometry[id(previous)]
+                self._viewed[id(plan.geometry)] = viewed.geometry
+                self._geometry[id(viewed.geometry)] = uploaded
         return viewed, stats
 
     def uniforms(self, plan: DrawPlan, camera, light) -> dict:
@@ -217,11 +230,8 @@ class Executor:
                     textures=None, program_override: Program | None = None,
                     raster=None) -> None:
         """One draw of a plan already seen from ``camera`` (`view`)."""
-        prog = self.program(program_override or viewed.program)
-        vao = self._vertex_array(prog, viewed.geometry)
-        samplers = self.bind_textures(prog, {**viewed.textures, **(textures or {})})
-        set_uniforms(prog, self.uniforms(viewed, camera, light) | (extra_uniforms or {})
-                     | samplers)
+        vao = self.bind(viewed, camera, light, extra_uniforms=extra_uniforms,
+                        textures=textures, program_override=program_override)
         self.set_raster(raster or viewed.raster)
         try:
             vao.render(_MODES[viewed.geometry.primitive], **_counts(viewed))
@@ -242,11 +252,24 @@ class Executor:
         finally:
             self.reset_raster()
 
+    def bind(self, viewed: DrawPlan, camera, light, *, extra_uniforms=None, textures=None,
+             program_override: Program | None = None):
+        """Bind the textures and set the uniforms of a draw of ``viewed`` (as `draw_viewed`
+        does) and return its vertex array: for multi-pass kinds that draw ranges of it
+        themselves, under their own raster state."""
+        prog = self.program(program_override or viewed.program)
+        vao = self._vertex_array(prog, viewed.geometry)
+        samplers = self.bind_textures(prog, {**viewed.textures, **(textures or {})})
+        set_uniforms(prog, self.uniforms(viewed, camera, light) | (extra_uniforms or {})
+                     | samplers)
+        return vao
+
     def release(self) -> None:
         """Free every GL object, newest first."""
         for obj in reversed(self._made):
             obj.release()
         self._made, self._textures, self._geometry, self._keep_alive = [], {}, {}, []
+        self._viewed = {}
         self.groups, self.cache, self._full_screen = {}, {}, {}
 
 
@@ -325,4 +348,5 @@ def _upload_texture(ctx, tex: Texture):
 MULTIPASS = {"shadow-map": shadow_map.draw_shadow_mapped,
              "opaque-depth": opaque_depth.draw_with_opaque_depth,
              "half-opacity-search": half_opacity_search.draw_half_opacity_search,
-             "depth-peel": depth_peel.draw_depth_peeled}
+             "depth-peel": depth_peel.draw_depth_peeled,
+             "stencil-count": stencil_count.draw_stencil_counted}

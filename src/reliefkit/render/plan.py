@@ -124,8 +124,9 @@ class ViewHook:
 class ViewUpdate:
     """A hook's answer for one camera: uniforms to set, vertex arrays (by attribute name) or
     indices to replace, a new vertex/instance count, a new ``count`` of the range drawn (0:
-    nothing from this view, a level of detail switched off), the faces to cull, and
-    statistics for the drawable's `finish`. Empty fields leave the plan's own."""
+    nothing from this view, a level of detail switched off), the faces to cull, parameters
+    of the plan's multi-pass kind (added to ``MultiPass.params``) and statistics for the
+    drawable's `finish`. Empty fields leave the plan's own."""
 
     uniforms: dict = field(default_factory=dict)
     attributes: dict = field(default_factory=dict)
@@ -134,6 +135,7 @@ class ViewUpdate:
     instances: int | None = None
     count: int | None = None
     cull: str | None = None
+    params: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
 
 
@@ -193,7 +195,9 @@ class DrawPlan:
                 else update.instances)
         raster = self.raster if update.cull is None else replace(self.raster, cull=update.cull)
         count = self.count if update.count is None else update.count
-        return replace(self, geometry=geometry, raster=raster, count=count,
+        multipass = self.multipass if not update.params else replace(
+            self.multipass, params={**self.multipass.params, **update.params})
+        return replace(self, geometry=geometry, raster=raster, count=count, multipass=multipass,
                        uniforms={**self.uniforms, **update.uniforms}), update.stats
 
 

@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from slicing_scenes import CUP_FLOOR, CUP_TOP, box_mesh, cup_mesh, sphere_mesh
+from slicing_scenes import (
+    CUP_FLOOR,
+    CUP_TOP,
+    assert_same_frames,
+    box_mesh,
+    cup_mesh,
+    frame_from_json_plans,
+    sphere_mesh,
+)
 
 from reliefkit.errors import UsageError
 from reliefkit.render import render
@@ -208,23 +216,48 @@ def test_bake_report_warns_when_a_sheet_is_carved_away(gl):
 
 def test_a_render_over_the_host_memory_limit_is_refused_before_uploading(objects,
                                                                          monkeypatch):
-    """Drawing N = 32 images needs 6 x 32² texels x 72 B = 432 KiB at its peak: with the
+    """Drawing N = 32 images needs 6 x 32² texels x 88 B = 528 KiB at its peak: with the
     host-memory limit below that it is refused with the estimate before any texture is
     made; above it (and above the 16² frame's read-back) it renders."""
     import reliefkit.gl.targets as targets
-    import reliefkit.techniques.slicing.render as depth_render
+    from reliefkit.render import executor
 
     rep = objects["sphere"]
     cam = Camera.orbit(tuple(rep.bounds.mean(axis=0)), 30, 25, 1.7 * rep.images.side,
                        size=(16, 16))
     uploads = []
-    upload = depth_render.texture_array
-    monkeypatch.setattr(depth_render, "texture_array",
+    upload = executor.texture_array
+    monkeypatch.setattr(executor, "texture_array",
                         lambda *a, **k: uploads.append(1) or upload(*a, **k))
-    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 72 - 1)
-    with pytest.raises(UsageError, match=r"res 32: to render .*432\.0 KiB of host memory"):
+    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 88 - 1)
+    with pytest.raises(UsageError, match=r"res 32: to render .*528\.0 KiB of host memory"):
         render(rep, cam)
     assert not uploads
-    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 72)
+    monkeypatch.setattr(targets, "host_limit", lambda: 6 * N**2 * 88)
     assert render(rep, cam).mask.any()
     assert len(uploads) == 3
+
+
+DRAWINGS = [{"slicing": "raycast"}, {"slicing": "raycast", "count_iterations": True},
+            {"slicing": "orthogonal", "slices": 12}, {"slicing": "screen"},
+            {"slicing": "screen", "alpha_test": "point", "slices": 12},
+            {"slicing": "orthogonal", "passes": "stencil", "slices": 12}]
+
+
+@pytest.mark.parametrize("options", DRAWINGS, ids=str)
+@pytest.mark.parametrize("hull", [False, True])
+def test_a_list_of_cameras_draws_each_as_if_alone(objects, options, hull):
+    """One upload, the slices (or the proxy's culling) per camera: the same frames as one
+    render per camera."""
+    rep = VisualHull.of(objects["cup"].images) if hull else objects["cup"]
+    a, b, _ = cameras(rep)
+    both = render(rep, [a, b], **options)
+    assert_same_frames(both[0], render(rep, a, **options))
+    assert_same_frames(both[1], render(rep, b, **options))
+
+
+@pytest.mark.parametrize("options", DRAWINGS, ids=str)
+def test_plans_read_back_from_json_draw_the_same_frame(objects, options):
+    rep = objects["cup"]
+    cam = cameras(rep)[1]
+    assert_same_frames(frame_from_json_plans(rep, cam, **options), render(rep, cam, **options))

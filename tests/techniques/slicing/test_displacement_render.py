@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from slicing_scenes import assert_same_frames, frame_from_json_plans
 
 from reliefkit.render import render
 from reliefkit.scene.views import orbit_bounds
@@ -296,3 +297,57 @@ def test_the_bake_report_counts_the_triangles_left_out(tmp_path):
     assert "warning: 1 triangles were left out of the base (no area in space or in uv)" in \
         report
     assert np.array_equal(rep.base.material, [0, 1])  # the kept triangles keep theirs
+
+
+DRAWINGS = [{"slicing": "orthogonal"}, {"slicing": "screen", "slices": 12},
+            {"slicing": "surface", "alpha_test": "bound", "slices": 10},
+            {"slicing": "orthogonal", "count_iterations": True}]
+
+
+@pytest.fixture(scope="module")
+def tinted(gl, tmp_path_factory):
+    """A map whose base has two materials (a surface atlas, a third texture)."""
+    return baked_on(two_material_square(), tmp_path_factory.mktemp("tinted"))
+
+
+@pytest.mark.parametrize("options", DRAWINGS, ids=str)
+def test_a_list_of_cameras_draws_each_as_if_alone(gl, rep, tinted, options):
+    """One upload, the slices per camera: the same frames as one render per camera."""
+    for drawn in (rep, tinted):
+        a, b = camera(drawn, 30.0, 40.0, 48), camera(drawn, 200.0, 15.0, 48)
+        both = render(drawn, [a, b], **options)
+        assert_same_frames(both[0], render(drawn, a, **options))
+        assert_same_frames(both[1], render(drawn, b, **options))
+
+
+@pytest.mark.parametrize("options", DRAWINGS, ids=str)
+def test_plans_read_back_from_json_draw_the_same_frame(gl, rep, tinted, options):
+    for drawn in (rep, tinted):
+        cam = camera(drawn, 120.0, 30.0, 48)
+        assert_same_frames(frame_from_json_plans(drawn, cam, **options),
+                           render(drawn, cam, **options))
+
+
+def test_a_list_of_cameras_holds_one_view_of_slices_at_a_time(gl, rep, monkeypatch):
+    """The upload is kept across views, the slices are not: each view's vertex arrays are
+    freed once the next view's replace them (24 views of 2M slice triangles would
+    otherwise hold 10 GiB)."""
+    import gc
+    import weakref
+
+    from reliefkit.render.draw import Scene
+    from reliefkit.techniques.slicing import displacement_render
+
+    hook, views = displacement_render.slices_view, []
+
+    def recording(*args, **kwargs):
+        update = hook(*args, **kwargs)
+        views.append(weakref.ref(update.attributes["in_position"]))
+        return update
+
+    monkeypatch.setattr(displacement_render, "slices_view", recording)
+    with Scene(rep, slicing="screen", slices=8) as scene:
+        for az in (30.0, 120.0, 210.0):
+            scene.frame(camera(rep, az, 40.0, 32))
+            gc.collect()
+            assert [v() is not None for v in views] == [False] * (len(views) - 1) + [True]

@@ -10,32 +10,32 @@ show nothing new), K clamped to [2, 512] (`auto_slices`), and halved while the f
 need more than `displacement_slices.MAX_POLYGONS` polygons; the slices across the volume
 (orthogonal u and v, screen planes) are then never closer than that spacing either, so a
 displacement thinner than a pixel costs the base and a few slices, not 1 / scale of them.
+
+The drawable is one draw plan (`render.plan`): the textures, the base as its geometry, and a
+view hook that returns each camera's slice polygons as new vertex arrays. The hook's data
+is the map as plain arrays (its base mesh, textures and tetrahedra), rebuilt per call.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
 from ...bake.uv_atlas import atlas_uniforms
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
-from ...gl.context import check_gl_error
-from ...gl.objects import GLObjects
-from ...gl.shaders import program
-from ...gl.textures import texture2d, texture_array
-from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
-from .displacement import DisplacementMap
-from .displacement_slices import MODES, TooManyPolygons, slice_triangles
+from ...render.plan import Attribute, DrawPlan, Geometry, Program, Texture, ViewHook, ViewUpdate
+from ...scene.mesh import RenderMesh
+from .displacement import DisplacementMap, DisplacementVolume
+from .displacement_slices import MODES, TooManyPolygons, base_triangles, slice_triangles
 from .slices import auto_slice_count, pixel_world_size, projected_area
 
 PROGRAM = "slicing:displacement.glsl"
 PROGRAMS = (ProgramVariant(PROGRAM, {}), ProgramVariant(PROGRAM, {"UNLIT": True}))
 ALPHA_TESTS = ("fill", "bound")
 AUTO_MIN, AUTO_MAX = 2, 512
-_HEIGHT_UNIT, _COLOR_UNIT, _SURFACE_UNIT = 0, 1, 2
 
 
 @dataclass(frozen=True)
@@ -84,100 +84,106 @@ def auto_slices(rep: DisplacementMap, camera) -> int:
                             maximum=AUTO_MAX)
 
 
-def vertex_data(tris, origin, layers) -> np.ndarray:
-    """(3M, 16) float32: position relative to ``origin``, (u, v, h), d/du, d/dv, d/dh, the
-    surface layer (``layers`` (F,) per base triangle: `DisplacementMap.surface_layers`)."""
+def vertex_arrays(tris, origin, layers) -> dict:
+    """The shader's vertex arrays (float32) of slice triangles ``tris``: position relative
+    to ``origin``, (u, v, h), d/du, d/dv, d/dh, the surface layer (``layers`` (F,) per base
+    triangle: `DisplacementMap.surface_layers`)."""
     j = tris.jacobian
-    out = np.concatenate([tris.positions - origin, tris.box, j[:, :, 0], j[:, :, 1],
-                          j[:, :, 2], layers[tris.triangle][:, None]], axis=1)
-    return np.ascontiguousarray(out, np.float32)
+    arrays = {"in_position": tris.positions - origin, "in_uvh": tris.box,
+              "in_ju": j[:, :, 0], "in_jv": j[:, :, 1], "in_jh": j[:, :, 2],
+              "in_layer": layers[tris.triangle]}
+    return {name: np.ascontiguousarray(a, np.float32) for name, a in arrays.items()}
 
 
-class DisplacementDrawable(GLObjects):
-    """The displacement texture on the GPU; slices recomputed for every camera."""
+class DisplacementDrawable:
+    """The displacement texture as one draw plan; its slices recomputed for every camera by
+    the plan's view hook."""
 
-    def __init__(self, ctx, rep: DisplacementMap,
-                 options: DisplacementRenderOptions | None = None, instrument: bool = False):
-        self.ctx, self.rep = ctx, rep
-        self.options = options or DisplacementRenderOptions()
+    def __init__(self, rep: DisplacementMap, options: DisplacementRenderOptions | None = None,
+                 instrument: bool = False):
+        self.rep = rep
+        self.options = opts = options or DisplacementRenderOptions()
         self.extra_attachments = 1 if instrument else 0
-        self.instrument = instrument
         lo, hi = rep.bounds
-        self.origin = 0.5 * (lo + hi)
-        self.volume = None if self.options.slicing == "surface" else rep.volume()
-        self.stats: dict = {}
-        self._upload_owned(self._upload)
-
-    def _upload(self) -> None:
-        ctx, rep = self.ctx, self.rep
-        self.prog = program(ctx, PROGRAM, {"UNLIT": self.options.unlit,
-                                           "COUNT_ITERATIONS": self.instrument})
-        self.height = self.keep(texture2d(ctx, rep.height, what="displacement height",
-                                          filter="nearest"))
-        self.color = self.keep(texture2d(ctx, rep.color, what="displacement colour",
-                                         repeat=rep.wrap))
-        if rep.surface is not None:
-            self.surface = self.keep(texture_array(ctx, rep.surface.rgba8, srgb=True,
-                                                   what="displacement surface materials"))
-        check_gl_error(ctx, "uploading a displacement texture")
-
-    def draw(self, camera, light) -> None:
-        import moderngl
-
-        rep, opts, ctx = self.rep, self.options, self.ctx
-        count = opts.slices if opts.slices is not None else auto_slices(rep, camera)
-        finest = finest_spacing(rep, camera) if opts.slices is None else 0.0
-        while True:
-            try:
-                tris = slice_triangles(rep, camera, opts.slicing, count, self.volume, finest)
-                break
-            except TooManyPolygons:
-                if opts.slices is not None or count <= AUTO_MIN:
-                    raise
-                count = max(AUTO_MIN, count // 2)  # automatic: halve until the slices fit
-        h, w = rep.height.shape
+        origin = 0.5 * (lo + hi)
         test = opts.alpha_test if opts.slicing == "surface" else "fill"
-        bound = 1.0 / (count - 1) if count > 1 else 1.0
-        self.stats = {"slices": int(count), "slicing": opts.slicing,
-                      "alpha_test": test,
-                      "slice_planes": int(tris.slices), "slice_polygons": int(tris.polygons),
-                      "slice_triangles": int(tris.triangle_count),
-                      "slice_spacing": float(tris.spacing),
-                      "fill_pixels": projected_area(tris.positions, camera),
-                      **{f"direction_{k}": v for k, v in tris.directions.items()}}
-        if not tris.triangle_count:
-            return
-        data = vertex_data(tris, self.origin, rep.surface_layers())
-        vbo = ctx.buffer(data.tobytes())
-        try:
-            vao = ctx.vertex_array(self.prog, [(vbo, "3f 3f 3f 3f 3f 1f", "in_position",
-                                                "in_uvh", "in_ju", "in_jv", "in_jh",
-                                                "in_layer")])
-            try:
-                set_uniforms(self.prog, camera_uniforms(camera)
-                             | model_offset(camera, self.origin) | light.uniforms()
-                             | {"u_height": _HEIGHT_UNIT, "u_color": _COLOR_UNIT,
-                                "u_hf_size": (w, h), "u_wrap": rep.wrap,
-                                "u_tile": tuple(rep.tile),
-                                "u_test": ALPHA_TESTS.index(test),
-                                "u_bound": float(bound)}
-                             | atlas_uniforms(rep.surface, _SURFACE_UNIT))
-                self.height.use(_HEIGHT_UNIT)
-                self.color.use(_COLOR_UNIT)
-                if rep.surface is not None:
-                    self.surface.use(_SURFACE_UNIT)
-                ctx.enable(moderngl.DEPTH_TEST)
-                ctx.disable(moderngl.CULL_FACE)
-                vao.render(moderngl.TRIANGLES)
-                check_gl_error(ctx, f"drawing {tris.polygons} displacement slice polygons")
-            finally:
-                vao.release()
-        finally:
-            vbo.release()
+        textures = {"u_height": Texture(rep.height, filter="nearest",
+                                        what="displacement height"),
+                    "u_color": Texture(rep.color, wrap=("repeat",) * 3 if rep.wrap
+                                       else ("clamp",) * 3, what="displacement colour")}
+        if rep.surface is not None:
+            textures["u_surface"] = Texture(rep.surface.rgba8, "2d_array", srgb=True,
+                                            what="displacement surface materials")
+        h, w = rep.height.shape
+        layers = rep.surface_layers()
+        volume = None if opts.slicing == "surface" else rep.volume()
+        base = vertex_arrays(base_triangles(rep), origin, layers)
+        self.plans = [DrawPlan(
+            "displacement slices",
+            Program(PROGRAM, {"UNLIT": opts.unlit, "COUNT_ITERATIONS": instrument}),
+            Geometry({name: Attribute(a) for name, a in base.items()}), textures,
+            # without a surface its sampler names a unit no texture of the plan uses
+            {"u_hf_size": (w, h), "u_wrap": rep.wrap, "u_tile": tuple(rep.tile),
+             "u_test": ALPHA_TESTS.index(test)} | atlas_uniforms(rep.surface, len(textures)),
+            origin=tuple(float(x) for x in origin),
+            per_view=ViewHook(f"{__name__}:slices_view", {
+                "displacement": _map_data(rep), "layers": layers,
+                "volume": None if volume is None else {
+                    f.name: getattr(volume, f.name) for f in fields(volume)},
+                "slicing": opts.slicing, "slices": opts.slices, "alpha_test": test}))]
 
-    def finish(self, frame) -> None:
-        frame.stats.update(self.stats)
+    def finish(self, frame, stats: dict) -> None:
+        frame.stats.update(stats)
+
+
+def _map_data(rep: DisplacementMap) -> dict:
+    """What slicing reads of ``rep``, as plain data (`_map` rebuilds it)."""
+    base = rep.base
+    return {"positions": base.positions, "origin": tuple(float(x) for x in base.origin),
+            "indices": base.indices, "normals": base.normals, "uvs": base.uvs,
+            "color": rep.color, "height": rep.height, "scale": rep.scale,
+            "tile": tuple(rep.tile), "wrap": rep.wrap}
+
+
+def _map(data: dict) -> DisplacementMap:
+    """The map of `_map_data` (its surface left out: the hook is given the layers)."""
+    positions = data["positions"]
+    base = RenderMesh(positions, data["indices"], data["normals"],
+                      np.broadcast_to(np.float32(1.0), (len(positions), 4)), data["uvs"],
+                      origin=data["origin"])
+    return DisplacementMap(base, data["color"], data["height"], data["scale"], data["tile"],
+                           data["wrap"])
+
+
+def slices_view(plan, camera, light, *, displacement, layers, volume, slicing, slices,
+                alpha_test) -> ViewUpdate:
+    """View hook: this camera's slice polygons (`displacement_slices`) as the vertex
+    arrays; their count K is ``slices`` or automatic (see the module docstring)."""
+    rep = _map(displacement)
+    volume = None if volume is None else DisplacementVolume(**volume)
+    count = slices if slices is not None else auto_slices(rep, camera)
+    finest = finest_spacing(rep, camera) if slices is None else 0.0
+    while True:
+        try:
+            tris = slice_triangles(rep, camera, slicing, count, volume, finest)
+            break
+        except TooManyPolygons:
+            if slices is not None or count <= AUTO_MIN:
+                raise
+            count = max(AUTO_MIN, count // 2)  # automatic: halve until the slices fit
+    bound = 1.0 / (count - 1) if count > 1 else 1.0
+    stats = {"slices": int(count), "slicing": slicing, "alpha_test": alpha_test,
+             "slice_planes": int(tris.slices), "slice_polygons": int(tris.polygons),
+             "slice_triangles": int(tris.triangle_count),
+             "slice_spacing": float(tris.spacing),
+             "fill_pixels": projected_area(tris.positions, camera),
+             **{f"direction_{k}": v for k, v in tris.directions.items()}}
+    return ViewUpdate(uniforms={"u_bound": float(bound)},
+                      attributes=vertex_arrays(tris, np.asarray(plan.origin, np.float64),
+                                               layers),
+                      stats=stats)
 
 
 def drawable_spec() -> DrawableSpec:
-    return DrawableSpec(DisplacementMap, DisplacementDrawable, DisplacementRenderOptions)
+    return DrawableSpec(DisplacementMap, DisplacementDrawable, DisplacementRenderOptions,
+                        planned=True)

@@ -199,6 +199,11 @@ def _offset_surfaces(rep, count: int) -> SliceTriangles:
     return _joined(surfaces, spacing, "surface", {"a": surfaces[0][3]})
 
 
+def base_triangles(rep) -> SliceTriangles:
+    """The base itself (the offset surface h = 0), which every slicing draws."""
+    return _offset_surfaces(rep, 1)
+
+
 def _joined(parts, spacing: float, mode: str, directions: dict,
             base: int = 0) -> SliceTriangles:
     """One `SliceTriangles` of several (positions, box, jacobian, polygons, levels, base

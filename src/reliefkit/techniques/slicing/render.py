@@ -23,6 +23,12 @@ Texturing (§4.2): the three images closest to the view direction, or the single
 (``texturing``), restricted to the images that see the point (a point is seen by image k
 when it lies within `VISIBLE_TEXELS` of k's first surface; ``visibility=False`` is the
 paper's texturing); lit with the blended normal unless ``unlit``.
+
+The drawable is one draw plan (`render.plan`): the six images as texture arrays, and the
+object's box (ray casting) or the cube (slices) as geometry. Its view hook sets the box's
+camera-relative uniforms and either the proxy's faces to cull or the frame's slice stack
+(new vertex and index arrays, nearest slice first); the stencil passes are the executor's
+"stencil-count" multi-pass kind, one test per image.
 """
 
 from __future__ import annotations
@@ -31,17 +37,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...bake.project import axis_frame
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...errors import UsageError
-from ...gl.context import check_gl_error
-from ...gl.objects import GLObjects
-from ...gl.shaders import program
-from ...gl.textures import texture_array
-from ...gl.uniforms import box_uniforms, camera_uniforms, model_offset, set_uniforms
+from ...gl.uniforms import box_uniforms
+from ...render.plan import (
+    Attribute,
+    DrawPlan,
+    Geometry,
+    MultiPass,
+    Program,
+    Raster,
+    Texture,
+    ViewHook,
+    ViewUpdate,
+)
+from ...render.proxy import Proxy, box_planes, convex_proxy, cull_face
 from .depth_images import FACE_INDEX, check_memory
 from .representation import DepthObject
-from .slices import auto_slice_count, orthogonal_slices, screen_slices
+from .slices import auto_slice_count, orthogonal_slices, screen_slices, view_direction
 
 PROGRAM = "slicing:depth_object.glsl"
 COPY_PROGRAM = "slicing:copy_frame.glsl"
@@ -54,7 +69,6 @@ FINEST_TEXELS = 0.5        # automatic slices: never closer than half a texel (a
                            # lies up to one spacing / cos(angle) behind the exact one)
 VISIBLE_TEXELS = 1.5       # a point this many texels (plus one slice) behind image k's
                            # surface still counts as seen by image k
-_DEPTH_UNIT, _COLOR_UNIT, _NORMAL_UNIT = 0, 1, 2
 PROGRAMS = tuple(ProgramVariant(PROGRAM, d) for d in (
     {}, {"HULL": True}, {"TEXTURING_NEAREST": True}, {"UNLIT": True}, {"TEST_ONE": True},
     {"COLOR_ONLY": True}, {"SLAB": True}, {"RAYCAST": True}, {"RAYCAST": True, "HULL": True})) + (
@@ -89,27 +103,22 @@ class DepthObjectRenderOptions:
 
 def _face_normals() -> list[tuple]:
     """Outward world normal of each face, in face order."""
-    from ...bake.project import axis_frame
-
     return [tuple(float(x) for x in axis_frame(face)[2])
             for face in sorted(FACE_INDEX, key=FACE_INDEX.get)]
 
 
-def _mat4_array(prog, name: str, matrices) -> None:
-    """Write a uniform ``mat4 name[n]`` (column-major), cut to what the compiler kept."""
-    if name not in prog:
-        return
-    length = prog[name].array_length
-    data = np.stack([np.asarray(m, np.float64).T for m in matrices[:length]])
-    prog[name].write(data.astype(np.float32).tobytes())
+def _mat4_list(matrices) -> list[tuple]:
+    """A ``mat4 name[n]`` uniform's value: each matrix column-major."""
+    return [tuple(float(x) for x in np.asarray(m, np.float64).T.ravel()) for m in matrices]
 
 
-class DepthObjectDrawable(GLObjects):
-    """The six images of one depth object (or hull) on the GPU, sliced or ray cast per frame."""
+class DepthObjectDrawable:
+    """The six images of one depth object (or hull) as one draw plan, sliced or ray cast
+    per camera by its view hook."""
 
-    def __init__(self, ctx, rep: DepthObject, options: DepthObjectRenderOptions | None = None,
+    def __init__(self, rep: DepthObject, options: DepthObjectRenderOptions | None = None,
                  instrument: bool = False):
-        self.ctx, self.rep = ctx, rep
+        self.rep = rep
         self.options = opts = options or DepthObjectRenderOptions()
         if opts.slicing == "raycast" and opts.passes == "stencil":
             raise UsageError("--passes stencil counts image tests per slice; ray casting "
@@ -125,227 +134,175 @@ class DepthObjectDrawable(GLObjects):
                 raise UsageError(f"{' and '.join(given)} set the slices of --slicing "
                                  "orthogonal or screen; ray casting (the default) has none")
         self.extra_attachments = 1 if instrument and opts.slicing == "raycast" else 0
-        self.instrument = instrument
-        images = rep.images
-        self.centre = images.cube_to_world[:3, 3] + 0.5 * images.side
-        self.cube_to_face = [np.linalg.inv(images.box_to_world[k]) @ images.cube_to_world
-                             for k in range(6)]
-        self.stats: dict = {}
         check_memory(rep.resolution, "render")
-        self._upload_owned(self._upload)
+        self.plans = [self._plan()]
 
-    def _upload(self) -> None:
-        ctx, images, opts = self.ctx, self.rep.images, self.options
-        # One host copy per upload at most, each freed before the next (`RENDER_TEXEL_BYTES`).
-        self.depth_tex = self.keep(texture_array(
-            ctx, np.where(images.mask, images.depth, np.float32(EMPTY_DEPTH)),
-            what="depth images", filter="nearest"))
-        premultiplied = images.color.astype(np.float32)
-        premultiplied[..., :3] *= premultiplied[..., 3:]
-        self.color_tex = self.keep(texture_array(ctx, premultiplied,
-                                                 what="depth-image colours"))
-        del premultiplied
-        self.normal_tex = self.keep(texture_array(ctx, images.normal.astype(np.float32,
-                                                                            copy=False),
-                                                  what="depth-image normals"))
-        common = {"HULL": self.rep.hull, "TEXTURING_NEAREST": opts.texturing == "nearest",
-                  "UNLIT": opts.unlit, "COUNT_ITERATIONS": bool(self.extra_attachments)}
-        self.vbo = self.ibo = None
-        self.vaos: dict = {}
-        if opts.slicing == "raycast":
-            self.programs = {"main": program(ctx, PROGRAM, common | {"RAYCAST": True})}
-            self._cube_proxy()
-        elif opts.passes == "stencil":
-            self.programs = {"test": program(ctx, PROGRAM, common | {"TEST_ONE": True}),
-                             "color": program(ctx, PROGRAM, common | {"COLOR_ONLY": True})}
-            self.copy_program = program(ctx, COPY_PROGRAM)
-            self.copy_vao = self.keep(ctx.vertex_array(self.copy_program, []))
-        else:
-            self.programs = {"main": program(ctx, PROGRAM, common | {
-                "SLAB": self.alpha_test == "slab"})}
-        check_gl_error(ctx, "uploading a depth object")
+    def _plan(self) -> DrawPlan:
+        rep, opts = self.rep, self.options
+        images = rep.images
+        cube_to_face = [np.linalg.inv(images.box_to_world[k]) @ images.cube_to_world
+                        for k in range(6)]
+        uniforms = {"u_res": rep.resolution, "u_face_normal": _face_normals(),
+                    "u_max_steps": 3 * rep.resolution + 3,
+                    "u_check_visibility": opts.visibility,
+                    "u_cube_to_face": _mat4_list(cube_to_face)}
+        defines = {"HULL": rep.hull, "TEXTURING_NEAREST": opts.texturing == "nearest",
+                   "UNLIT": opts.unlit, "COUNT_ITERATIONS": bool(self.extra_attachments)}
+        make = self._ray_cast_plan if opts.slicing == "raycast" else self._slices_plan
+        return make(defines, uniforms, name="visual hull" if rep.hull else "depth object",
+                    textures=_textures(images))
 
-    def _cube_proxy(self) -> None:
-        """The object's box (its `bounds`, inside the cube), not the whole cube: views hug
-        the bounds with their near and far planes, which would clip the cube's corners."""
-        from ...render.proxy import box_planes, convex_proxy
-
-        cube = self.rep.images.cube_to_world
-        lo, hi = self.rep.bounds
+    def _ray_cast_plan(self, defines: dict, uniforms: dict, **shared) -> DrawPlan:
+        """The object's box (its `bounds`), not the whole cube: views hug the bounds with
+        their near and far planes, which would clip the cube's corners."""
+        rep = self.rep
+        lo, hi = rep.bounds
         box = np.diag([*(hi - lo), 1.0])
         box[:3, 3] = lo
-        self.proxy = convex_proxy(box_planes(np.linalg.inv(box)), near=0.5 * (lo + hi))
-        corners = self.proxy.world_positions
-        cube_coords = (np.c_[corners, np.ones(len(corners))] @ np.linalg.inv(cube).T)[:, :3]
-        self._geometry(self.proxy.positions, cube_coords, self.proxy.triangles, self.proxy.origin)
+        proxy, cube = _box_proxy(box, rep.images.cube_to_world, 0.5 * (lo + hi))
+        return DrawPlan(
+            program=Program(PROGRAM, defines | {"RAYCAST": True}),
+            geometry=_geometry(proxy.positions, cube, proxy.triangles),
+            uniforms=uniforms | {"u_visible_depth": visible_depth(rep.resolution)},
+            raster=Raster(depth_func="<=", depth_clamp=True, cull="back"),
+            origin=tuple(float(x) for x in proxy.origin),
+            per_view=ViewHook(f"{__name__}:ray_cast_view", {
+                "cube_to_world": rep.images.cube_to_world, "planes": proxy.planes,
+                "texturing": self.options.texturing}), **shared)
 
-    def _geometry(self, positions, cube_coords, triangles, origin) -> None:
-        """(Re)upload the vertex and index buffers; positions float32 relative to origin."""
-        for vao in self.vaos.values():
-            vao.release()
-        for buf in (self.vbo, self.ibo):
-            if buf is not None:
-                buf.release()
-        self.vaos = {}
-        self.vbo = self.ibo = None
-        data = np.concatenate([np.asarray(positions, np.float32),
-                               np.asarray(cube_coords, np.float32)], axis=1)
-        self.vbo = self.ctx.buffer(data.astype(np.float32).tobytes())
-        self.ibo = self.ctx.buffer(np.asarray(triangles, np.uint32).tobytes())
-        self.geometry_origin = np.asarray(origin, np.float64)
-        for name, prog in self.programs.items():
-            self.vaos[name] = self.ctx.vertex_array(
-                prog, [(self.vbo, "3f 3f", "in_position", "in_cube")], self.ibo,
-                index_element_size=4)
-
-    def release(self) -> None:
-        for vao in getattr(self, "vaos", {}).values():
-            vao.release()
-        self.vaos = {}
-        for name in ("vbo", "ibo"):
-            buf = getattr(self, name, None)
-            if buf is not None:
-                buf.release()
-            setattr(self, name, None)
-        super().release()
-
-    # -- per frame ------------------------------------------------------------------------
-    def slice_stack(self, camera):
-        """The slices of this frame (slices.py), nearest first."""
-        images, opts = self.rep.images, self.options
-        cube = images.cube_to_world
-        if opts.slicing == "orthogonal":
-            thickness = images.side
-        else:
-            from .slices import view_direction
-
-            f = view_direction(camera, self.centre)
-            thickness = images.side * float(np.abs(f).sum())  # the cube's extent along f
-        count = opts.slices or auto_slice_count(thickness, camera, self.centre,
-                                                images.texel * FINEST_TEXELS)
-        make = orthogonal_slices if opts.slicing == "orthogonal" else screen_slices
-        return make(cube, camera, count)
-
-    def _uniforms(self, camera, light) -> dict:
-        return (camera_uniforms(camera) | box_uniforms(camera, self.rep.images.cube_to_world)
-                | light.uniforms() | {
-                    "u_res": self.rep.resolution, "u_face_normal": _face_normals(),
-                    "u_depth": _DEPTH_UNIT, "u_color": _COLOR_UNIT, "u_normals": _NORMAL_UNIT,
-                    "u_max_steps": 3 * self.rep.resolution + 3,
-                    "u_check_visibility": self.options.visibility})
-
-    def _bind(self, camera, light, extra: dict | None = None) -> None:
-        self.depth_tex.use(_DEPTH_UNIT)
-        self.color_tex.use(_COLOR_UNIT)
-        self.normal_tex.use(_NORMAL_UNIT)
-        values = self._uniforms(camera, light) | model_offset(camera, self.geometry_origin) | \
-            (extra or {})
-        for prog in self.programs.values():
-            set_uniforms(prog, values)
-            _mat4_array(prog, "u_cube_to_face", self.cube_to_face)
-
-    def draw(self, camera, light) -> None:
-        import moderngl
-
-        opts = self.options
-        if opts.slicing == "raycast":
-            from ...render.proxy import cull_face, proxy_raster_state
-
-            self._bind(camera, light, {"u_visible_depth": self._visible_depth(None)})
-            with proxy_raster_state(self.ctx):
-                self.ctx.cull_face = cull_face(self.proxy, camera)
-                self.vaos["main"].render()
-            self.stats = {"slicing": "raycast", "slices": 0, "passes": "single",
-                          "texturing": opts.texturing}
-            return
-        stack = self.slice_stack(camera)
-        relative = stack.positions - self.centre
-        ordered = stack.triangles_in_order(front_to_back=True)
-        self._geometry(relative, stack.box, ordered, self.centre)
-        self._bind(camera, light, {"u_visible_depth": self._visible_depth(stack),
-                                   "u_slice_normal": tuple(float(x) for x in stack.plane_normal),
-                                   "u_slice_spacing": stack.spacing or self.rep.images.side})
+    def _slices_plan(self, defines: dict, uniforms: dict, **shared) -> DrawPlan:
+        """The cube, which the view hook replaces by each frame's slices; the stencil
+        passes are the "stencil-count" kind, one test per tested image."""
+        rep, opts = self.rep, self.options
+        cube_to_world = rep.images.cube_to_world
+        centre = cube_to_world[:3, 3] + 0.5 * rep.images.side
+        proxy, cube = _box_proxy(cube_to_world, cube_to_world, centre)
+        multipass = None
         if opts.passes == "stencil":
-            draws = self._draw_stencil(camera, stack)
+            program = Program(PROGRAM, defines | {"COLOR_ONLY": True})
+            multipass = MultiPass("stencil-count", {
+                "test": Program(PROGRAM, defines | {"TEST_ONE": True}), "color": program,
+                "copy": Program(COPY_PROGRAM)}, {"uniform": "u_face",
+                                                 "values": rep.tested_faces})
         else:
-            self.vaos["main"].render(moderngl.TRIANGLES)
-            draws = 1
-        self.stats = {"slicing": opts.slicing, "slices": stack.slice_count,
-                      "passes": opts.passes, "texturing": opts.texturing, "draws": draws,
-                      "alpha_test": self.alpha_test,
-                      "slice_polygons": int(np.count_nonzero(np.diff(stack.first_triangle))),
-                      "fill_pixels": stack.area_pixels(camera)}
+            program = Program(PROGRAM, defines | {"SLAB": self.alpha_test == "slab"})
+        return DrawPlan(
+            program=program,
+            geometry=_geometry(proxy.world_positions - centre, cube, proxy.triangles),
+            uniforms=uniforms, origin=tuple(float(x) for x in centre), multipass=multipass,
+            per_view=ViewHook(f"{__name__}:slices_view", {
+                "cube_to_world": cube_to_world, "resolution": rep.resolution,
+                "slicing": opts.slicing, "slices": opts.slices, "passes": opts.passes,
+                "alpha_test": self.alpha_test, "texturing": opts.texturing}), **shared)
 
-    def _visible_depth(self, stack) -> float:
-        """How far behind image k's surface a drawn point may be and still count as seen by
-        it (cube-side units): `VISIBLE_TEXELS`, plus a slice spacing for the point test,
-        whose points lie up to that far inside the surface."""
-        slack = stack.spacing / self.rep.images.side if stack is not None and \
-            self.alpha_test == "point" else 0.0
-        return VISIBLE_TEXELS / self.rep.resolution + slack
-
-    def _draw_stencil(self, camera, stack) -> int:
-        """§4.1's algorithm into a stencil target, then copied into the frame's target."""
-        import moderngl
-
-        from ...gl import stencil as st
-        from ...gl.targets import FRAME_ATTACHMENTS
-
-        ctx = self.ctx
-        frame_fbo = ctx.fbo
-        faces = self.rep.tested_faces
-        complete = len(faces)
-        target = st.StencilTarget(ctx, camera.size, FRAME_ATTACHMENTS)
-        draws = 0
-        try:
-            target.use()
-            target.clear()
-            ctx.disable(moderngl.DEPTH_TEST)
-            first = np.concatenate([[0], np.cumsum(np.diff(stack.first_triangle)[
-                stack.front_to_back])])
-            test, color = self.vaos["test"], self.vaos["color"]
-            for k in range(stack.slice_count):
-                start, stop = int(first[k]), int(first[k + 1])
-                if stop == start:
-                    continue
-                span = {"vertices": 3 * (stop - start), "first": 3 * start}
-                for i, face in enumerate(faces):
-                    target.stencil(st.EQUAL, i, st.INCR, color=False)
-                    self.programs["test"]["u_face"].value = face
-                    test.render(moderngl.TRIANGLES, **span)
-                target.stencil(st.EQUAL, complete, st.INCR, color=True)
-                color.render(moderngl.TRIANGLES, **span)
-                target.stencil(st.GREATER, complete, st.ZERO, color=False)
-                color.render(moderngl.TRIANGLES, **span)
-                draws += complete + 2
-            target.end()
-            frame_fbo.use()
-            ctx.enable(moderngl.DEPTH_TEST)
-            for unit, tex in enumerate(target.textures):
-                tex.use(_NORMAL_UNIT + 1 + unit)
-            set_uniforms(self.copy_program, camera_uniforms(camera) | {
-                "u_src_color": _NORMAL_UNIT + 1, "u_src_position": _NORMAL_UNIT + 2,
-                "u_src_normal": _NORMAL_UNIT + 3})
-            self.copy_vao.render(moderngl.TRIANGLES, vertices=3)
-            check_gl_error(ctx, "drawing a depth object with stencil passes")
-        finally:
-            target.end()
-            frame_fbo.use()
-            ctx.enable(moderngl.DEPTH_TEST)
-            target.release()
-            frame_fbo.use()
-        return draws
-
-    def finish(self, frame) -> None:
+    def finish(self, frame, stats: dict) -> None:
         covered = int(frame.mask.sum())
-        frame.stats.update(self.stats)
-        if "fill_pixels" in self.stats:
+        frame.stats.update(stats)
+        if "fill_pixels" in stats:
             frame.stats["fill_per_covered_pixel"] = (
-                self.stats["fill_pixels"] / covered if covered else 0.0)
+                stats["fill_pixels"] / covered if covered else 0.0)
+
+
+def _textures(images) -> dict:
+    """The images as texture arrays (layer k = face k): depth (empty texels at
+    `EMPTY_DEPTH`, nearest texel), premultiplied colour and normals (linear)."""
+    premultiplied = images.color.astype(np.float32)
+    premultiplied[..., :3] *= premultiplied[..., 3:]
+    return {"u_depth": Texture(np.where(images.mask, images.depth, np.float32(EMPTY_DEPTH)),
+                               "2d_array", filter="nearest", what="depth images"),
+            "u_color": Texture(premultiplied, "2d_array", what="depth-image colours"),
+            "u_normals": Texture(images.normal.astype(np.float32, copy=False), "2d_array",
+                                 what="depth-image normals")}
+
+
+def _box_proxy(box, cube_to_world, near) -> tuple[Proxy, np.ndarray]:
+    """A box's proxy (`render.proxy`, solved around ``near``) and its corners' cube
+    coordinates."""
+    proxy = convex_proxy(box_planes(np.linalg.inv(box)), near=near)
+    corners = proxy.world_positions
+    return proxy, (np.c_[corners, np.ones(len(corners))] @ np.linalg.inv(cube_to_world).T)[:, :3]
+
+
+def _vertices(positions, cube) -> dict:
+    """The shader's ``in_position`` (float32, relative to the plan's origin) and
+    ``in_cube`` (the vertices' cube coordinates)."""
+    return {"in_position": np.asarray(positions, np.float32),
+            "in_cube": np.asarray(cube, np.float32)}
+
+
+def _geometry(positions, cube, triangles) -> Geometry:
+    return Geometry({name: Attribute(a) for name, a in _vertices(positions, cube).items()},
+                    indices=np.asarray(triangles, np.uint32))
+
+
+def visible_depth(resolution: int, slack: float = 0.0) -> float:
+    """How far behind image k's surface a drawn point may be and still count as seen by it
+    (cube-side units): `VISIBLE_TEXELS`, plus ``slack`` (a slice spacing for the point
+    test, whose points lie up to that far inside the surface)."""
+    return VISIBLE_TEXELS / resolution + slack
+
+
+def slice_stack(cube_to_world, resolution: int, slicing: str, slices: int | None, camera):
+    """The slices of the cube for ``camera`` (slices.py), nearest first: ``slices`` of
+    them, or automatically one per pixel of the cube on screen, never closer than
+    `FINEST_TEXELS`."""
+    side = float(np.linalg.norm(cube_to_world[:3, 0]))
+    centre = cube_to_world[:3, 3] + 0.5 * side
+    if slicing == "orthogonal":
+        thickness = side
+    else:
+        f = view_direction(camera, centre)
+        thickness = side * float(np.abs(f).sum())  # the cube's extent along f
+    count = slices or auto_slice_count(thickness, camera, centre,
+                                       side / resolution * FINEST_TEXELS)
+    make = orthogonal_slices if slicing == "orthogonal" else screen_slices
+    return make(cube_to_world, camera, count)
+
+
+def ray_cast_view(plan, camera, light, *, cube_to_world, planes, texturing) -> ViewUpdate:
+    """View hook of ray casting: the box's uniforms and the proxy's faces to cull."""
+    geometry = plan.geometry
+    proxy = Proxy(geometry.attributes["in_position"].array, geometry.indices, planes,
+                  np.asarray(plan.origin, np.float64))
+    return ViewUpdate(uniforms=box_uniforms(camera, cube_to_world),
+                      cull=cull_face(proxy, camera),
+                      stats={"slicing": "raycast", "slices": 0, "passes": "single",
+                             "texturing": texturing})
+
+
+def slices_view(plan, camera, light, *, cube_to_world, resolution, slicing, slices, passes,
+                alpha_test, texturing) -> ViewUpdate:
+    """View hook of slicing: this frame's slice stack as the vertex and index arrays,
+    nearest slice first; for the stencil passes each slice's index range."""
+    stack = slice_stack(cube_to_world, resolution, slicing, slices, camera)
+    side = float(np.linalg.norm(cube_to_world[:3, 0]))
+    slack = stack.spacing / side if alpha_test == "point" else 0.0
+    stats = {"slicing": slicing, "slices": stack.slice_count, "passes": passes,
+             "texturing": texturing, "alpha_test": alpha_test,
+             "slice_polygons": int(np.count_nonzero(np.diff(stack.first_triangle))),
+             "fill_pixels": stack.area_pixels(camera)}
+    params = {}
+    if passes == "stencil":
+        sizes = np.diff(stack.first_triangle)[stack.front_to_back]  # triangles, draw order
+        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        drawn = sizes > 0
+        params["ranges"] = 3 * np.stack([starts[drawn], sizes[drawn]], axis=1)
+    else:
+        stats["draws"] = 1
+    return ViewUpdate(
+        uniforms=box_uniforms(camera, cube_to_world) | {
+            "u_visible_depth": visible_depth(resolution, slack),
+            "u_slice_normal": tuple(float(x) for x in stack.plane_normal),
+            "u_slice_spacing": stack.spacing or side},
+        attributes=_vertices(stack.positions - np.asarray(plan.origin, np.float64),
+                             stack.box),
+        indices=np.asarray(stack.triangles_in_order(front_to_back=True), np.uint32),
+        params=params, stats=stats)
 
 
 def drawable_spec() -> DrawableSpec:
-    return DrawableSpec(DepthObject, DepthObjectDrawable, DepthObjectRenderOptions)
+    return DrawableSpec(DepthObject, DepthObjectDrawable, DepthObjectRenderOptions,
+                        planned=True)
 
 
 __all__ = ["DepthObjectDrawable", "DepthObjectRenderOptions", "PROGRAMS", "drawable_spec"]
