@@ -1,6 +1,7 @@
 """Shader loader: namespaces, includes with #line, define variants, compile errors naming file
 and line, a bounded per-context cache, GLSL ES portability and the wheel's package data."""
 
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -162,8 +163,14 @@ def test_wheel_contains_every_shader(tmp_path):
     package = root / "src" / "reliefkit"
     expected = {str(p.relative_to(package.parent)) for p in package.rglob("*.glsl")}
     assert len(expected) >= 8
+    # from a copy: a build/ folder left in the checkout would ship files since deleted
+    copy = tmp_path / "source"
+    shutil.copytree(root / "src", copy / "src",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy(root / name, copy / name)
     out = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps",
-                          "--no-build-isolation", "-q", "-w", str(tmp_path), str(root)],
+                          "--no-build-isolation", "-q", "-w", str(tmp_path), str(copy)],
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     (wheel,) = tmp_path.glob("reliefkit-*.whl")
