@@ -47,7 +47,7 @@ def _markdown(data: dict) -> str:
              "|---|---|---|---|---|---|"]
     for row in rows:
         met = "" if row["ratio"] <= TARGET else " (over target)"
-        lines.append(f"| {row['tile']} | {row['kind']} | {row['separate']:.3f} | "
+        lines.append(f"| {row["name"]} | {row['kind']} | {row['separate']:.3f} | "
                      f"{row['one_call']:.3f} | {row['ratio']:.2f}{met} | "
                      f"{'yes' if row['identical'] else 'NO'} |")
     lines += ["", f"Target: one call <= {TARGET} x the separate calls' time. "
@@ -72,5 +72,5 @@ def _measure(tile, views: int) -> dict:
     identical = all(np.array_equal(a.color, b.color) and np.array_equal(a.depth, b.depth)
                     for a, b in zip(separate, together, strict=True))
     best_separate, best_one = min(separate_times), min(one_call_times)
-    return {"tile": tile.title, "kind": type(obj).__name__, "separate": best_separate,
+    return {"name": tile.title, "kind": type(obj).__name__, "separate": best_separate,
             "one_call": best_one, "ratio": best_one / best_separate, "identical": identical}
