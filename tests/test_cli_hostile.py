@@ -17,6 +17,7 @@ import pytest
 from helpers import assert_one_line_error, run_cli
 
 from reliefkit import cli
+from reliefkit.builtins import registry
 
 
 @pytest.fixture(scope="module")
@@ -200,10 +201,10 @@ def test_info_says_ok_only_for_files_render_loads(gl, small_rk, tmp_path):
     report = json.loads(run_cli("info", "--json", small_rk).stdout)["file"]
     assert report["checksums"] == report["valid"] == "ok"
     # a forged file whose checksums are right but whose representation is invalid
-    from reliefkit.io.rk import _codec_for_object, load, write_rk
+    from reliefkit.io.rk import load, write_rk
 
     rep = load(small_rk)
-    codec = _codec_for_object(rep)
+    codec = registry().codecs().for_object(rep)
     arrays, params = codec.to_arrays(rep)
     arrays = dict(arrays)
     arrays["box_to_world"] = (np.diag([1e300] * 3 + [1.0]) @ arrays["box_to_world"]).astype(

@@ -33,12 +33,12 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     ``references``: see `mesh_references`).
     """
     from . import metrics
-    from .core.technique import technique_of
+    from .builtins import registry
     from .errors import UsageError
     from .io.rk import array_bytes
     from .render import render
 
-    tech = technique_of(representation)
+    tech = registry().technique_of(representation)
     if tech is None or not tech.compare_variants:
         raise UsageError(f"nothing to compare: {type(representation).__name__} declares no "
                          "compare variants")

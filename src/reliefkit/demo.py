@@ -33,10 +33,10 @@ def mesh_tiles() -> list[DemoTile]:
 
 def demo_tiles() -> list[DemoTile]:
     """Every tile of the sheet: the meshes, then each registered technique's tiles."""
-    from .core.technique import techniques
+    from .builtins import registry
 
     tiles = mesh_tiles()
-    for tech in techniques():
+    for tech in registry().techniques():
         if tech.demo_tiles is not None:
             tiles += tech.demo_tiles()
     return tiles

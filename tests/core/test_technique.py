@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from helpers import toy_technique
 
+from reliefkit.builtins import registry
 from reliefkit.core import params
 from reliefkit.core.params import param
 from reliefkit.core.technique import (
@@ -17,7 +18,6 @@ from reliefkit.core.technique import (
     Technique,
     bakers,
     bench_suites,
-    load_all,
     register,
     technique,
     technique_of,
@@ -26,16 +26,19 @@ from reliefkit.errors import UsageError
 from reliefkit.io import rk
 from reliefkit.scene.assets import make_asset
 
-FRESH = ("from reliefkit.io.rk import registered_kinds; "
+FRESH = ("import sys, reliefkit as rk; from reliefkit.io.rk import registered_kinds; "
          "from reliefkit.core.technique import techniques; "
+         "path = rk.save(sys.argv[1], rk.load_mesh('demo:blob')); "
+         "print(type(rk.load(path)).__name__); "
          "print(','.join(registered_kinds())); print(','.join(t.name for t in techniques()))")
 
 
-def test_registered_kinds_are_right_in_a_fresh_process():
-    out = subprocess.run([sys.executable, "-c", FRESH], capture_output=True, text=True,
-                         timeout=120)
+def test_the_public_api_registers_the_builtins_in_a_fresh_process(tmp_path):
+    out = subprocess.run([sys.executable, "-c", FRESH, str(tmp_path / "m.rk")],
+                         capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
-    kinds, names = out.stdout.split()
+    loaded, kinds, names = out.stdout.split()
+    assert loaded == "RenderMesh"
     import reliefkit.techniques as builtin
 
     expected = {"mesh"} | {k for t in builtin.TECHNIQUES for k in t.kinds}
@@ -43,9 +46,9 @@ def test_registered_kinds_are_right_in_a_fresh_process():
     assert names.split(",") == [t.name for t in builtin.TECHNIQUES]
 
 
-def test_load_all_is_idempotent():
-    first = load_all()
-    assert load_all() == first and len({t.name for t in first}) == len(first)
+def test_the_builtins_are_registered_once():
+    first = registry().techniques()
+    assert registry().techniques() == first and len({t.name for t in first}) == len(first)
 
 
 def test_duplicates_are_refused():
@@ -60,7 +63,7 @@ def test_duplicates_are_refused():
                                       representations=(), drawables=())
     with pytest.raises(UsageError, match="baker 'relief' is already registered"):
         register(taken_baker)
-    assert "copycat" not in {t.name for t in load_all()}
+    assert "copycat" not in {t.name for t in registry().techniques()}
     assert "copycat" not in rk.registered_kinds()
 
 

@@ -40,12 +40,13 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
 
 def suites() -> dict:
     """Every suite by name: the core's, then each technique's (`core.technique.BenchSuite`)."""
-    from ..core.technique import BenchSuite, bench_suites
+    from ..builtins import registry
+    from ..core.technique import BenchSuite
     from . import loading
 
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
                                   loading.run_suite, takes_mesh=True)}
-    return core | {name: suite for name, (_, suite) in bench_suites().items()}
+    return core | {s.name: s for t in registry().techniques() for s in t.bench_suites}
 
 
 def suite_names() -> tuple[str, ...]:

@@ -132,8 +132,10 @@ def _command(sub, name: str, summary: str, description: str):
 
 def build_parser() -> argparse.ArgumentParser:
     from ..bench import suite_names, suites
+    from ..builtins import registry
     from ..core.technique import bakers, techniques
-    from ..render.registry import core_drawables
+
+    core_drawables = registry().core_drawables
 
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
                      epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)

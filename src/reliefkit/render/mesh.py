@@ -22,7 +22,6 @@ from ..gl.textures import texture2d
 from ..gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from ..scene.light import DirectionalLight
 from ..scene.mesh import Material, RenderMesh
-from .registry import register_core_drawable
 from .shadows import SHADOW_UNIT, render_shadow_map
 
 PROGRAM = "core:mesh.glsl"
@@ -166,8 +165,5 @@ def material_uniforms(material: Material) -> dict:
             "u_alpha_cutoff": float(material.alpha_cutoff)}
 
 
-def _register() -> None:
-    register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions))
-
-
-_register()
+#: The core's ground-truth drawable; the composition root (`reliefkit.builtins`) registers it.
+MESH_DRAWABLE = DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions)
