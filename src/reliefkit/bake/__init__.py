@@ -26,11 +26,4 @@ def bake(source, kind: str, *, progress=None, **params):
     return chosen.bake(source, values, progress)
 
 
-def bake_kinds() -> tuple[str, ...]:
-    """The ``--as`` names of every registered baker."""
-    from ..core.technique import bakers
-
-    return tuple(bakers())
-
-
-__all__ = ["bake", "bake_kinds"]
+__all__ = ["bake"]

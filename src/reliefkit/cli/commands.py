@@ -328,8 +328,6 @@ def cmd_compare(args) -> int:
 
     check_writable(args.out, "--out", folder=True)
     mesh = _bake_source(args.input, "compare")
-    if not hasattr(mesh, "triangle_count"):
-        raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not a heightmap")
     rep = _bake_input(args, mesh)
     camera = orbit_bounds(mesh.bounds, az, el, dist, size, args.fov)
     result = _compare_with_progress(mesh, rep, camera, light)

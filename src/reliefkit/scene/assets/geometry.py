@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from ...errors import UsageError
 from ..mesh import RenderMesh
@@ -195,6 +194,7 @@ def lathe(base, axis, profile, segments: int) -> Geometry:
 
 def _hull(points) -> Geometry:
     """Flat-shaded convex hull of `points`, outward-facing, one vertex per triangle corner."""
+    from scipy.spatial import ConvexHull  # scipy: slow to import
     points = np.asarray(points, dtype=np.float64)
     hull = ConvexHull(points)
     tri = hull.simplices.copy()

@@ -16,7 +16,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from ...errors import UsageError
 from ..mesh import RenderMesh, vertex_normals
@@ -299,6 +298,7 @@ def vase(segments: int = 32, rings: int = 24) -> RenderMesh:
     length: u goes around (seam at -z), v along the profile's arc length from 0 at the
     bottom centre (one pole vertex) to 1 at the lip. Normals come from the spline's tangent.
     """
+    from scipy.interpolate import CubicSpline  # scipy: slow to import
     segments = _check_count("segments", segments, 3)
     rings = _check_count("rings", rings, 2)
     chord = np.linalg.norm(np.diff(VASE_PROFILE, axis=0), axis=1)

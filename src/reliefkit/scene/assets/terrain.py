@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
 
 from ..mesh import RenderMesh, vertex_normals
 from .colors import mix, rgb, smoothstep
@@ -24,6 +23,7 @@ def _fbm(
     Octave k interpolates a random lattice of ``cells * 2**k`` cells with cubic splines; the
     random draws do not depend on the sampling, so every resolution samples the same noise.
     """
+    from scipy import ndimage  # scipy: slow to import
     total = np.zeros(np.shape(u))
     amplitude, norm = 1.0, 0.0
     for k in range(octaves):

@@ -16,7 +16,6 @@ Tevs et al. do for dynamic heightfields, and falls back to the CPU below OpenGL 
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import maximum_filter
 
 from ...gl.context import check_gl_error
 from ...gl.shaders import program
@@ -28,6 +27,8 @@ GROUP = 8  # the compute pass's work group is GROUP x GROUP nodes
 
 def max_pyramid(height: np.ndarray) -> list[np.ndarray]:
     """[level 0 (P, P), ..., (1, 1)] float32, P the power of two >= the field's sides."""
+    from scipy.ndimage import maximum_filter  # scipy: slow to import
+
     h = np.asarray(height, dtype=np.float32)
     base = maximum_filter(h, size=3, mode="nearest")
     side = pyramid_side(h.shape)

@@ -20,7 +20,6 @@ from ...render.proxy import (
     cull_face,
     proxy_raster_state,
 )
-from .cone import relaxed_cone_ratios
 from .maxmip import max_pyramid_texture
 from .representation import ReliefObject, ReliefTexture
 
@@ -132,6 +131,8 @@ class ReliefDrawable:
                 self.textures["u_height_safety"] = texture2d(ctx, packed, what="height and safety",
                                                              filter="nearest")
             if self.method == "cone":
+                from .cone import relaxed_cone_ratios  # numba: slow to import
+
                 self.textures["u_cone"] = texture2d(ctx, relaxed_cone_ratios(relief.height),
                                                     what="cone ratios", filter="nearest")
             if self.method == "maxmip":

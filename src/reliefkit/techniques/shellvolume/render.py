@@ -33,8 +33,8 @@ from ...gl.textures import read_depth, read_rgba, texture2d, texture3d, texture_
 from ...gl.uniforms import camera_uniforms, model_offset, set_uniforms
 from ...render.shadows import light_camera
 from .filtering import mip_pyramid, naive_pyramid
-from .order import METHODS, visibility_order
 from .representation import TET_TEXELS, TETS_PER_ROW, TexturedShell
+from .sorts import METHODS
 from .textures import density_floor, density_normals, marched_volume
 
 PROGRAM = "shellvolume:shell.glsl"
@@ -247,6 +247,8 @@ class TexturedShellDrawable(GLObjects):
         ctx = self.ctx
         start = time.perf_counter()
         if self.transparent and not self.peel:
+            from .order import visibility_order  # numba: slow to import
+
             # the A-buffer samples the frame's own pixel rays: the order is exact on them
             order = visibility_order(self.shell, camera, method=self.options.sort,
                                      resolution=max(camera.size))

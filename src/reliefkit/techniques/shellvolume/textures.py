@@ -27,7 +27,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import ndimage
 
 from ...errors import FormatError, UsageError
 from ...io.npy import npy_header
@@ -181,6 +180,7 @@ def _check_size(size):
 
 def _noise(rng, shape, sigma, wrap_w=False):
     """Smooth noise in [0,1]: Gaussian-filtered white noise, wrapped in u and v."""
+    from scipy import ndimage  # scipy: slow to import
     field = rng.random(shape)
     modes = ["wrap"] * field.ndim
     if field.ndim == 3 and not wrap_w:
