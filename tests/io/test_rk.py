@@ -855,7 +855,7 @@ def test_codec_table_refuses_conflicts_and_bad_specs():
         with_kinds(Codec("bad", dict, {"a": ArraySpec(("O",), 1)}, None, None))
     with pytest.raises(FormatError, match="invalid kind"):
         with_kinds(Codec("Bad Kind", dict, {}, None, None))
-    assert "mesh" in formats.registered_kinds() and "bad" not in formats.registered_kinds()
+    assert "mesh" in registry().codecs().kinds and "bad" not in registry().codecs().kinds
 
 
 # ------------------------------------------------------------------------ atomic writes

@@ -22,7 +22,6 @@ __all__ = [
     "Baker", "BenchSuite", "CompareMetric", "CompareVariant", "DemoTile", "DrawableSpec",
     "ProgramVariant", "REGISTRY", "Registry", "Technique", "register", "unregister",
     "techniques", "technique", "technique_of", "baker", "bakers", "drawable_spec",
-    "bench_suites", "registered_kinds",
 ]
 
 #: The core's shader namespace and the package whose ``shaders/`` folder it is.
@@ -345,11 +344,3 @@ def baker(name: str) -> tuple[Technique, Baker]:
                          f"{', '.join(table) or 'none'})")
     return table[name]
 
-
-def bench_suites() -> dict[str, tuple[Technique, BenchSuite]]:
-    return {s.name: (t, s) for t in REGISTRY.techniques() for s in t.bench_suites}
-
-
-def registered_kinds() -> tuple[str, ...]:
-    """Every .rk kind this process reads and writes."""
-    return REGISTRY.codecs().kinds

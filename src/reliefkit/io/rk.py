@@ -42,7 +42,7 @@ from ..errors import FormatError, ReliefkitError
 from .atomic import atomic_path
 
 __all__ = [
-    "ArraySpec", "Codec", "CodecTable", "RkFile", "use_codecs", "registered_kinds",
+    "ArraySpec", "Codec", "CodecTable", "RkFile", "use_codecs",
     "save", "load", "read_manifest", "write_rk", "read_rk", "file_sha256", "array_bytes",
     "FORMAT_NAME", "FORMAT_VERSION", "DEFAULT_MAX_BYTES",
 ]
@@ -212,11 +212,6 @@ def use_codecs(table: Callable[[], CodecTable]) -> None:
 
 def _table(codecs: CodecTable | None) -> CodecTable:
     return codecs if codecs is not None else _codec_table()
-
-
-def registered_kinds(codecs: CodecTable | None = None) -> tuple[str, ...]:
-    """The kinds this process can read and write, sorted."""
-    return _table(codecs).kinds
 
 
 def _check_spec(kind: str, name: str, spec: ArraySpec) -> None:

@@ -4,7 +4,7 @@ surfaces.
 The surfaces (`SURFACE_NAMES`, from :mod:`.surfaces`: a sphere, a dented sphere, a torus, two
 spheres, a plane, a tube, a vase and the Utah teapot) carry texture coordinates and smooth
 normals for techniques that need (u, v); `make_asset` builds them by name too, while
-`ASSET_NAMES` and `all_assets` keep to the four assets (the cup, `SHAPE_NAMES`, is a
+`ASSET_NAMES` keeps to the four assets (the cup, `SHAPE_NAMES`, is a
 test shape for the depth objects).
 
 Every asset is deterministic for a given seed (``np.random.default_rng(seed)``), built with
@@ -37,7 +37,6 @@ __all__ = [
     "DEMO_NAMES",
     "SHAPE_NAMES",
     "SURFACE_NAMES",
-    "all_assets",
     "blob",
     "cup",
     "make_asset",
@@ -48,7 +47,7 @@ __all__ = [
 ]
 
 ASSET_NAMES = ("terrain", "blob", "tree", "vehicle")
-#: Further shapes `make_asset` knows that are not in the demo set (`all_assets`).
+#: Further shapes `make_asset` knows that are not in the demo set (`ASSET_NAMES`).
 SHAPE_NAMES = ("cup",)
 
 #: The textured demo surfaces `make_asset` also knows (see :mod:`.surfaces`).
@@ -82,7 +81,3 @@ def make_asset(name: str) -> RenderMesh:
                          f"or a surface: {', '.join(SURFACE_NAMES)}")
     return factory()
 
-
-def all_assets() -> dict[str, RenderMesh]:
-    """Every demo asset with its default parameters, keyed by name (`ASSET_NAMES` order)."""
-    return {name: make_asset(name) for name in ASSET_NAMES}
