@@ -136,7 +136,7 @@ def test_a_read_only_folder_is_refused_before_rendering(tmp_path, monkeypatch, c
     real_access = os.access
     monkeypatch.setattr(os, "access", lambda p, mode: False if Path(p) == locked
                         else real_access(p, mode))
-    monkeypatch.setattr("reliefkit.io.inputs.load_input",
+    monkeypatch.setattr("reliefkit.cli.commands.load_input",
                         lambda spec: pytest.fail("the input was loaded"))
     status = cli.main(["render", "demo:blob", "-o", str(tmp_path / "x.png"), "--aovs",
                        str(locked / "a.npz")])
@@ -252,7 +252,7 @@ def warned_mesh(monkeypatch):
     mesh = make_asset("blob")
     mesh.extra["warnings"] = ["model.mtl is missing: the default material is used",
                               "texture a.png cannot be read\n(truncated): material colour"]
-    monkeypatch.setattr("reliefkit.io.inputs.load_input", lambda spec: mesh)
+    monkeypatch.setattr("reliefkit.cli.commands.load_input", lambda spec: mesh)
     return mesh
 
 
@@ -356,7 +356,7 @@ def test_an_interrupt_a_library_swallows_or_wraps_still_stops_the_command(
     import importlib
     import signal
 
-    bake_module = importlib.import_module("reliefkit.bake")
+    bake_module = importlib.import_module("reliefkit.cli.commands")  # where the CLI finds bake
     real_bake = bake_module.bake
 
     def bake_inside_a_library(*args, **kwargs):

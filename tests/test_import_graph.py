@@ -26,7 +26,9 @@ def import_graph(package: Path) -> dict[str, set[str]]:
 
     ``from .a import b`` points at ``a.b`` when that is a module, else at ``a``; ``import
     a.b`` at ``a.b``; ``importlib.import_module("a.b")`` (a constant name) at ``a.b`` too.
-    Imports of other distributions are left out.
+    Importing ``a.b`` runs the package ``a`` first: it is a target too, unless it is a
+    package of the importer's own (already running). Imports of other distributions are
+    left out.
     """
     names = module_names(package)
     graph = {}
@@ -44,7 +46,10 @@ def import_graph(package: Path) -> dict[str, set[str]]:
                 targets |= subs | ({source} if named or not subs else set())
             elif _imports_by_name(node):
                 targets.add(node.args[0].value)
-        graph[name] = {t for t in targets if t in names and t != name}
+        own = {".".join(here[:i]) for i in range(1, len(here) + 1)}
+        parents = {".".join(t.split(".")[:i]) for t in targets
+                   for i in range(1, t.count(".") + 1)}
+        graph[name] = {t for t in targets | (parents - own) if t in names and t != name}
     return graph
 
 
@@ -129,13 +134,18 @@ def test_a_planted_cycle_is_found(tmp_path):
     (pkg / "low" / "table.py").write_text("def f():\n    from ..high import root\n")
     (pkg / "high.py").write_text("from . import low\nfrom .low import table\n")
     (pkg / "root.py").write_text("import pkg.low.table\n")
-    (pkg / "alone.py").write_text("from .low import table\n")
     (pkg / "plugins.py").write_text("import importlib\n\ndef load():\n"
                                     "    return importlib.import_module('pkg.alone')\n")
+    (pkg / "tools").mkdir()  # a second circle, through a package's __init__
+    (pkg / "tools" / "__init__.py").write_text("from ..plugins import load\n")
+    (pkg / "tools" / "report.py").write_text("")
+    (pkg / "alone.py").write_text("from .low import table\nfrom .tools import report\n")
     graph = import_graph(pkg)
     assert graph["pkg.high"] == {"pkg.low", "pkg.low.table"}  # `from . import low`: the module
     assert graph["pkg.low.table"] == {"pkg.high"}  # inside a function, an attribute of a module
     assert graph["pkg.plugins"] == {"pkg.alone"}  # by a constant name
-    assert cycles(graph) == [["pkg.high", "pkg.low.table"]]
+    assert graph["pkg.alone"] == {"pkg.low", "pkg.low.table", "pkg.tools", "pkg.tools.report"}
+    assert cycles(graph) == [["pkg.alone", "pkg.plugins", "pkg.tools"],
+                             ["pkg.high", "pkg.low.table"]]
     assert a_circle(graph, ["pkg.high", "pkg.low.table"]) == ["pkg.high", "pkg.low.table",
                                                             "pkg.high"]

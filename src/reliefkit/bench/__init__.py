@@ -2,12 +2,18 @@
 core's own (`loading`: the memory of loading meshes).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
-`timing` has the shared frame-timing helper.
+`timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
+so this package sits below the composition root: its caller (the CLI) fills the registry.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+
+from ..core.technique import REGISTRY, BenchSuite
+from ..errors import UsageError
+from ..progress import activity
+from . import loading
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -18,9 +24,6 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
     Without ``log`` the suite's step messages are its progress (`reliefkit.progress.activity`:
     ``bench NAME: ...`` lines on stderr, a spinner on a terminal).
     """
-    from ..errors import UsageError
-    from ..progress import activity
-
     table = suites()
     if name not in table:
         raise UsageError(f"unknown benchmark {name!r} (choose from {', '.join(table)})")
@@ -40,13 +43,9 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
 
 def suites() -> dict:
     """Every suite by name: the core's, then each technique's (`core.technique.BenchSuite`)."""
-    from ..builtins import registry
-    from ..core.technique import BenchSuite
-    from . import loading
-
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
                                   loading.run_suite, takes_mesh=True)}
-    return core | {s.name: s for t in registry().techniques() for s in t.bench_suites}
+    return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 
 def suite_names() -> tuple[str, ...]:

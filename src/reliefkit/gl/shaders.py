@@ -31,6 +31,7 @@ from functools import cache
 from importlib import resources
 
 from ..errors import GPUError
+from .targets import FRAME_ATTACHMENTS
 
 STAGES = ("VERTEX_SHADER", "GEOMETRY_SHADER", "FRAGMENT_SHADER", "COMPUTE_SHADER")
 DEFAULT_VERSION = "330 core"
@@ -142,8 +143,6 @@ def _define_lines(defines: dict) -> list[str]:
 
 def stage_sources(name: str, defines: dict | None = None, *, es: bool = False) -> dict[str, str]:
     """Full source per stage present in the file, keyed by moderngl's argument names."""
-    from .targets import FRAME_ATTACHMENTS
-
     name = qualify(name)
     defines = dict(defines or {})
     unknown = set(defines) - allowed_defines(name)

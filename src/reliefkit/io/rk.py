@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy
 
+from .. import __version__
 from ..errors import FormatError, ReliefkitError
 from .atomic import atomic_path
 
@@ -363,7 +364,6 @@ def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
         _check_source_hash(source_hash)
     except FormatError as exc:
         raise FormatError(f"cannot write {path}: {exc}") from None
-    from .. import __version__
 
     head = {"format": FORMAT_NAME, "format_version": FORMAT_VERSION, "kind": codec.kind,
             "kind_version": codec.version, "params": params, "source_hash": source_hash,

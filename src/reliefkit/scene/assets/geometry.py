@@ -11,7 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ...errors import UsageError
-from ..mesh import RenderMesh
+from ..mesh import RenderMesh, vertex_normals
 
 
 class Geometry(NamedTuple):
@@ -264,8 +264,6 @@ def isosurface(field: np.ndarray, half_extent: float) -> Geometry:
     [-half_extent, half_extent]^3 ([i, j, k] = x, y, z), by marching cubes: a closed,
     outward-facing surface (the grid is padded with outside values) with smooth normals."""
     from skimage.measure import marching_cubes  # heavy import, only needed here
-
-    from ..mesh import vertex_normals
 
     n = field.shape[0]
     step = 2.0 * half_extent / (n - 1)
