@@ -53,7 +53,7 @@ def _check_not_empty(spec: str) -> None:
 
 def _check_mesh_file(spec: str, flag: str) -> None:
     """A mesh file (not demo:NAME, a heightmap or an .rk) that exists, refused up front."""
-    from ..scene.loader import SUPPORTED_EXTENSIONS  # trimesh: slow to import
+    from ..io.meshes import SUPPORTED_EXTENSIONS  # trimesh: slow to import
 
     if Path(spec).suffix.lower() not in SUPPORTED_EXTENSIONS:
         raise UsageError(f"{flag} needs a mesh file ({' '.join(SUPPORTED_EXTENSIONS)}), got "

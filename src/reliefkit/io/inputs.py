@@ -26,7 +26,7 @@ def load_input(spec: str):
 
 
 def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
-    """A mesh file (see `reliefkit.scene.loader.load_mesh`), or ``demo:NAME``: the procedural
+    """A mesh file (see `reliefkit.io.meshes.load_mesh`), or ``demo:NAME``: the procedural
     asset or surface the CLI calls so (`reliefkit.scene.assets.make_asset`).
 
     `name` labels the mesh in pictures and messages (default: the file name without its
@@ -34,7 +34,7 @@ def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
     loaded or an unknown demo name.
     """
     if not _is_demo(spec):
-        from ..scene.loader import load_mesh as load_mesh_file  # trimesh: slow to import
+        from .meshes import load_mesh as load_mesh_file  # trimesh: slow to import
 
         return load_mesh_file(spec, name=name)
 

@@ -35,11 +35,11 @@ import numpy as np
 from ...bench.report import save_figure, write_report
 from ...bench.timing import time_render
 from ...gl.context import gl_info
+from ...io.meshes import load_mesh
 from ...io.rk import array_bytes
 from ...metrics import compare
 from ...render import render
 from ...scene.assets import make_asset
-from ...scene.loader import load_mesh
 from ...scene.mesh import RenderMesh, vertex_normals
 from ...scene.views import bounds_radius, orbit_bounds
 from ...units import format_bytes

@@ -18,10 +18,10 @@ from ...bench.report import machine, machine_line, save_figure, write_report
 from ...bench.timing import time_render, time_renders
 from ...gl.context import get_context
 from ...gl.textures import texture2d
+from ...io.meshes import load_mesh
 from ...io.rk import array_bytes
 from ...render import render
 from ...scene.assets import DEMO_NAMES, make_asset
-from ...scene.loader import load_mesh
 from ...scene.views import orbit_bounds
 from ...units import format_bytes
 from .bake import DEFAULT_TOLERANCE, bake_relief
