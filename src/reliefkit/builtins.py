@@ -22,8 +22,8 @@ from .core.technique import REGISTRY, Registry
 from .gl import shaders
 from .io import rk
 from .io.mesh_codec import MESH_CODEC
+from .render import render as _render
 from .render.mesh import MESH_DRAWABLE
-from .render.registry import render as _render
 from .techniques import TECHNIQUES
 
 __all__ = ["registry", "bake", "load", "render", "save"]
