@@ -191,10 +191,10 @@ class Registry:
             specs = (*self._core_drawables, *drawables)
             if len({s.cls for s in specs}) < len(specs):
                 raise UsageError("a core drawable is registered twice for one class")
-            table = CodecTable((*self._codecs, *codecs))
-            self._core_codecs += tuple(codecs)
+            core_codecs = (*self._core_codecs, *codecs)
+            self._codecs = _kinds(core_codecs, self._techniques.values())
+            self._core_codecs = core_codecs
             self._core_drawables = specs
-            self._codecs = table
 
     def register(self, tech: Technique) -> None:
         """Add a technique; refuses anything that another technique already claims."""
@@ -204,23 +204,21 @@ class Registry:
             if tech.name in self._techniques or tech.name == CORE_NAMESPACE:
                 raise UsageError(f"technique {tech.name!r} is already registered")
             self._refuse_duplicates(tech)
-            table = CodecTable((*self._codecs, *tech.codecs))
+            self._codecs = _kinds(self._core_codecs, (*self._techniques.values(), tech))
             self._techniques[tech.name] = tech
-            self._codecs = table
 
     def unregister(self, name: str) -> None:
         """Remove a technique and its kinds (for tests that plug in a toy technique)."""
         with self._lock:
             if self._techniques.pop(name, None) is not None:
-                self._codecs = CodecTable((*self._core_codecs,
-                                           *(c for t in self._techniques.values()
-                                             for c in t.codecs)))
+                self._codecs = _kinds(self._core_codecs, self._techniques.values())
 
     def techniques(self) -> tuple[Technique, ...]:
         return tuple(self._techniques.values())
 
     def codecs(self) -> CodecTable:
-        """Every .rk kind: the core's and the techniques' (what `reliefkit.io.rk` reads)."""
+        """Every .rk kind: the core's and the techniques' (what `reliefkit.io.rk` reads);
+        derived again whenever a technique comes or goes."""
         return self._codecs
 
     def shader_namespaces(self) -> dict[str, str]:
@@ -295,6 +293,11 @@ class Registry:
                     if first.kind != opt.kind:
                         raise UsageError(f"bake option --{opt.flag} is a {opt.kind} for baker "
                                          f"{b.name!r} but a {first.kind} elsewhere; rename one")
+
+
+def _kinds(core_codecs, techniques) -> CodecTable:
+    """The codec table of the core's kinds and the techniques' (conflicts refused)."""
+    return CodecTable((*core_codecs, *(c for t in techniques for c in t.codecs)))
 
 
 #: The one registry; `reliefkit.builtins.registry()` fills it with the built-ins.
