@@ -5,8 +5,8 @@ of ``reliefkit.techniques.TECHNIQUES`` in `reliefkit.core.technique.REGISTRY`, o
 process, and hands the tables derived from it to the layers below: the .rk reader's kinds
 (`reliefkit.io.rk.use_codecs`) and the shader loader's namespaces
 (`reliefkit.gl.shaders.use_namespaces`). Those layers never reach back up for them. Every
-entry point (the public API in ``reliefkit/__init__``, the CLI, compare, the demo) calls
-`registry()` before it looks anything up; the benches run from the CLI.
+entry point (the public API in ``reliefkit/__init__``, the CLI, compare) calls `registry()`
+before it looks anything up; the benches and the demo sheet run from the CLI.
 
 Importing this module is light: the techniques' packages declare what they offer and import
 their bakers, drawables and benches when those are called.

@@ -7,8 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .builtins import registry
-from .core.technique import DemoTile
+from .core.technique import REGISTRY, DemoTile
 from .io.atomic import atomic_path
 from .pictures import TILE_BACKGROUND, contact_sheet, save_image
 from .progress import progress_bar
@@ -35,9 +34,11 @@ def mesh_tiles() -> list[DemoTile]:
 
 
 def demo_tiles() -> list[DemoTile]:
-    """Every tile of the sheet: the meshes, then each registered technique's tiles."""
+    """Every tile of the sheet: the meshes, then each registered technique's tiles (the
+    CLI fills the registry; benches draw these tiles too, so this module sits below the
+    composition root)."""
     tiles = mesh_tiles()
-    for tech in registry().techniques():
+    for tech in REGISTRY.techniques():
         if tech.demo_tiles is not None:
             tiles += tech.demo_tiles()
     return tiles
