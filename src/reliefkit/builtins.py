@@ -8,8 +8,9 @@ process, and hands the tables derived from it to the layers below: the .rk reade
 entry point (the public API in ``reliefkit/__init__``, the CLI, compare) calls `registry()`
 before it looks anything up; the benches and the demo sheet run from the CLI.
 
-Importing this module is light: the techniques' packages declare what they offer and import
-their bakers, drawables and benches when those are called.
+Importing this module is light: it loads none of numba, scipy or trimesh. The techniques
+import those where they run them, and their benches, demo tiles and references when those
+are called (`tests/test_cli_startup.py`).
 """
 
 from __future__ import annotations

@@ -51,7 +51,6 @@ _VERSION = re.compile(r"^//!\s*version:\s*(\d+)\s*$", re.M)
 _ERROR_LOC = re.compile(r"^\s*(?:ERROR:\s*)?(\d+)[:(](\d+)\)?(?:\(\d+\))?\s*:\s*(.*)$", re.M)
 
 
-
 def _core_only() -> Mapping[str, str]:
     return {"core": "reliefkit"}
 
