@@ -9,7 +9,11 @@ import sys
 import numpy as np
 import pytest
 
+from reliefkit.builtins import registry
+
 sys.path.insert(0, os.path.dirname(__file__))  # `import helpers` from any test folder
+
+registry()  # the composition root, as every public entry point runs it: tests use the layers
 
 PROBE = ("from reliefkit.gl.context import create_context; "
          "print(create_context().info['GL_RENDERER'])")

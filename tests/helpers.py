@@ -30,9 +30,8 @@ def toy_technique():
     """Plug the toy technique (tests/toy_technique) in for the duration of a test."""
     import toy_technique
 
-    from reliefkit.core.technique import load_all, register, unregister
+    from reliefkit.core.technique import register, unregister
 
-    load_all()
     register(toy_technique.TECHNIQUE)
     try:
         yield toy_technique
@@ -44,10 +43,10 @@ def technique_samples() -> list[tuple[str, str]]:
     """(technique, kind) of every sample representation: the built-ins and the toy's."""
     import toy_technique
 
-    from reliefkit.core.technique import load_all
+    from reliefkit.core.technique import techniques
 
     out = []
-    for tech in (*load_all(), toy_technique.TECHNIQUE):
+    for tech in (*techniques(), toy_technique.TECHNIQUE):
         assert tech.samples is not None, f"technique {tech.name} declares no samples"
         out += [(tech.name, kind) for kind in tech.samples()]
     return out
@@ -56,9 +55,9 @@ def technique_samples() -> list[tuple[str, str]]:
 def sample(technique_name: str, kind: str):
     import toy_technique
 
-    from reliefkit.core.technique import load_all
+    from reliefkit.core.technique import techniques
 
-    table = {t.name: t for t in (*load_all(), toy_technique.TECHNIQUE)}
+    table = {t.name: t for t in (*techniques(), toy_technique.TECHNIQUE)}
     return table[technique_name].samples()[kind]
 
 

@@ -17,6 +17,7 @@ import pytest
 from helpers import assert_one_line_error, run_cli
 
 from reliefkit import cli
+from reliefkit.builtins import registry
 
 
 @pytest.fixture(scope="module")
@@ -135,7 +136,7 @@ def test_a_read_only_folder_is_refused_before_rendering(tmp_path, monkeypatch, c
     real_access = os.access
     monkeypatch.setattr(os, "access", lambda p, mode: False if Path(p) == locked
                         else real_access(p, mode))
-    monkeypatch.setattr("reliefkit.io.inputs.load_input",
+    monkeypatch.setattr("reliefkit.cli.commands.load_input",
                         lambda spec: pytest.fail("the input was loaded"))
     status = cli.main(["render", "demo:blob", "-o", str(tmp_path / "x.png"), "--aovs",
                        str(locked / "a.npz")])
@@ -200,10 +201,10 @@ def test_info_says_ok_only_for_files_render_loads(gl, small_rk, tmp_path):
     report = json.loads(run_cli("info", "--json", small_rk).stdout)["file"]
     assert report["checksums"] == report["valid"] == "ok"
     # a forged file whose checksums are right but whose representation is invalid
-    from reliefkit.io.rk import _codec_for_object, load, write_rk
+    from reliefkit.io.rk import load, write_rk
 
     rep = load(small_rk)
-    codec = _codec_for_object(rep)
+    codec = registry().codecs().for_object(rep)
     arrays, params = codec.to_arrays(rep)
     arrays = dict(arrays)
     arrays["box_to_world"] = (np.diag([1e300] * 3 + [1.0]) @ arrays["box_to_world"]).astype(
@@ -251,7 +252,7 @@ def warned_mesh(monkeypatch):
     mesh = make_asset("blob")
     mesh.extra["warnings"] = ["model.mtl is missing: the default material is used",
                               "texture a.png cannot be read\n(truncated): material colour"]
-    monkeypatch.setattr("reliefkit.io.inputs.load_input", lambda spec: mesh)
+    monkeypatch.setattr("reliefkit.cli.commands.load_input", lambda spec: mesh)
     return mesh
 
 
@@ -355,7 +356,7 @@ def test_an_interrupt_a_library_swallows_or_wraps_still_stops_the_command(
     import importlib
     import signal
 
-    bake_module = importlib.import_module("reliefkit.bake")
+    bake_module = importlib.import_module("reliefkit.cli.commands")  # where the CLI finds bake
     real_bake = bake_module.bake
 
     def bake_inside_a_library(*args, **kwargs):

@@ -26,11 +26,11 @@ TIMING_KEYS = ("seconds", "ms", "time")
 
 
 def _samples() -> dict:
-    from reliefkit.core.technique import load_all
+    from reliefkit.builtins import registry
     from reliefkit.io.inputs import load_mesh
 
     out = {"mesh:cup": load_mesh("demo:cup")}
-    for tech in load_all():
+    for tech in registry().techniques():
         for kind, rep in tech.samples().items():
             out[f"{tech.name}:{kind}"] = rep
     return out

@@ -12,10 +12,12 @@ import sys
 import types
 
 # each public name and the module it lives in; imported on first use (PEP 562), so that
-# `import reliefkit.cli` is quick and the command line takes Ctrl-C from its first moment
+# `import reliefkit.cli` is quick and the command line takes Ctrl-C from its first moment.
+# The functions that look things up in the registry come from the composition root, which
+# registers the built-ins before their first call.
 _EXPORTS = {
-    "metrics": "", "bake": ".bake", "load": ".io.rk", "save": ".io.rk",
-    "Frame": ".render", "render": ".render", "Camera": ".scene.camera",
+    "metrics": "", **dict.fromkeys(("bake", "load", "render", "save"), ".builtins"),
+    "Frame": ".render", "Camera": ".scene.camera",
     "DirectionalLight": ".scene.light", "load_mesh": ".io.inputs",
     "RenderMesh": ".scene.mesh",
     **dict.fromkeys(("ReliefkitError", "MeshError", "FormatError", "GPUError", "UsageError"),
@@ -47,12 +49,12 @@ def __dir__() -> list[str]:
 
 
 class _Package(types.ModuleType):
-    """Importing the packages ``reliefkit.bake`` and ``reliefkit.render`` sets them as
-    attributes here; the public names ``bake`` and ``render`` stay their functions."""
+    """Importing the packages ``reliefkit.bake`` and ``reliefkit.render`` would set them as
+    attributes here; the public names ``bake`` and ``render`` stay the root's functions."""
 
     def __setattr__(self, name: str, value) -> None:
-        if isinstance(value, types.ModuleType) and _EXPORTS.get(name) == f".{name}":
-            value = getattr(value, name)
+        if isinstance(value, types.ModuleType) and _EXPORTS.get(name):
+            return  # resolved by __getattr__ on first use
         super().__setattr__(name, value)
 
 

@@ -12,8 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
+from . import metrics, strict_json
+from .builtins import registry
+from .errors import UsageError
 from .io.atomic import atomic_path, written_together
-from .pictures import TILE_BACKGROUND
+from .io.rk import array_bytes
+from .pictures import TILE_BACKGROUND, contact_sheet, save_image
+from .render import render, render_options
 from .units import format_bytes
 
 CORE_COLUMNS = ("psnr", "ssim", "iou", "position_mean_rel", "iterations_mean",
@@ -32,13 +37,7 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     variant that draws the representation as a plain render does, see `default_variant`;
     ``references``: see `mesh_references`).
     """
-    from . import metrics
-    from .core.technique import technique_of
-    from .errors import UsageError
-    from .io.rk import array_bytes
-    from .render import render
-
-    tech = technique_of(representation)
+    tech = registry().technique_of(representation)
     if tech is None or not tech.compare_variants:
         raise UsageError(f"nothing to compare: {type(representation).__name__} declares no "
                          "compare variants")
@@ -82,8 +81,6 @@ def default_variant(representation, variants) -> str:
     """The name of the first of ``variants`` whose options are the representation's render
     defaults (what the bake produced, drawn as `reliefkit render` draws it), else the first
     one's: the coverage tile shows it, not whichever variant happens to come last."""
-    from .render import render_options
-
     defaults = {opt.name: opt.default for opt in render_options(representation)}
     for variant in variants:
         if all(defaults.get(name) == value for name, value in variant.options.items()):
@@ -95,8 +92,6 @@ def mesh_references(mesh, camera, light, variants) -> dict:
     """The mesh's frame each variant is scored against, by variant name (``None``: the
     plain mesh): rendered with the variant's options that the mesh also takes (a variant
     with ``shadows`` against the mesh's shadows), each distinct set once."""
-    from .render import render, render_options
-
     takes = {opt.name for opt in render_options(mesh)}
     drawn: dict[tuple, object] = {}
 
@@ -119,8 +114,6 @@ def _measured_columns(compare_metrics, rows) -> tuple[str, ...]:
 
 def comparison_sheet(result: dict, title: str):
     """`comparison_tiles` on a contact sheet, one row per kind of tile."""
-    from .pictures import contact_sheet
-
     return contact_sheet(comparison_tiles(result), columns=len(result["frames"]),
                          title=title)
 
@@ -129,8 +122,6 @@ def comparison_tiles(result: dict) -> list[tuple[str, np.ndarray]]:
     """(caption, RGBA) tiles: mesh and every variant; then the default variant's coverage
     against the mesh (green both, red representation only, blue mesh only), named, and per
     variant the colour error, its technique's error mask (wrong hits, ...) in red."""
-    from . import metrics
-
     frames, truth = result["frames"], result["frames"]["mesh"]
     tiles = [(name, frame.rgba8(TILE_BACKGROUND)) for name, frame in frames.items()]
     default = result["default"]
@@ -186,8 +177,6 @@ def _cell(value, column: str) -> str:
 def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]:
     """compare.png, metrics.md and metrics.json in ``out_dir`` (created): all three, or none
     if one cannot be written."""
-    from .pictures import save_image
-
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = {"picture": out_dir / "compare.png", "markdown": out_dir / "metrics.md",
              "json": out_dir / "metrics.json"}
@@ -203,7 +192,5 @@ def write_comparison(result: dict, out_dir: Path, title: str) -> dict[str, Path]
 def metrics_json(result: dict, title: str) -> str:
     """``{"title", "bytes", "variants": {name: row}}`` as strict JSON: a score not measured,
     or infinite (the PSNR of identical pictures), is null."""
-    from . import strict_json
-
     return strict_json.dumps({"title": title, "bytes": result["bytes"],
                               "variants": result["metrics"]}, indent=2)

@@ -7,15 +7,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.technique import DemoTile
+from .core.technique import REGISTRY, DemoTile
 from .io.atomic import atomic_path
-from .pictures import TILE_BACKGROUND
+from .pictures import TILE_BACKGROUND, contact_sheet, save_image
+from .progress import progress_bar
+from .render import render
+from .scene.assets import make_asset
+from .scene.views import framing_bounds, orbit_bounds
 
 
 def _asset(name: str) -> Callable[[], object]:
     def make():
-        from .scene.assets import make_asset
-
         return make_asset(name)
 
     return make
@@ -32,11 +34,11 @@ def mesh_tiles() -> list[DemoTile]:
 
 
 def demo_tiles() -> list[DemoTile]:
-    """Every tile of the sheet: the meshes, then each registered technique's tiles."""
-    from .core.technique import techniques
-
+    """Every tile of the sheet: the meshes, then each registered technique's tiles (the
+    CLI fills the registry; benches draw these tiles too, so this module sits below the
+    composition root)."""
     tiles = mesh_tiles()
-    for tech in techniques():
+    for tech in REGISTRY.techniques():
         if tech.demo_tiles is not None:
             tiles += tech.demo_tiles()
     return tiles
@@ -45,11 +47,6 @@ def demo_tiles() -> list[DemoTile]:
 def build_demo(out_dir: Path, tile_size=(256, 256), columns: int = 4) -> Path:
     """Render every tile into ``out_dir/<slug>.png`` and the sheet into ``out_dir/demo.png``."""
     from PIL import Image
-
-    from .pictures import contact_sheet, save_image
-    from .progress import progress_bar
-    from .render import render
-    from .scene.views import framing_bounds, orbit_bounds
 
     out_dir.mkdir(parents=True, exist_ok=True)
     tiles = demo_tiles()

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from reliefkit.bench.loading import FORMATS, measure, tiled_spheres, write_meshes
-from reliefkit.scene.loader import load_mesh
+from reliefkit.io.meshes import load_mesh
 
 
 def test_every_format_holds_the_same_triangles(tmp_path):

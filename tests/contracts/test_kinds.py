@@ -13,6 +13,7 @@ import pytest
 from helpers import sample, technique_samples, toy_technique
 from numpy.lib import format as npy
 
+from reliefkit.builtins import registry
 from reliefkit.errors import FormatError
 from reliefkit.io import rk
 
@@ -36,7 +37,7 @@ def written(request, tmp_path):
 
 
 def _arrays_of(rep):
-    codec = rk._codec_for_object(rep)
+    codec = registry().codecs().for_object(rep)
     arrays, params = codec.to_arrays(rep)
     return {k: np.asarray(v) for k, v in arrays.items() if v is not None}, params
 
@@ -84,7 +85,7 @@ def _refused(path, *words):
 
 def test_kind_is_registered_in_a_fresh_view(written):
     kind, rep, path = written
-    assert kind in rk.registered_kinds()
+    assert kind in registry().codecs().kinds
     assert rk.read_manifest(path)["kind"] == kind
 
 
@@ -135,7 +136,7 @@ def test_wrong_checksum_is_refused(written):
 
 def test_missing_required_part_is_refused(written):
     kind, rep, path = written
-    codec = rk._codec_for_kind(kind)
+    codec = registry().codecs().for_kind(kind)
     present = rk.read_manifest(path)["arrays"]
     required = [n for n, spec in codec.arrays.items() if spec.required and n in present]
     if not required:  # kinds made of optional parts (several prefixed parts) check themselves
@@ -194,7 +195,7 @@ def test_bad_typed_fields_are_refused_or_valid(written, forgery):
         assert type(back) is type(rep), f"{name} forged as {forgery}"
         if forgery == "dtype":
             pytest.fail(f"{kind}: array {name} with dtype {bad.dtype} was accepted")
-        if forgery == "nan" and rk._codec_for_kind(kind).arrays[name].finite:
+        if forgery == "nan" and registry().codecs().for_kind(kind).arrays[name].finite:
             pytest.fail(f"{kind}: NaN accepted in finite array {name}")
 
 

@@ -10,32 +10,33 @@ import numpy as np
 import pytest
 from helpers import toy_technique
 
+from reliefkit.bench import suites
+from reliefkit.builtins import registry
 from reliefkit.core import params
 from reliefkit.core.params import param
 from reliefkit.core.technique import (
     Baker,
     Technique,
     bakers,
-    bench_suites,
-    load_all,
     register,
     technique,
     technique_of,
 )
 from reliefkit.errors import UsageError
-from reliefkit.io import rk
 from reliefkit.scene.assets import make_asset
 
-FRESH = ("from reliefkit.io.rk import registered_kinds; "
-         "from reliefkit.core.technique import techniques; "
-         "print(','.join(registered_kinds())); print(','.join(t.name for t in techniques()))")
+FRESH = ("import sys, reliefkit as rk; from reliefkit.core.technique import REGISTRY; "
+         "path = rk.save(sys.argv[1], rk.load_mesh('demo:blob')); "
+         "print(type(rk.load(path)).__name__); print(','.join(REGISTRY.codecs().kinds)); "
+         "print(','.join(t.name for t in REGISTRY.techniques()))")
 
 
-def test_registered_kinds_are_right_in_a_fresh_process():
-    out = subprocess.run([sys.executable, "-c", FRESH], capture_output=True, text=True,
-                         timeout=120)
+def test_the_public_api_registers_the_builtins_in_a_fresh_process(tmp_path):
+    out = subprocess.run([sys.executable, "-c", FRESH, str(tmp_path / "m.rk")],
+                         capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
-    kinds, names = out.stdout.split()
+    loaded, kinds, names = out.stdout.split()
+    assert loaded == "RenderMesh"
     import reliefkit.techniques as builtin
 
     expected = {"mesh"} | {k for t in builtin.TECHNIQUES for k in t.kinds}
@@ -43,9 +44,9 @@ def test_registered_kinds_are_right_in_a_fresh_process():
     assert names.split(",") == [t.name for t in builtin.TECHNIQUES]
 
 
-def test_load_all_is_idempotent():
-    first = load_all()
-    assert load_all() == first and len({t.name for t in first}) == len(first)
+def test_the_builtins_are_registered_once():
+    first = registry().techniques()
+    assert registry().techniques() == first and len({t.name for t in first}) == len(first)
 
 
 def test_duplicates_are_refused():
@@ -60,8 +61,8 @@ def test_duplicates_are_refused():
                                       representations=(), drawables=())
     with pytest.raises(UsageError, match="baker 'relief' is already registered"):
         register(taken_baker)
-    assert "copycat" not in {t.name for t in load_all()}
-    assert "copycat" not in rk.registered_kinds()
+    assert "copycat" not in {t.name for t in registry().techniques()}
+    assert "copycat" not in registry().codecs().kinds
 
 
 def test_conflicting_flag_kinds_are_refused():
@@ -78,11 +79,11 @@ def test_conflicting_flag_kinds_are_refused():
 
 def test_toy_plugs_in_and_out_without_touching_the_core():
     with toy_technique() as toy:
-        assert "toy-quad" in rk.registered_kinds() and "toy-quad" in bakers()
-        assert "toy" in bench_suites()
+        assert "toy-quad" in registry().codecs().kinds and "toy-quad" in bakers()
+        assert "toy" in suites()
         quad = toy.TECHNIQUE.samples()["toy-quad"]
         assert technique_of(quad).name == "toy"
-    assert "toy-quad" not in rk.registered_kinds() and "toy-quad" not in bakers()
+    assert "toy-quad" not in registry().codecs().kinds and "toy-quad" not in bakers()
 
 
 def test_bake_validates_its_typed_parameters():

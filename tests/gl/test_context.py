@@ -6,7 +6,7 @@ import pytest
 from reliefkit.errors import GPUError
 from reliefkit.gl.context import check_framebuffer_size, check_gl_error, gl_info
 from reliefkit.gl.textures import texture2d
-from reliefkit.gl.timing import gpu_time_ms
+from reliefkit.gl.timing import gpu_times_ms
 
 
 def test_gl_info_reports_renderer_and_limits(gl):
@@ -60,7 +60,7 @@ def test_gl_errors_are_raised_and_home_framebuffer_avoids_them(gl):
 def test_timer_reports_positive_times(gl):
     fbo = gl.simple_framebuffer((8, 8))
     fbo.use()
-    timing = gpu_time_ms(gl, lambda: fbo.clear(1.0, 0.0, 0.0, 1.0), repeats=3)
+    (timing,) = gpu_times_ms(gl, [lambda: fbo.clear(1.0, 0.0, 0.0, 1.0)], repeats=3)
     assert timing["repeats"] == 3 and timing["wall_ms"] > 0 and timing["gpu_ms"] >= 0
 
 

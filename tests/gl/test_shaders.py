@@ -8,6 +8,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from helpers import toy_technique
 
 from reliefkit.core.technique import techniques
 from reliefkit.errors import GPUError
@@ -47,7 +48,8 @@ def fake_files(monkeypatch):
         return real(name)
 
     monkeypatch.setattr(shaders, "read_shader_file", read)
-    monkeypatch.setitem(shaders._namespaces, "test", "reliefkit")
+    namespaces = shaders._namespace_table
+    monkeypatch.setattr(shaders, "_namespace_table", lambda: {**namespaces(), "test": "reliefkit"})
 
 
 def test_stage_sources_have_version_stage_defines_and_line(fake_files):
@@ -90,9 +92,12 @@ def test_bad_names_are_errors(fake_files):
         shaders.read_shader_file("core:missing.glsl")
 
 
-def test_namespaces_cannot_be_taken_twice():
-    with pytest.raises(GPUError, match="already taken"):
-        shaders.register_namespace("relief", "some.other.package")
+def test_namespaces_follow_the_registered_techniques():
+    """A technique's namespace is its name, found while it is registered and not after."""
+    with toy_technique():
+        assert "void main" in shaders.read_shader_file("toy:toy.glsl")
+    with pytest.raises(GPUError, match="unknown shader namespace 'toy'"):
+        shaders.read_shader_file("toy:toy.glsl")
 
 
 def test_variants_compile_and_differ(gl, fake_files):

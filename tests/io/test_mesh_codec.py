@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from numpy.lib import format as npy
 
+from reliefkit.builtins import registry
 from reliefkit.errors import FormatError
 from reliefkit.io import rk
 from reliefkit.io.mesh_codec import MAX_TEXTURED
@@ -120,7 +121,7 @@ def test_too_many_textured_materials_cannot_be_saved(tmp_path):
 def forged(tmp_path, **changes):
     """A multi-material file whose arrays or params are changed after a valid write."""
     mesh = three_materials()
-    codec = rk._codec_for_object(mesh)  # noqa: SLF001 - forging needs the codec's arrays
+    codec = registry().codecs().for_object(mesh)  # forging needs the codec's arrays
     arrays, params = codec.to_arrays(mesh)
     arrays = {k: v for k, v in arrays.items() if v is not None}
     for name, value in changes.items():

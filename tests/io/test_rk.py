@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from numpy.lib import format as npy
 
+from reliefkit.builtins import registry
 from reliefkit.errors import FormatError
 from reliefkit.io import rk as formats
 from reliefkit.io.rk import ArraySpec, Codec
@@ -59,11 +60,18 @@ BAG = Codec(
 )
 
 
+def with_kinds(*codecs: Codec) -> formats.CodecTable:
+    """The process's kinds plus ``codecs``."""
+    return formats.CodecTable((*registry().codecs(), *codecs))
+
+
 @pytest.fixture(autouse=True)
 def _bag_kind():
-    formats.register(BAG)
+    """The functions' default table holds the bag kind during each test."""
+    table = with_kinds(BAG)
+    formats.use_codecs(lambda: table)
     yield
-    formats.unregister(BAG.kind)
+    formats.use_codecs(registry().codecs)
 
 
 def make_mesh(textured: bool = False) -> RenderMesh:
@@ -290,7 +298,7 @@ def test_manifest_fields_and_deflated_members(tmp_path):
     path = rk_file(tmp_path, source_hash=SOURCE_HASH)
     man = formats.read_manifest(path)
     assert man["format"] == "reliefkit" and man["format_version"] == 1
-    assert man["kind_version"] == formats._codec_for_kind("mesh").version
+    assert man["kind_version"] == registry().codecs().for_kind("mesh").version
     assert man["params"] == {"name": "quad"}
     assert man["created_by"].startswith("reliefkit ")
     assert man["arrays"]["indices"]["dtype"] == "<u4"
@@ -838,16 +846,16 @@ def test_write_refuses_bad_source_hash_unknown_kind_and_type(tmp_path):
         formats.save(tmp_path / "b.rk", object())
 
 
-def test_register_refuses_conflicts_and_bad_specs():
+def test_codec_table_refuses_conflicts_and_bad_specs():
     with pytest.raises(FormatError, match="already registered"):
-        formats.register(Codec("mesh", Bag, {}, BAG.to_arrays, BAG.from_arrays))
+        with_kinds(BAG, Codec("mesh", Bag, {}, BAG.to_arrays, BAG.from_arrays))
     with pytest.raises(FormatError, match="already registered as kind 'test-bag'"):
-        formats.register(Codec("bag2", Bag, {}, BAG.to_arrays, BAG.from_arrays))
+        with_kinds(BAG, Codec("bag2", Bag, {}, BAG.to_arrays, BAG.from_arrays))
     with pytest.raises(FormatError, match="not a plain numeric dtype"):
-        formats.register(Codec("bad", dict, {"a": ArraySpec(("O",), 1)}, None, None))
+        with_kinds(Codec("bad", dict, {"a": ArraySpec(("O",), 1)}, None, None))
     with pytest.raises(FormatError, match="invalid kind"):
-        formats.register(Codec("Bad Kind", dict, {}, None, None))
-    assert "mesh" in formats.registered_kinds() and "bad" not in formats.registered_kinds()
+        with_kinds(Codec("Bad Kind", dict, {}, None, None))
+    assert "mesh" in registry().codecs().kinds and "bad" not in registry().codecs().kinds
 
 
 # ------------------------------------------------------------------------ atomic writes
@@ -864,12 +872,9 @@ def test_failing_to_arrays_leaves_old_file_and_no_temp(tmp_path):
     def broken(bag):
         raise RuntimeError("bake exploded")
 
-    formats.register(Codec("test-broken", dict, {}, broken, BAG.from_arrays))
-    try:
-        with pytest.raises(RuntimeError, match="bake exploded"):
-            formats.save(path, {})
-    finally:
-        formats.unregister("test-broken")
+    kinds = with_kinds(Codec("test-broken", dict, {}, broken, BAG.from_arrays))
+    with pytest.raises(RuntimeError, match="bake exploded"):
+        formats.save(path, {}, codecs=kinds)
     assert path.read_bytes() == before and _folder_listing(tmp_path) == ["x.rk"]
 
 

@@ -18,9 +18,9 @@ import trimesh
 from helpers import write_obj_quad
 from PIL import Image
 
+from reliefkit.io.meshes import load_mesh
 from reliefkit.render import render
 from reliefkit.scene.camera import Camera
-from reliefkit.scene.loader import load_mesh
 
 LOW, HIGH = 26, 204  # texture alpha bytes of the left and right half
 CAMERA = Camera(eye=(0, 0, 4), target=(0, 0, 0), size=(48, 48), near=1.0, far=10.0,

@@ -126,7 +126,7 @@ def test_frame_save_and_aovs(gl, tmp_path):
 def test_textured_glb_renders_its_texture_the_right_way_up(gl, tmp_path):
     from PIL import Image
 
-    from reliefkit.scene.loader import load_mesh
+    from reliefkit.io.meshes import load_mesh
 
     # a 2x2 texture: red top-left, green top-right, blue bottom-left, white bottom-right
     image = Image.fromarray(np.array([[[255, 0, 0], [0, 255, 0]], [[0, 0, 255],
@@ -209,7 +209,7 @@ def _assert_texels_shown(rgb, image, col0, top_row, step):
 
 
 def test_two_materials_render_each_its_own_texture(gl, tmp_path):
-    from reliefkit.scene.loader import load_mesh
+    from reliefkit.io.meshes import load_mesh
 
     mesh = load_mesh(_two_textured_quads(tmp_path))
     camera = Camera(eye=(1.5, 0.5, 3), target=(1.5, 0.5, 0), size=(96, 32), ortho_height=0.5)
@@ -221,7 +221,7 @@ def test_two_materials_render_each_its_own_texture(gl, tmp_path):
 
 def test_projected_bake_colour_shows_both_textures(gl, tmp_path):
     from reliefkit.bake.project import project_mesh
-    from reliefkit.scene.loader import load_mesh
+    from reliefkit.io.meshes import load_mesh
 
     mesh = load_mesh(_two_textured_quads(tmp_path))
     box_to_world = np.array([[3.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.5], [0, 0, 0, 1]])
@@ -266,7 +266,7 @@ def test_uv_transform_moves_the_lookup(gl):
 
 
 def test_uvs_without_an_image_render_the_default_colour(gl, tmp_path):
-    from reliefkit.scene.loader import DEFAULT_COLOR, load_mesh
+    from reliefkit.io.meshes import DEFAULT_COLOR, load_mesh
 
     path = tmp_path / "uv_only.obj"
     path.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
@@ -282,7 +282,7 @@ def test_rotated_textured_boxes_are_lit_from_the_front(gl, tmp_path):
     from PIL import Image
     from scipy.spatial.transform import Rotation
 
-    from reliefkit.scene.loader import load_mesh
+    from reliefkit.io.meshes import load_mesh
 
     box = trimesh.creation.box(extents=(1.0, 1.5, 2.0))
     corners = box.vertices[box.faces].reshape(-1, 3)

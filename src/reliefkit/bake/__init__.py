@@ -4,6 +4,10 @@
 
 from __future__ import annotations
 
+from ..core import params as options
+from ..core.technique import baker
+from ..errors import UsageError
+
 
 def bake(source, kind: str, *, progress=None, **params):
     """Bake a RenderMesh (or a 2D height array) into the representation ``kind``.
@@ -12,10 +16,6 @@ def bake(source, kind: str, *, progress=None, **params):
     kind); an unknown or invalid one is a UsageError.
     """
     import numpy as np
-
-    from ..core import params as options
-    from ..core.technique import baker
-    from ..errors import UsageError
 
     tech, chosen = baker(kind)
     source_kind = "heightmap" if isinstance(source, np.ndarray) else "mesh"
@@ -26,11 +26,4 @@ def bake(source, kind: str, *, progress=None, **params):
     return chosen.bake(source, values, progress)
 
 
-def bake_kinds() -> tuple[str, ...]:
-    """The ``--as`` names of every registered baker."""
-    from ..core.technique import bakers
-
-    return tuple(bakers())
-
-
-__all__ = ["bake", "bake_kinds"]
+__all__ = ["bake"]

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..core.transforms import box_center, invert_box
 from ..errors import UsageError
+from ..render import render
 from ..scene.camera import MatrixCamera
 from ..scene.light import DirectionalLight
 
@@ -71,8 +72,6 @@ def box_camera(box_to_world: np.ndarray, size) -> MatrixCamera:
 
 def project_mesh(mesh, box_to_world: np.ndarray, size, ctx=None) -> Projection:
     """Rasterize ``mesh`` through the box at ``size`` (W, H) texels."""
-    from ..render import render
-
     box_to_world = np.asarray(box_to_world, dtype=np.float64)
     if box_to_world.shape != (4, 4) or not np.isfinite(box_to_world).all():
         raise UsageError("box_to_world must be a finite 4x4 matrix")

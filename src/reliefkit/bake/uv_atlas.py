@@ -16,6 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..colorspace import srgb_decode, to_rgba8
+from ..scene.mesh import RenderMesh
+from .project import dilate, project_mesh
+
 #: Texels along each side of a layer.
 ATLAS_SIZE = 256
 #: Meshes with more materials keep none (a texture array of this many layers is small).
@@ -39,10 +43,6 @@ def has_material(mesh) -> bool:
 def material_atlas(mesh, size: int = ATLAS_SIZE, ctx=None) -> MaterialAtlas:
     """The colour of each of ``mesh``'s materials (at most `MAX_MATERIALS`) over the
     rectangle its uvs span (it needs uvs)."""
-    from ..colorspace import to_rgba8
-    from ..scene.mesh import RenderMesh
-    from .project import dilate, project_mesh
-
     uvs = np.asarray(mesh.uvs, np.float64)
     lo, hi = uvs.min(axis=0), uvs.max(axis=0)
     extent = np.maximum(hi - lo, 1e-9)
@@ -91,8 +91,6 @@ def linear_tint(atlas: MaterialAtlas, uv, layer) -> np.ndarray:
     """(..., 3) linear colour of ``atlas`` at base uvs ``uv`` (..., 2) in layers ``layer``
     (...): bilinear between texel centres, clamped at the border, as surface_tint.glsl
     samples it."""
-    from ..colorspace import srgb_decode
-
     uv = np.asarray(uv, np.float64)
     layer = np.asarray(layer, np.int64)
     _, height, width, _ = atlas.rgba8.shape

@@ -31,7 +31,9 @@ import numpy as np
 
 from ..core.transforms import invert_box
 from ..errors import GPUError, UsageError
-from ..gl.textures import read_rgba
+from ..gl.context import bind_home_framebuffer, check_framebuffer_size, check_gl_error, get_context
+from ..gl.shaders import program
+from ..gl.textures import read_rgba, texture2d
 from ..gl.uniforms import set_uniforms
 from ..render.mesh import material_uniforms
 from ..scene.mesh import RenderMesh
@@ -115,8 +117,6 @@ def voxelize(mesh: RenderMesh, box_to_world, resolution, *, mode: str = "surface
     ``progress(done, total)`` is called after each slab. Raises UsageError for bad arguments
     or when nothing of the mesh is found inside the box, GPUError for GL limits.
     """
-    from ..gl.context import get_context
-
     if not isinstance(mesh, RenderMesh):
         raise UsageError(f"voxelize needs a RenderMesh, got {type(mesh).__name__} "
                          "(load it with reliefkit.load_mesh)")
@@ -212,8 +212,6 @@ def _check_box(box_to_world) -> np.ndarray:
 def _check_gl_limits(ctx, size, s: int) -> None:
     """The grid must fit a 3D texture, and each sweep's image (s pixels per voxel) a
     framebuffer; both are GL limits, so GPUError."""
-    from ..gl.context import check_framebuffer_size
-
     limit = int(ctx.info["GL_MAX_3D_TEXTURE_SIZE"])
     if max(size) > limit:
         raise GPUError(f"a {size[0]}x{size[1]}x{size[2]} voxel grid exceeds this GPU's 3D "
@@ -244,8 +242,6 @@ class _Sweeps:
     def run(self):
         import moderngl
 
-        from ..gl.context import bind_home_framebuffer
-
         ctx = self.ctx
         w, h, d = self.size
         # per voxel: premultiplied colour sum (4), normal sum (3), crossings, coverage (max)
@@ -275,9 +271,6 @@ class _Sweeps:
     def _upload(self) -> None:
         """Vertex buffer and one texture per material, shared by all sweeps (a material
         without an image gets a white texel when others have one: one program for all)."""
-        from ..gl.context import check_gl_error
-        from ..gl.textures import texture2d
-
         ctx, mesh = self.ctx, self.mesh
         uvs = mesh.uvs if mesh.uvs is not None else np.zeros((len(mesh.positions), 2))
         data = np.hstack([self.box_pos, mesh.normals, mesh.colors, uvs]).astype(np.float32)
@@ -332,9 +325,6 @@ class _Sweeps:
         """Rasterize every slab along z' = box axis perm[2], adding to ``acc`` (a view
         indexed [z', y', x', channel]); with ``inside`` given, also count the winding."""
         import moderngl
-
-        from ..gl.context import check_gl_error
-        from ..gl.shaders import program
 
         ctx, s = self.ctx, self.s
         winding = inside is not None
@@ -411,8 +401,6 @@ class _Sweeps:
         return vao, ibo
 
     def _target(self, width: int, height: int, attachments: int):
-        from ..gl.context import check_gl_error
-
         ctx = self.ctx
         colors = []
         for _ in range(attachments):

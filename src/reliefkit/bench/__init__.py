@@ -2,12 +2,18 @@
 core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
-`timing` has the shared frame-timing helper.
+`timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
+so this package sits below the composition root: its caller (the CLI) fills the registry.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+
+from ..core.technique import REGISTRY, BenchSuite
+from ..errors import UsageError
+from ..progress import activity
+from . import loading, platform
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -18,9 +24,6 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
     Without ``log`` the suite's step messages are its progress (`reliefkit.progress.activity`:
     ``bench NAME: ...`` lines on stderr, a spinner on a terminal).
     """
-    from ..errors import UsageError
-    from ..progress import activity
-
     table = suites()
     if name not in table:
         raise UsageError(f"unknown benchmark {name!r} (choose from {', '.join(table)})")
@@ -40,14 +43,11 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
 
 def suites() -> dict:
     """Every suite by name: the core's, then each technique's (`core.technique.BenchSuite`)."""
-    from ..core.technique import BenchSuite, bench_suites
-    from . import loading, platform
-
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
                                   loading.run_suite, takes_mesh=True),
             "platform": BenchSuite("platform", "a turntable in one render call against one "
                                    "call per view, per demo tile", platform.run_suite)}
-    return core | {name: suite for name, (_, suite) in bench_suites().items()}
+    return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 
 def suite_names() -> tuple[str, ...]:

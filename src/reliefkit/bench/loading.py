@@ -30,7 +30,7 @@ FORMATS = ("obj", "stl", "ply", "glb")
 # resident baseline, then the load and its peak; both in KiB
 _CHILD = """
 import json, sys, time
-from reliefkit.scene.loader import load_mesh
+from reliefkit.io.meshes import load_mesh
 load_mesh(sys.argv[2])  # a small file of the same format: what loading imports lazily
 
 def status(key):

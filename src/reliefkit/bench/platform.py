@@ -47,7 +47,7 @@ def _markdown(data: dict) -> str:
              "|---|---|---|---|---|---|"]
     for row in rows:
         met = "" if row["ratio"] <= TARGET else " (over target)"
-        lines.append(f"| {row["name"]} | {row['kind']} | {row['separate']:.3f} | "
+        lines.append(f"| {row['name']} | {row['kind']} | {row['separate']:.3f} | "
                      f"{row['one_call']:.3f} | {row['ratio']:.2f}{met} | "
                      f"{'yes' if row['identical'] else 'NO'} |")
     lines += ["", f"Target: one call <= {TARGET} x the separate calls' time. "

@@ -9,6 +9,8 @@ import platform
 from collections.abc import Callable
 from pathlib import Path
 
+from ..io.atomic import atomic_path
+
 
 def machine() -> dict:
     """Platform, CPU and the GL renderer (or why there is none), for the report's header."""
@@ -32,8 +34,6 @@ def machine_line(m: dict) -> str:
 
 def write_report(out, stem: str, data: dict, markdown: Callable[[dict], str]) -> list[Path]:
     """``stem``.json (the data) and ``stem``.md (``markdown(data)``) into ``out``, atomically."""
-    from ..io.atomic import atomic_path
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / f"{stem}.json", out / f"{stem}.md"]
@@ -47,8 +47,6 @@ def write_report(out, stem: str, data: dict, markdown: Callable[[dict], str]) ->
 def save_figure(fig, path) -> None:
     """A matplotlib figure as a PNG at ``path``, atomically (no torn file), then closed."""
     import matplotlib.pyplot as plt
-
-    from ..io.atomic import atomic_path
 
     fig.tight_layout()
     with atomic_path(Path(path)) as tmp:

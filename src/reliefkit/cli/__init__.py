@@ -56,8 +56,10 @@ def run() -> None:
 
 def _parse_and_run(argv: list[str] | None) -> int:
     try:
+        from ..builtins import registry
         from .parser import build_parser
 
+        registry()
         parser = build_parser()
     except Exception as exc:
         raise_pending()  # a signal a library turned into its own error (a RuntimeError)

@@ -5,10 +5,41 @@ from __future__ import annotations
 import itertools
 import json
 import sys
+from contextlib import closing
 from pathlib import Path
 
 from .. import strict_json
-from ..errors import FormatError, UsageError
+from ..animation import (
+    check_animation_output,
+    frame_background,
+    is_animation_name,
+    save_animation,
+)
+from ..bake import bake
+from ..bench import run_suite
+from ..compare import compare, metrics_markdown, write_comparison
+from ..core.params import ANIMATION_TIME
+from ..core.technique import baker, technique_of
+from ..demo import build_demo
+from ..errors import FormatError, MeshError, UsageError
+from ..gl.context import gl_info
+from ..io.atomic import atomic_path, check_writable, written_together
+from ..io.inputs import describe, load_input
+from ..io.rk import array_bytes, file_sha256, load, read_manifest, save
+from ..progress import progress_bar, waiting
+from ..render import Scene, render, render_options
+from ..scene.heightmap import is_heightmap, load_heightmap
+from ..scene.light import DirectionalLight
+from ..scene.views import (
+    check_fov,
+    framing_bounds,
+    orbit_bounds,
+    parse_light,
+    parse_size,
+    parse_view,
+    turntable,
+)
+from ..units import format_bytes
 from .options import applicable, given_options
 
 MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
@@ -23,8 +54,7 @@ def _check_not_empty(spec: str) -> None:
 
 def _check_mesh_file(spec: str, flag: str) -> None:
     """A mesh file (not demo:NAME, a heightmap or an .rk) that exists, refused up front."""
-    from ..errors import MeshError
-    from ..scene.loader import SUPPORTED_EXTENSIONS
+    from ..io.meshes import SUPPORTED_EXTENSIONS  # trimesh: slow to import
 
     if Path(spec).suffix.lower() not in SUPPORTED_EXTENSIONS:
         raise UsageError(f"{flag} needs a mesh file ({' '.join(SUPPORTED_EXTENSIONS)}), got "
@@ -37,8 +67,6 @@ def _check_mesh_file(spec: str, flag: str) -> None:
 
 def _bake_source(spec: str, command: str = "bake"):
     """The mesh or heightmap ``bake`` and ``compare`` start from."""
-    from ..scene.heightmap import is_heightmap, load_heightmap
-
     _check_not_empty(spec)
     if Path(spec).suffix.lower() == ".rk":
         raise UsageError(f"{command} needs a mesh or heightmap, not an .rk file ({spec})")
@@ -53,8 +81,6 @@ def _bake_source(spec: str, command: str = "bake"):
 
 def _load(spec: str):
     """`load_input`, then each warning the loader left on a mesh as one `warning:` line."""
-    from ..io.inputs import load_input
-
     obj = load_input(spec)
     _print_load_warnings(obj)
     return obj
@@ -70,10 +96,6 @@ def _print_load_warnings(obj) -> None:
 
 
 def _bake_input(args, source=None):
-    from ..bake import bake
-    from ..core.technique import baker
-    from ..progress import progress_bar
-
     _, chosen = baker(args.kind)
     params = applicable(given_options(args), chosen.options, f"--as {args.kind}")
     source = _bake_source(args.input) if source is None else source
@@ -82,10 +104,6 @@ def _bake_input(args, source=None):
 
 
 def cmd_bake(args) -> int:
-    from ..io.atomic import check_writable
-    from ..io.rk import array_bytes, file_sha256, save
-    from ..units import format_bytes
-
     if Path(args.output).suffix.lower() != ".rk":
         raise UsageError(f"output must be an .rk file, got {args.output}")
     check_writable(args.output, "-o")
@@ -103,8 +121,6 @@ def _arrays_summary(sizes: dict[str, int], path: str, shown: int = 3) -> str:
     """``N arrays, TOTAL (the largest ...)``: a cube's or a cloud's dozens of arrays in one
     short line; `reliefkit info` lists every one."""
     import shlex
-
-    from ..units import format_bytes
 
     largest = sorted(sizes.items(), key=lambda item: -item[1])[:shown]
     named = ", ".join(f"{name} {format_bytes(n)}" for name, n in largest)
@@ -130,9 +146,6 @@ def _background(text: str):
 
 
 def _light(args):
-    from ..scene.light import DirectionalLight
-    from ..scene.views import parse_light
-
     return DirectionalLight.from_angles(*parse_light(args.light))
 
 
@@ -159,9 +172,6 @@ def _print_frame_warnings(per_frame: list, noun: str = "") -> None:
 
 
 def cmd_render(args) -> int:
-    from ..render import Scene, render, render_options
-    from ..scene.views import check_fov, framing_bounds, orbit_bounds, parse_size, parse_view
-
     az, el, dist = parse_view(args.view)
     size = parse_size(args.size)
     check_fov(args.fov)
@@ -186,7 +196,6 @@ def cmd_render(args) -> int:
     camera = orbit_bounds(framing_bounds(obj), az, el, dist, size, args.fov)
     if args.animate is not None:
         return _render_animation(args, obj, camera, draw, background)
-    from ..progress import waiting
 
     with waiting("render"):  # silent unless it takes long (a peeled shell: 46 s)
         frame = draw(camera)
@@ -204,8 +213,6 @@ def cmd_render(args) -> int:
 
 def _write_render_outputs(args, frame, counted, background) -> None:
     """The picture, --aovs and --stats: all of them or, if one cannot be written, none."""
-    from ..io.atomic import written_together
-
     with written_together():
         frame.save(args.output, background)
         if args.aovs:
@@ -217,9 +224,6 @@ def _write_render_outputs(args, frame, counted, background) -> None:
 def _check_render_outputs(args) -> None:
     """The output names fit what is written; per-frame outputs do not go with --turntable
     or --animate."""
-    from ..animation import is_animation_name
-    from ..io.atomic import check_writable
-
     suffix = Path(args.output).suffix.lower()
     if args.turntable is not None and args.animate is not None:
         raise UsageError("--turntable and --animate both write an animation: give one of them")
@@ -229,8 +233,6 @@ def _check_render_outputs(args) -> None:
         count = args.turntable if args.turntable is not None else args.animate
         if not 1 <= count <= MAX_FRAMES:
             raise UsageError(f"{sequence} takes 1..{MAX_FRAMES} frames, got {count}")
-        from ..animation import check_animation_output
-        from ..scene.views import parse_size
 
         check_animation_output(args.output, parse_size(args.size), count)
         given = [flag for flag, value in (("--aovs", args.aovs), ("--stats", args.stats))
@@ -257,10 +259,6 @@ def _check_render_outputs(args) -> None:
 def _render_turntable(args, bounds, views, elevation, distance, size, background) -> int:
     """``args.turntable`` views (``views(cameras)`` yields their Frames) into an animation,
     warning about empty views."""
-    from contextlib import closing
-
-    from ..scene.views import turntable
-
     cameras = turntable(bounds, args.turntable, elevation, distance, size, args.fov)
     with closing(views(cameras)) as frames:
         empty, warned, written = _stream_frames(args.output, "turntable", frames,
@@ -276,9 +274,6 @@ def _render_turntable(args, bounds, views, elevation, distance, size, background
 
 def _render_animation(args, obj, camera, draw, background) -> int:
     """``args.animate`` frames of ``obj``'s animation (its ``time`` render option)."""
-    from ..core.params import ANIMATION_TIME
-    from ..render import render_options
-
     if ANIMATION_TIME not in {opt.name for opt in render_options(obj)}:
         raise UsageError(f"--animate: {args.input} ({type(obj).__name__}) has no animation "
                          "(no --time option); use --turntable for views around it")
@@ -297,9 +292,6 @@ def _stream_frames(path, description: str, frames, count: int, background):
     at a time, with progress, so streamed formats hold one frame at a time; returns the
     numbers (from 1) of the frames that cover no pixel, each frame's warnings and what was
     written."""
-    from ..animation import frame_background, save_animation
-    from ..progress import progress_bar
-
     empty, warned = [], []
     over = frame_background(path, background)
     with progress_bar(description, count) as advance:
@@ -316,8 +308,6 @@ def _stream_frames(path, description: str, frames, count: int, background):
 
 def _write_stats(args, frame, counted) -> None:
     """The plain frame's counters plus the instrumented pass's (fragments, iterations)."""
-    from ..io.atomic import atomic_path
-
     stats = {"input": args.input, "size": list(frame.size), "view": args.view,
              **counted.stats, **frame.stats}
     with atomic_path(args.stats) as tmp:
@@ -325,19 +315,13 @@ def _write_stats(args, frame, counted) -> None:
 
 
 def cmd_compare(args) -> int:
-    from ..compare import metrics_markdown, write_comparison
-    from ..scene.views import check_fov, orbit_bounds, parse_size, parse_view
-
     az, el, dist = parse_view(args.view)
     size = parse_size(args.size)
     check_fov(args.fov)
     light = _light(args)
-    from ..io.atomic import check_writable
 
     check_writable(args.out, "--out", folder=True)
     mesh = _bake_source(args.input, "compare")
-    if not hasattr(mesh, "triangle_count"):
-        raise UsageError("compare needs a mesh (or demo:NAME) as INPUT, not a heightmap")
     rep = _bake_input(args, mesh)
     camera = orbit_bounds(mesh.bounds, az, el, dist, size, args.fov)
     result = _compare_with_progress(mesh, rep, camera, light)
@@ -353,10 +337,6 @@ def cmd_compare(args) -> int:
 
 def _compare_with_progress(mesh, rep, camera, light) -> dict:
     """`compare` with a progress line per variant (the mesh, then each available variant)."""
-    from ..compare import compare
-    from ..core.technique import technique_of
-    from ..progress import progress_bar
-
     tech = technique_of(rep)
     variants = [v for v in (tech.compare_variants if tech else ()) if v.available(rep)]
     with progress_bar("compare", len(variants) + 1) as advance:
@@ -364,9 +344,6 @@ def _compare_with_progress(mesh, rep, camera, light) -> dict:
 
 
 def cmd_bench(args) -> int:
-    from ..bench import run_suite
-    from ..io.atomic import check_writable
-
     check_writable(args.out, "--out", folder=True)
     if args.mesh is not None:
         _check_mesh_file(args.mesh, "--mesh")
@@ -381,8 +358,6 @@ def cmd_info(args) -> int:
         raise UsageError("info needs --gl and/or a FILE")
     report = {}
     if args.gl:
-        from ..gl.context import gl_info
-
         report["gl"] = gl_info()
     if args.file:
         report["file"] = _describe_file(args.file)
@@ -413,20 +388,13 @@ def _describe_file(spec: str) -> dict:
     checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
     _check_not_empty(spec)
     if Path(spec).suffix.lower() == ".rk":
-        from ..io.rk import load, read_manifest
-
         load(spec)  # every check render makes: checksums, then the representation's own
         return {**read_manifest(spec), "checksums": "ok", "valid": "ok"}
-    from ..io.inputs import describe
 
     return describe(_load(spec))
 
 
 def cmd_demo(args) -> int:
-    from ..demo import build_demo
-    from ..io.atomic import check_writable
-    from ..scene.views import parse_size
-
     size = parse_size(args.size)
     check_writable(args.out, "--out", folder=True)
     sheet = build_demo(Path(args.out), tile_size=size)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..core.params import describe_default
 from ..core.transforms import MAX_COORDINATE
 from ..errors import UsageError
 
@@ -57,8 +58,6 @@ def _takes_dash(opt) -> bool:
 def _option_help(decls: list) -> str:
     """One help text for an option that several owners declare: owners sharing a text or a
     default are listed together."""
-    from ..core.params import describe_default
-
     texts: dict[str, list[str]] = {}
     defaults: dict[str, list[str]] = {}
     for owner, opt in decls:

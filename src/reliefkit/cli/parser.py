@@ -6,6 +6,10 @@ import argparse
 import sys
 
 from .. import __version__
+from ..bench import suite_names, suites
+from ..builtins import registry
+from ..core.technique import bakers, techniques
+from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
 from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW
 from .commands import cmd_bake, cmd_bench, cmd_compare, cmd_demo, cmd_info, cmd_render
@@ -35,8 +39,6 @@ ORDER = ("demo", "render", "bake", "compare", "bench", "info")
 
 def _examples(command: str | None = None) -> list[str]:
     """Example lines: the core's and every technique's, for one command or all in order."""
-    from ..core.technique import techniques
-
     table = {name: list(lines) for name, lines in CORE_EXAMPLES.items()}
     for tech in techniques():
         for name, lines in tech.cli_examples.items():
@@ -47,9 +49,6 @@ def _examples(command: str | None = None) -> list[str]:
 
 def _epilog() -> str:
     import textwrap
-
-    from ..core.technique import bakers
-    from ..scene.assets import DEMO_NAMES
 
     heightmap_kinds = [name for name, (_, b) in bakers().items() if "heightmap" in b.sources]
     inputs = ("inputs: a mesh file (.obj .ply .stl .off .gltf .glb), an .rk file, demo:NAME "
@@ -131,9 +130,7 @@ def _command(sub, name: str, summary: str, description: str):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from ..bench import suite_names, suites
-    from ..core.technique import bakers, techniques
-    from ..render.registry import core_drawables
+    core_drawables = registry().core_drawables
 
     parser = _Parser(prog="reliefkit", description="Render geometry from textures with depth.",
                      epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)

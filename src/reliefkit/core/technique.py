@@ -1,27 +1,31 @@
 """The technique registry: one `Technique` record per technique, found by kind, class or name.
 
-The core never imports a technique; `load_all()` imports `reliefkit.techniques`, whose
-``TECHNIQUES`` tuple lists them, and registers each record once. Everything generic (the CLI,
-`bake`, `render`, `compare`, `bench`, the demo, the .rk reader) asks this registry what exists.
-Duplicates (a kind, a class, a baker or bench name, a shader namespace) are refused.
+The core never imports a technique: the composition root (`reliefkit.builtins`) puts the
+core's own kind and drawable and every technique of ``reliefkit.techniques.TECHNIQUES`` into
+`REGISTRY`, once. Everything generic (the CLI, `bake`, `render`, `compare`, `bench`, the
+demo) asks this registry what exists; the .rk reader and the shader loader are handed the
+tables derived from it. Duplicates (a kind, a class, a baker or bench name, a shader
+namespace) are refused.
 """
 
 from __future__ import annotations
 
-import importlib
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from ..errors import UsageError
+from ..io.rk import Codec, CodecTable
 from .params import Option, options_of
 
 __all__ = [
     "Baker", "BenchSuite", "CompareMetric", "CompareVariant", "DemoTile", "DrawableSpec",
-    "ProgramVariant", "Technique", "register", "unregister", "load_all", "techniques",
-    "technique", "technique_of", "baker", "bakers", "drawable_spec", "bench_suite",
-    "bench_suites", "registered_kinds",
+    "ProgramVariant", "REGISTRY", "Registry", "Technique", "register", "unregister",
+    "techniques", "technique", "technique_of", "baker", "bakers", "drawable_spec",
 ]
+
+#: The core's shader namespace and the package whose ``shaders/`` folder it is.
+CORE_NAMESPACE, CORE_PACKAGE = "core", "reliefkit"
 
 
 @dataclass(frozen=True)
@@ -168,140 +172,176 @@ class Technique:
         return tuple(codec.kind for codec in self.codecs)
 
 
-_lock = threading.RLock()
-_techniques: dict[str, Technique] = {}
-_loaded = False
+class Registry:
+    """What this process knows: the core's own kinds and drawables, and every technique.
+
+    The tables the layers below look things up in are derived from it, never kept beside
+    it: `codecs` (the .rk kinds, handed to `reliefkit.io.rk`), `shader_namespaces` (handed
+    to `reliefkit.gl.shaders`) and `drawable_spec`. The composition root
+    (`reliefkit.builtins`) fills the one instance, `REGISTRY`; tests plug a toy technique
+    in and out with `register` / `unregister`.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.RLock()
+        self._techniques: dict[str, Technique] = {}
+        self._core_codecs: tuple[Codec, ...] = ()
+        self._core_drawables: tuple[DrawableSpec, ...] = ()
+        self._codecs = CodecTable()
+
+    def add_core(self, *, codecs: Iterable[Codec] = (), drawables: Iterable[DrawableSpec] = ()):
+        """The core's own kinds (``mesh``) and drawables (the ground-truth mesh)."""
+        with self._lock:
+            specs = (*self._core_drawables, *drawables)
+            if len({s.cls for s in specs}) < len(specs):
+                raise UsageError("a core drawable is registered twice for one class")
+            core_codecs = (*self._core_codecs, *codecs)
+            self._codecs = _kinds(core_codecs, self._techniques.values())
+            self._core_codecs = core_codecs
+            self._core_drawables = specs
+
+    def register(self, tech: Technique) -> None:
+        """Add a technique; refuses anything that another technique already claims."""
+        if not isinstance(tech, Technique):
+            raise UsageError(f"register() needs a Technique, got {type(tech).__name__}")
+        with self._lock:
+            if tech.name in self._techniques or tech.name == CORE_NAMESPACE:
+                raise UsageError(f"technique {tech.name!r} is already registered")
+            self._refuse_duplicates(tech)
+            self._codecs = _kinds(self._core_codecs, (*self._techniques.values(), tech))
+            self._techniques[tech.name] = tech
+
+    def unregister(self, name: str) -> None:
+        """Remove a technique and its kinds (for tests that plug in a toy technique)."""
+        with self._lock:
+            if self._techniques.pop(name, None) is not None:
+                self._codecs = _kinds(self._core_codecs, self._techniques.values())
+
+    def techniques(self) -> tuple[Technique, ...]:
+        return tuple(self._techniques.values())
+
+    def codecs(self) -> CodecTable:
+        """Every .rk kind: the core's and the techniques' (what `reliefkit.io.rk` reads);
+        derived again whenever a technique comes or goes."""
+        return self._codecs
+
+    def shader_namespaces(self) -> dict[str, str]:
+        """Shader namespace -> the package whose ``shaders/`` folder it is."""
+        return {CORE_NAMESPACE: CORE_PACKAGE,
+                **{t.name: t.package for t in self._techniques.values()}}
+
+    def drawable_spec(self, obj) -> tuple[Technique | None, DrawableSpec | None]:
+        """(technique, spec) drawing ``obj``; the core's own drawables have technique None."""
+        for spec in self._core_drawables:
+            if isinstance(obj, spec.cls):
+                return None, spec
+        return self._owner(obj, "drawables")
+
+    def technique_of(self, obj) -> Technique | None:
+        """The technique whose representation ``obj`` is (None for meshes, unknown objects)."""
+        return self._owner(obj, "representations")[0]
+
+    def core_drawables(self) -> tuple[DrawableSpec, ...]:
+        return self._core_drawables
+
+    def drawable_specs(self) -> tuple[DrawableSpec, ...]:
+        """Every drawable: the core's first, then the techniques'."""
+        return (*self._core_drawables, *(d for t in self._techniques.values()
+                                         for d in t.drawables))
+
+    def _owner(self, obj, attr: str):
+        for tech in self._techniques.values():
+            for spec in getattr(tech, attr):
+                cls = spec if isinstance(spec, type) else spec.cls
+                if isinstance(obj, cls):
+                    return tech, spec
+        return None, None
+
+    def _refuse_duplicates(self, tech: Technique) -> None:
+        others = self._techniques.values()
+        taken = {
+            "kind": set(self._codecs.kinds),
+            "baker": {b.name for t in others for b in t.bakers},
+            "bench suite": {s.name for t in others for s in t.bench_suites},
+            "representation class": {c for t in others for c in t.representations},
+            "drawable class": {d.cls for t in others for d in t.drawables},
+        }
+        mine = {
+            "kind": [c.kind for c in tech.codecs],
+            "baker": [b.name for b in tech.bakers],
+            "bench suite": [s.name for s in tech.bench_suites],
+            "representation class": list(tech.representations),
+            "drawable class": [d.cls for d in tech.drawables],
+        }
+        for what, names in mine.items():
+            for name in names:
+                label = getattr(name, "__qualname__", name)
+                if name in taken[what]:
+                    raise UsageError(f"technique {tech.name!r}: {what} {label!r} is already "
+                                     "registered by another technique")
+                if names.count(name) > 1:
+                    raise UsageError(f"technique {tech.name!r} declares {what} {label!r} twice")
+        for spec in tech.drawables:
+            spec.option_list  # noqa: B018 - validates the option dataclass now, not at render time
+        for b in tech.bakers:
+            b.options  # noqa: B018
+        self._check_shared_flags(tech)
+
+    def _check_shared_flags(self, tech: Technique) -> None:
+        """Two bakers (of any techniques) may share a flag only if it parses the same way."""
+        seen: dict[str, Option] = {}
+        for other in (*self._techniques.values(), tech):
+            for b in other.bakers:
+                for opt in b.options:
+                    first = seen.setdefault(opt.name, opt)
+                    if first.kind != opt.kind:
+                        raise UsageError(f"bake option --{opt.flag} is a {opt.kind} for baker "
+                                         f"{b.name!r} but a {first.kind} elsewhere; rename one")
+
+
+def _kinds(core_codecs, techniques) -> CodecTable:
+    """The codec table of the core's kinds and the techniques' (conflicts refused)."""
+    return CodecTable((*core_codecs, *(c for t in techniques for c in t.codecs)))
+
+
+#: The one registry; `reliefkit.builtins.registry()` fills it with the built-ins.
+REGISTRY = Registry()
 
 
 def register(tech: Technique) -> None:
-    """Add a technique; refuses anything that another technique already claims."""
-    from ..gl.shaders import register_namespace
-    from ..io import rk
-
-    if not isinstance(tech, Technique):
-        raise UsageError(f"register() needs a Technique, got {type(tech).__name__}")
-    with _lock:
-        if tech.name in _techniques or tech.name == "core":
-            raise UsageError(f"technique {tech.name!r} is already registered")
-        _refuse_duplicates(tech)
-        for codec in tech.codecs:
-            rk.register(codec)
-        register_namespace(tech.name, tech.package)
-        _techniques[tech.name] = tech
-
-
-def _refuse_duplicates(tech: Technique) -> None:
-    from ..io import rk
-
-    taken = {
-        "kind": set(rk.registered_kinds(load=False)),
-        "baker": {b.name for t in _techniques.values() for b in t.bakers},
-        "bench suite": {s.name for t in _techniques.values() for s in t.bench_suites},
-        "representation class": {c for t in _techniques.values() for c in t.representations},
-        "drawable class": {d.cls for t in _techniques.values() for d in t.drawables},
-    }
-    mine = {
-        "kind": [c.kind for c in tech.codecs],
-        "baker": [b.name for b in tech.bakers],
-        "bench suite": [s.name for s in tech.bench_suites],
-        "representation class": list(tech.representations),
-        "drawable class": [d.cls for d in tech.drawables],
-    }
-    for what, names in mine.items():
-        for name in names:
-            label = getattr(name, "__qualname__", name)
-            if name in taken[what]:
-                raise UsageError(f"technique {tech.name!r}: {what} {label!r} is already "
-                                 "registered by another technique")
-            if names.count(name) > 1:
-                raise UsageError(f"technique {tech.name!r} declares {what} {label!r} twice")
-    for spec in tech.drawables:
-        spec.option_list  # noqa: B018 - validates the option dataclass now, not at render time
-    for b in tech.bakers:
-        b.options  # noqa: B018
-    _check_shared_flags(tech)
-
-
-def _check_shared_flags(tech: Technique) -> None:
-    """Two bakers (of any techniques) may share a flag only if it parses the same way."""
-    seen: dict[str, Option] = {}
-    for other in (*_techniques.values(), tech):
-        for b in other.bakers:
-            for opt in b.options:
-                first = seen.setdefault(opt.name, opt)
-                if first.kind != opt.kind:
-                    raise UsageError(f"bake option --{opt.flag} is a {opt.kind} for baker "
-                                     f"{b.name!r} but a {first.kind} elsewhere; rename one")
+    """Add a technique to `REGISTRY` (see `Registry.register`)."""
+    REGISTRY.register(tech)
 
 
 def unregister(name: str) -> None:
-    """Remove a technique and its kinds (for tests that plug in a toy technique)."""
-    from ..gl.shaders import unregister_namespace
-    from ..io import rk
-
-    with _lock:
-        tech = _techniques.pop(name, None)
-        if tech is not None:
-            for codec in tech.codecs:
-                rk.unregister(codec.kind)
-            unregister_namespace(name)
-
-
-def load_all() -> tuple[Technique, ...]:
-    """Register every built-in technique (once per process) and return all registered."""
-    global _loaded
-    with _lock:
-        if not _loaded:
-            _loaded = True
-            try:
-                builtin = importlib.import_module("reliefkit.techniques").TECHNIQUES
-                for tech in builtin:
-                    if tech.name not in _techniques:
-                        register(tech)
-            except BaseException:
-                _loaded = False
-                raise
-        return tuple(_techniques.values())
+    """Remove a technique from `REGISTRY` (see `Registry.unregister`)."""
+    REGISTRY.unregister(name)
 
 
 def techniques() -> tuple[Technique, ...]:
-    return load_all()
+    return REGISTRY.techniques()
 
 
 def technique(name: str) -> Technique:
-    load_all()
-    if name not in _techniques:
-        raise UsageError(f"unknown technique {name!r} (known: {', '.join(_techniques)})")
-    return _techniques[name]
-
-
-def _owner(obj, attr: str):
-    for tech in load_all():
-        for spec in getattr(tech, attr):
-            cls = spec if isinstance(spec, type) else spec.cls
-            if isinstance(obj, cls):
-                return tech, spec
-    return None, None
+    table = {t.name: t for t in REGISTRY.techniques()}
+    if name not in table:
+        raise UsageError(f"unknown technique {name!r} (known: {', '.join(table)})")
+    return table[name]
 
 
 def technique_of(obj) -> Technique | None:
     """The technique whose representation ``obj`` is (None for meshes and unknown objects)."""
-    return _owner(obj, "representations")[0]
+    return REGISTRY.technique_of(obj)
 
 
 def drawable_spec(obj) -> tuple[Technique | None, DrawableSpec | None]:
     """(technique, spec) drawing ``obj``; the core's own drawables have technique None."""
-    from ..render.registry import core_drawables
-
-    for spec in core_drawables():
-        if isinstance(obj, spec.cls):
-            return None, spec
-    return _owner(obj, "drawables")
+    return REGISTRY.drawable_spec(obj)
 
 
 def bakers() -> dict[str, tuple[Technique, Baker]]:
     """Every baker by its ``--as`` name, in registration order."""
-    return {b.name: (t, b) for t in load_all() for b in t.bakers}
+    return {b.name: (t, b) for t in REGISTRY.techniques() for b in t.bakers}
 
 
 def baker(name: str) -> tuple[Technique, Baker]:
@@ -311,20 +351,3 @@ def baker(name: str) -> tuple[Technique, Baker]:
                          f"{', '.join(table) or 'none'})")
     return table[name]
 
-
-def bench_suites() -> dict[str, tuple[Technique, BenchSuite]]:
-    return {s.name: (t, s) for t in load_all() for s in t.bench_suites}
-
-
-def bench_suite(name: str) -> BenchSuite:
-    table = bench_suites()
-    if name not in table:
-        raise UsageError(f"unknown benchmark {name!r} (choose from {', '.join(table)})")
-    return table[name][1]
-
-
-def registered_kinds() -> tuple[str, ...]:
-    """Every .rk kind this process reads and writes (built-in techniques loaded first)."""
-    from ..io import rk
-
-    return rk.registered_kinds()

@@ -26,10 +26,12 @@ from __future__ import annotations
 import posixpath
 import re
 from collections import OrderedDict
+from collections.abc import Callable, Mapping
 from functools import cache
 from importlib import resources
 
 from ..errors import GPUError
+from .targets import FRAME_ATTACHMENTS
 
 STAGES = ("VERTEX_SHADER", "GEOMETRY_SHADER", "FRAGMENT_SHADER", "COMPUTE_SHADER")
 DEFAULT_VERSION = "330 core"
@@ -48,21 +50,19 @@ _VERSION = re.compile(r"^//!\s*version:\s*(\d+)\s*$", re.M)
 # Mesa: "0:12(5): error: ..." ; NVIDIA: "0(12) : error C0000: ..."
 _ERROR_LOC = re.compile(r"^\s*(?:ERROR:\s*)?(\d+)[:(](\d+)\)?(?:\(\d+\))?\s*:\s*(.*)$", re.M)
 
-_namespaces: dict[str, str] = {"core": "reliefkit"}
+
+def _core_only() -> Mapping[str, str]:
+    return {"core": "reliefkit"}
 
 
-def register_namespace(name: str, package: str) -> None:
-    """Make ``package``'s ``shaders/`` folder loadable as ``name:...``; duplicates refused."""
-    if _namespaces.get(name, package) != package:
-        raise GPUError(f"shader namespace {name!r} is already taken by {_namespaces[name]}")
-    _namespaces[name] = package
-    _read_text.cache_clear()
+_namespace_table: Callable[[], Mapping[str, str]] = _core_only
 
 
-def unregister_namespace(name: str) -> None:
-    if name != "core":
-        _namespaces.pop(name, None)
-        _read_text.cache_clear()
+def use_namespaces(table: Callable[[], Mapping[str, str]]) -> None:
+    """Where namespaces are found: ``table()`` maps each to the package whose ``shaders/``
+    folder it is, asked on each lookup (the composition root hands over the registry's)."""
+    global _namespace_table
+    _namespace_table = table
 
 
 def qualify(name: str, base: str | None = None) -> str:
@@ -85,17 +85,18 @@ def read_shader_file(name: str) -> str:
     return _read_text(qualify(name))
 
 
-@cache
 def _read_text(name: str) -> str:
     ns, path = name.split(":", 1)
-    if ns not in _namespaces:
-        from ..core.technique import load_all
-
-        load_all()
-    if ns not in _namespaces:
+    namespaces = _namespace_table()
+    if ns not in namespaces:
         raise GPUError(f"unknown shader namespace {ns!r} in {name!r} (known: "
-                       f"{', '.join(sorted(_namespaces))})")
-    file = resources.files(_namespaces[ns]).joinpath("shaders", *path.split("/"))
+                       f"{', '.join(sorted(namespaces))})")
+    return _read_package_file(namespaces[ns], ns, path)
+
+
+@cache
+def _read_package_file(package: str, ns: str, path: str) -> str:
+    file = resources.files(package).joinpath("shaders", *path.split("/"))
     if not file.is_file():
         raise GPUError(f"shader file not found: {ns}:{path}")
     return file.read_text(encoding="utf-8")
@@ -141,8 +142,6 @@ def _define_lines(defines: dict) -> list[str]:
 
 def stage_sources(name: str, defines: dict | None = None, *, es: bool = False) -> dict[str, str]:
     """Full source per stage present in the file, keyed by moderngl's argument names."""
-    from .targets import FRAME_ATTACHMENTS
-
     name = qualify(name)
     defines = dict(defines or {})
     unknown = set(defines) - allowed_defines(name)

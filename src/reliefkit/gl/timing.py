@@ -7,20 +7,16 @@ import time
 from collections.abc import Callable, Sequence
 
 
-def gpu_time_ms(ctx, draw: Callable[[], None], *, repeats: int = 5, warmup: int = 1) -> dict:
-    """Time ``draw`` with GL_TIME_ELAPSED queries and wall clock; medians in milliseconds.
-
-    Wall time includes ``ctx.finish()`` so it is meaningful on software rasterizers, whose
-    timer queries may only measure command submission.
-    """
-    return gpu_times_ms(ctx, [draw], repeats=repeats, warmup=warmup)[0]
-
-
 def gpu_times_ms(ctx, draws: Sequence[Callable[[], None]], *, repeats: int = 5,
                  warmup: int = 1) -> list[dict]:
-    """`gpu_time_ms` of several draws, interleaved: each of the ``repeats`` rounds times every
-    draw once, so a slow drift of the machine lands on all of them alike and their ratios
-    are steadier than those of timings taken one after the other."""
+    """Time each draw with GL_TIME_ELAPSED queries and wall clock; medians in milliseconds.
+
+    The draws are interleaved: each of the ``repeats`` rounds times every draw once, so a
+    slow drift of the machine lands on all of them alike and their ratios are steadier than
+    those of timings taken one after the other. Wall time includes ``ctx.finish()`` so it is
+    meaningful on software rasterizers, whose timer queries may only measure command
+    submission.
+    """
     for _ in range(warmup):
         for draw in draws:
             draw()

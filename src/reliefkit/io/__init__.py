@@ -1,1 +1,2 @@
-"""Files: the .rk container (`rk`), the mesh kind, the one atomic writer, opening inputs."""
+"""Files: the .rk container (`rk`), the mesh kind, the mesh files (`meshes`), the one atomic
+writer, opening inputs."""

@@ -10,20 +10,23 @@ import hashlib
 import os
 from pathlib import Path
 
+from ..errors import MeshError, UsageError
+from ..scene.assets import make_asset
+from ..scene.mesh import RenderMesh
+from .rk import load
+
 DEMO_PREFIX = "demo:"
 
 
 def load_input(spec: str):
     """``demo:NAME`` -> a procedural RenderMesh, ``*.rk`` -> its representation, else a mesh."""
     if not _is_demo(spec) and Path(spec).suffix.lower() == ".rk":
-        from .rk import load
-
         return load(spec)
     return load_mesh(spec)
 
 
 def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
-    """A mesh file (see `reliefkit.scene.loader.load_mesh`), or ``demo:NAME``: the procedural
+    """A mesh file (see `reliefkit.io.meshes.load_mesh`), or ``demo:NAME``: the procedural
     asset or surface the CLI calls so (`reliefkit.scene.assets.make_asset`).
 
     `name` labels the mesh in pictures and messages (default: the file name without its
@@ -31,12 +34,9 @@ def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
     loaded or an unknown demo name.
     """
     if not _is_demo(spec):
-        from ..scene.loader import load_mesh as load_mesh_file
+        from .meshes import load_mesh as load_mesh_file  # trimesh: slow to import
 
         return load_mesh_file(spec, name=name)
-    from ..errors import MeshError, UsageError
-    from ..scene.assets import make_asset
-    from ..scene.mesh import RenderMesh
 
     try:
         mesh = make_asset(spec[len(DEMO_PREFIX):])
@@ -56,8 +56,6 @@ def _is_demo(spec) -> bool:
 
 def describe(obj) -> dict:
     """A short JSON-able summary for `reliefkit info`."""
-    from ..scene.mesh import RenderMesh
-
     if isinstance(obj, RenderMesh):
         lo, hi = obj.bounds
         return {"kind": "mesh", "name": obj.name, "vertices": len(obj.positions),

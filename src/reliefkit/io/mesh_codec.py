@@ -23,7 +23,7 @@ import numpy as np
 from ..bake.uv_atlas import ATLAS_SIZE, MAX_MATERIALS, MaterialAtlas
 from ..errors import FormatError
 from ..scene.mesh import ALPHA_MODES, Material, RenderMesh
-from .rk import ArraySpec, Codec, register
+from .rk import ArraySpec, Codec
 
 #: Materials 0 .. MAX_TEXTURED - 1 can keep a texture in a .rk file.
 MAX_TEXTURED = 64
@@ -112,7 +112,8 @@ def _rows(dtype: str, cols: int, **options) -> ArraySpec:
 
 _TEXTURE = ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False)
 
-register(Codec(
+#: The core's ``mesh`` kind; the composition root (`reliefkit.builtins`) registers it.
+MESH_CODEC = Codec(
     kind="mesh",
     cls=RenderMesh,
     arrays={
@@ -132,7 +133,7 @@ register(Codec(
     to_arrays=_mesh_to_arrays,
     from_arrays=_mesh_from_arrays,
     version=3,
-))
+)
 
 
 #: The arrays of a base mesh that a representation builds its volume on (a shell, a

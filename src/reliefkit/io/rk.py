@@ -7,8 +7,9 @@ version, the representation *kind* and the kind's version, the bake parameters, 
 file's SHA-256 and, per array, its dtype, shape and the SHA-256 of its (uncompressed)
 ``.npy`` member.
 
-Kinds are a registry of `Codec` objects: a representation module registers one and `save` /
-`load` find it, by the representation's type and by the manifest's ``kind``. Writing is
+Kinds are `Codec` objects in a `CodecTable`: `save` / `load` find one by the
+representation's type and by the manifest's ``kind``, in the table they are given or, by
+default, in the one the composition root handed over (`use_codecs`). Writing is
 atomic (temp file in the same folder, fsync, ``os.replace``) and deterministic (fixed dates,
 order and deflate level). Reading validates everything it can from the zip directory, the
 manifest and the ``.npy`` headers *before* allocating any array, then streams each member
@@ -37,11 +38,12 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy
 
+from .. import __version__
 from ..errors import FormatError, ReliefkitError
 from .atomic import atomic_path
 
 __all__ = [
-    "ArraySpec", "Codec", "RkFile", "register", "unregister", "registered_kinds",
+    "ArraySpec", "Codec", "CodecTable", "RkFile", "use_codecs",
     "save", "load", "read_manifest", "write_rk", "read_rk", "file_sha256", "array_bytes",
     "FORMAT_NAME", "FORMAT_VERSION", "DEFAULT_MAX_BYTES",
 ]
@@ -72,7 +74,7 @@ _NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _SHA_RE = re.compile(r"[0-9a-f]{64}\Z")
 
 
-# --------------------------------------------------------------------------- registry
+# ------------------------------------------------------------------------------ kinds
 
 
 @dataclass(frozen=True)
@@ -140,48 +142,77 @@ class RkFile:
     arrays: dict[str, np.ndarray]
 
 
-_CODECS: dict[str, Codec] = {}
-_BY_CLASS: dict[type, Codec] = {}
+class CodecTable:
+    """The kinds a reader or writer knows: by manifest ``kind`` and by representation class.
 
-
-def register(codec: Codec) -> None:
-    """Make a representation kind loadable and savable.
-
-    Registering the same kind for the same class again replaces the codec (module reloads);
-    a kind or class that is already taken by another raises `FormatError`.
+    Immutable; built from codecs, each checked (kind name, version, array specs), and a kind
+    or a class claimed twice refused with `FormatError`. The registry
+    (`reliefkit.core.technique.Registry.codecs`) derives the process's table from the
+    techniques it holds; `use_codecs` hands it to the functions here.
     """
-    if not isinstance(codec, Codec):
-        raise FormatError(f"register() needs a Codec, got {type(codec).__name__}")
-    if not isinstance(codec.kind, str) or not _KIND_RE.match(codec.kind):
-        raise FormatError(f"invalid kind {codec.kind!r}: use lower-case letters, digits, _.-")
-    if type(codec.version) is not int or codec.version < 1:
-        raise FormatError(f"kind '{codec.kind}': version must be an int >= 1")
-    for name, spec in codec.arrays.items():
-        _check_spec(codec.kind, name, spec)
-    old = _CODECS.get(codec.kind)
-    if old is not None and old.cls is not codec.cls:
-        raise FormatError(f"kind '{codec.kind}' is already registered for "
-                          f"{old.cls.__qualname__}; pick another kind name")
-    other = _BY_CLASS.get(codec.cls)
-    if other is not None and other.kind != codec.kind:
-        raise FormatError(f"{codec.cls.__qualname__} is already registered as kind "
-                          f"'{other.kind}'; unregister it first")
-    _CODECS[codec.kind] = codec
-    _BY_CLASS[codec.cls] = codec
+
+    def __init__(self, codecs: Iterable[Codec] = ()) -> None:
+        self._by_kind: dict[str, Codec] = {}
+        self._by_class: dict[type, Codec] = {}
+        for codec in codecs:
+            self._add(codec)
+
+    def _add(self, codec: Codec) -> None:
+        if not isinstance(codec, Codec):
+            raise FormatError(f"a codec table needs Codecs, got {type(codec).__name__}")
+        if not isinstance(codec.kind, str) or not _KIND_RE.match(codec.kind):
+            raise FormatError(f"invalid kind {codec.kind!r}: use lower-case letters, digits, _.-")
+        if type(codec.version) is not int or codec.version < 1:
+            raise FormatError(f"kind '{codec.kind}': version must be an int >= 1")
+        for name, spec in codec.arrays.items():
+            _check_spec(codec.kind, name, spec)
+        old = self._by_kind.get(codec.kind)
+        if old is not None:
+            raise FormatError(f"kind '{codec.kind}' is already registered for "
+                              f"{old.cls.__qualname__}; pick another kind name")
+        other = self._by_class.get(codec.cls)
+        if other is not None:
+            raise FormatError(f"{codec.cls.__qualname__} is already registered as kind "
+                              f"'{other.kind}'; unregister it first")
+        self._by_kind[codec.kind] = codec
+        self._by_class[codec.cls] = codec
+
+    def __iter__(self) -> Iterator[Codec]:
+        return iter(self._by_kind.values())
+
+    @property
+    def kinds(self) -> tuple[str, ...]:
+        """The kinds it reads and writes, sorted."""
+        return tuple(sorted(self._by_kind))
+
+    def for_kind(self, kind) -> Codec:
+        codec = self._by_kind.get(kind) if isinstance(kind, str) else None
+        if codec is None:
+            known = ", ".join(self.kinds) or "none"
+            raise FormatError(f"unknown kind {kind!r} (known kinds: {known}); register the "
+                              "technique that reads it, or upgrade reliefkit")
+        return codec
+
+    def for_object(self, rep) -> Codec:
+        for cls in type(rep).__mro__:
+            if cls in self._by_class:
+                return self._by_class[cls]
+        raise FormatError(f"cannot save a {type(rep).__qualname__}: no .rk kind is registered "
+                          "for it; register the technique that declares its Codec")
 
 
-def unregister(kind: str) -> None:
-    """Remove a registered kind (no error if it is not registered)."""
-    codec = _CODECS.pop(kind, None)
-    if codec is not None:
-        _BY_CLASS.pop(codec.cls, None)
+_codec_table: Callable[[], CodecTable] = CodecTable
 
 
-def registered_kinds(*, load: bool = True) -> tuple[str, ...]:
-    """The kinds this process can read and write, sorted (built-in ones loaded first)."""
-    if load:
-        _load_builtin_codecs()
-    return tuple(sorted(_CODECS))
+def use_codecs(table: Callable[[], CodecTable]) -> None:
+    """Where the functions here find their kinds when they are not given ``codecs``:
+    ``table()`` is asked on each call (the composition root hands over the registry's)."""
+    global _codec_table
+    _codec_table = table
+
+
+def _table(codecs: CodecTable | None) -> CodecTable:
+    return codecs if codecs is not None else _codec_table()
 
 
 def _check_spec(kind: str, name: str, spec: ArraySpec) -> None:
@@ -204,33 +235,6 @@ def _check_spec(kind: str, name: str, spec: ArraySpec) -> None:
 
 def _ndims(spec: ArraySpec) -> tuple[int, ...]:
     return spec.ndim if isinstance(spec.ndim, tuple) else (spec.ndim,)
-
-
-def _load_builtin_codecs() -> None:
-    """Register the built-in kinds: the mesh's and every registered technique's."""
-    from ..core.technique import load_all
-    from . import mesh_codec  # noqa: F401
-
-    load_all()
-
-
-def _codec_for_kind(kind) -> Codec:
-    _load_builtin_codecs()
-    codec = _CODECS.get(kind) if isinstance(kind, str) else None
-    if codec is None:
-        known = ", ".join(registered_kinds()) or "none"
-        raise FormatError(f"unknown kind {kind!r} (known kinds: {known}); import the module "
-                          "that registers it, or upgrade reliefkit")
-    return codec
-
-
-def _codec_for_object(rep) -> Codec:
-    _load_builtin_codecs()
-    for cls in type(rep).__mro__:
-        if cls in _BY_CLASS:
-            return _BY_CLASS[cls]
-    raise FormatError(f"cannot save a {type(rep).__qualname__}: no .rk kind is registered for "
-                      "it; register a Codec with reliefkit.io.rk.register")
 
 
 # --------------------------------------------------------------------- shared checks
@@ -316,13 +320,14 @@ def _check_source_hash(value) -> None:
 # --------------------------------------------------------------------------- writing
 
 
-def array_bytes(representation) -> dict[str, int]:
+def array_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str, int]:
     """Bytes of each array a representation stores (its memory, uncompressed), by name."""
-    arrays, _ = _codec_for_object(representation).to_arrays(representation)
+    arrays, _ = _table(codecs).for_object(representation).to_arrays(representation)
     return {name: int(np.asarray(a).nbytes) for name, a in arrays.items() if a is not None}
 
 
-def save(path, representation, *, source_hash: str | None = None) -> Path:
+def save(path, representation, *, source_hash: str | None = None,
+         codecs: CodecTable | None = None) -> Path:
     """Write a representation to an .rk file atomically.
 
     Parameters
@@ -330,18 +335,20 @@ def save(path, representation, *, source_hash: str | None = None) -> Path:
     path : destination file; its folder must exist.
     representation : an object whose type (or a base class) has a registered `Codec`.
     source_hash : SHA-256 hex of the mesh or heightmap it was baked from (`file_sha256`).
+    codecs : the kinds known (default: the table handed to `use_codecs`).
 
     Returns
     -------
     Path : the path written.
     """
-    codec = _codec_for_object(representation)
+    codecs = _table(codecs)
+    codec = codecs.for_object(representation)
     arrays, params = codec.to_arrays(representation)
-    return write_rk(path, codec.kind, arrays, params, source_hash=source_hash)
+    return write_rk(path, codec.kind, arrays, params, source_hash=source_hash, codecs=codecs)
 
 
 def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
-             source_hash: str | None = None) -> Path:
+             source_hash: str | None = None, codecs: CodecTable | None = None) -> Path:
     """Validate arrays and params against a registered kind, then write atomically.
 
     Arrays are stored C-contiguous and little-endian; values are kept bit for bit. On any
@@ -349,7 +356,7 @@ def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
     """
     path = Path(path)
     try:
-        codec = _codec_for_kind(kind)
+        codec = _table(codecs).for_kind(kind)
         arrays = _prepare_arrays(codec, arrays)
         if not isinstance(params, dict):
             raise FormatError(f"params must be a dict, got {type(params).__name__}")
@@ -357,7 +364,6 @@ def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
         _check_source_hash(source_hash)
     except FormatError as exc:
         raise FormatError(f"cannot write {path}: {exc}") from None
-    from .. import __version__
 
     head = {"format": FORMAT_NAME, "format_version": FORMAT_VERSION, "kind": codec.kind,
             "kind_version": codec.version, "params": params, "source_hash": source_hash,
@@ -466,7 +472,7 @@ class _Member:
         return math.prod(self.shape) * self.dtype.itemsize
 
 
-def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
+def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None = None):
     """Read an .rk file and rebuild its representation.
 
     Parameters
@@ -474,6 +480,7 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
     path : the .rk file.
     max_bytes : refuse files whose arrays declare more bytes than this in total
         (uncompressed, as the arrays will be in memory).
+    codecs : the kinds known (default: the table handed to `use_codecs`).
 
     Raises
     ------
@@ -481,8 +488,9 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
         the representation rejects its data (the message names the file).
     """
     path = Path(path)
-    rk = read_rk(path, max_bytes=max_bytes)
-    codec = _codec_for_kind(rk.kind)
+    codecs = _table(codecs)
+    rk = read_rk(path, max_bytes=max_bytes, codecs=codecs)
+    codec = codecs.for_kind(rk.kind)
     try:
         return codec.from_arrays(dict(rk.arrays), dict(rk.params))
     except FormatError as exc:
@@ -492,7 +500,7 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES):
                           "forged") from exc
 
 
-def read_manifest(path) -> dict:
+def read_manifest(path, *, codecs: CodecTable | None = None) -> dict:
     """The manifest of an .rk file, after every check that needs no array data.
 
     The manifest, the zip directory and every ``.npy`` header are validated; array data and
@@ -500,11 +508,12 @@ def read_manifest(path) -> dict:
     any file size.
     """
     with _open_rk(path) as archive:
-        manifest, _, _ = _inspect(archive, None)
+        manifest, _, _ = _inspect(archive, None, _table(codecs))
     return manifest
 
 
-def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> RkFile:
+def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES,
+            codecs: CodecTable | None = None) -> RkFile:
     """Validate an .rk file completely and return its arrays without building the object.
 
     Checks run before any array is allocated: zip directory and local headers, manifest,
@@ -513,7 +522,7 @@ def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> RkFile:
     SHA-256 and CRC-32 verified and its length exact, and finite-required arrays are checked.
     """
     with _open_rk(path) as archive:
-        manifest, codec, members = _inspect(archive, max_bytes)
+        manifest, codec, members = _inspect(archive, max_bytes, _table(codecs))
         arrays = {name: _read_member(archive, name, m) for name, m in members.items()}
         for name, arr in arrays.items():
             if codec.arrays[name].finite:
@@ -550,11 +559,11 @@ def _open_rk(path):
                           "with reliefkit") from exc
 
 
-def _inspect(archive: _Archive, max_bytes: int | None):
+def _inspect(archive: _Archive, max_bytes: int | None, codecs: CodecTable):
     """All checks that need no array data; returns (manifest, codec, members)."""
     infos = _member_table(archive.zf)
     manifest = _read_manifest_json(archive, infos)
-    codec = _check_manifest(manifest)
+    codec = _check_manifest(manifest, codecs)
     entries = manifest["arrays"]
     _check_array_set(codec, entries)
     _check_member_set(entries, infos)
@@ -751,14 +760,14 @@ def _read_manifest_json(archive: _Archive, infos: dict) -> dict:
     return manifest
 
 
-def _check_manifest(manifest: dict) -> Codec:
+def _check_manifest(manifest: dict, codecs: CodecTable) -> Codec:
     """The manifest's top-level fields, in order; returns the kind's codec."""
     if manifest.get("format") != FORMAT_NAME:
         raise FormatError(f"manifest format is {manifest.get('format')!r}, not "
                           f"'{FORMAT_NAME}'; this is not a .rk file")
     version = manifest.get("format_version")
     _check_version(version, FORMAT_VERSION, "format_version")
-    codec = _codec_for_kind(manifest.get("kind"))
+    codec = codecs.for_kind(manifest.get("kind"))
     _check_version(manifest.get("kind_version"), codec.version,
                    f"kind '{codec.kind}' version")
     if not isinstance(manifest.get("params"), dict):

@@ -17,7 +17,6 @@ from ..core.params import param
 from ..core.technique import DrawableSpec, ProgramVariant
 from ..scene.mesh import Material, RenderMesh
 from .plan import Attribute, DrawPlan, Geometry, MultiPass, Program, Texture
-from .registry import register_core_drawable
 
 PROGRAM = "core:mesh.glsl"
 MESH_PROGRAMS = tuple(  # the draw-path variants (compiled as GLSL ES by the tests too)
@@ -107,9 +106,5 @@ def material_uniforms(material: Material) -> dict:
             "u_alpha_cutoff": float(material.alpha_cutoff)}
 
 
-def _register() -> None:
-    register_core_drawable(DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions,
-                                        planned=True))
-
-
-_register()
+#: The core's ground-truth drawable; the composition root (`reliefkit.builtins`) registers it.
+MESH_DRAWABLE = DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions, planned=True)

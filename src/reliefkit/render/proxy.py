@@ -14,7 +14,6 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 from ..errors import UsageError
 
@@ -105,6 +104,8 @@ def convex_proxy(planes: np.ndarray, near=(0.0, 0.0, 0.0)) -> Proxy:
     solvers' tolerances are absolute, which far from the world origin would swamp the box,
     and for a tiny box (a mesh scaled by 1e-9) exceed it.
     """
+    from scipy.spatial import ConvexHull, HalfspaceIntersection  # scipy: slow to import
+
     planes = _normalise(np.asarray(planes, dtype=np.float64))
     near = np.asarray(near, dtype=np.float64)
     around_near = _moved(planes, near)

@@ -9,33 +9,14 @@ a ``method`` option with different choices; an option nobody declares is an erro
 from __future__ import annotations
 
 from ..core import params as _params
+from ..core.technique import REGISTRY
 from ..errors import UsageError
-
-_core_specs: list = []
-
-
-def register_core_drawable(spec) -> None:
-    """The core's own drawables (the ground-truth mesh); techniques register through theirs."""
-    if any(s.cls is spec.cls for s in _core_specs):
-        raise UsageError(f"a core drawable for {spec.cls.__name__} is already registered")
-    _core_specs.append(spec)
-
-
-def core_drawables() -> tuple:
-    from . import mesh  # noqa: F401  (registers the ground-truth drawable)
-
-    return tuple(_core_specs)
 
 
 def _spec_for(obj):
-    from ..core.technique import drawable_spec
-
-    tech, spec = drawable_spec(obj)
+    tech, spec = REGISTRY.drawable_spec(obj)
     if spec is None:
-        from ..core.technique import techniques
-
-        known = [s.cls.__name__ for s in core_drawables()] + [
-            d.cls.__name__ for t in techniques() for d in t.drawables]
+        known = [s.cls.__name__ for s in REGISTRY.drawable_specs()]
         raise UsageError(f"no renderer for {type(obj).__name__} (known: {', '.join(known)})")
     return (tech.name if tech else "mesh"), spec
 

@@ -6,14 +6,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.transforms import translation
+from ..scene.camera import Camera
+
 SHADOW_SIZE = 1024
 SHADOW_UNIT = 9  # texture unit of u_shadow_map (a drawable's own textures stay below it)
 
 
 def light_camera(bounds, light, size: int = SHADOW_SIZE):
     """An orthographic camera looking along the light over ``bounds`` (its shadow map)."""
-    from ..scene.camera import Camera
-
     lo, hi = np.asarray(bounds, np.float64)
     centre, radius = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo)) or 1.0
     towards = np.asarray(light.direction, np.float64)
@@ -29,8 +30,6 @@ def render_shadow_map(ctx, bounds, light, origin, draw_depth, size: int = SHADOW
     stored relative to ``origin`` (float64 world point). Leaves the framebuffer and the
     enabled state to the caller to restore."""
     import moderngl
-
-    from ..core.transforms import translation
 
     cam = light_camera(bounds, light, size)
     depth = ctx.depth_texture(cam.size)

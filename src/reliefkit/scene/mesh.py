@@ -1,6 +1,6 @@
 """`RenderMesh` and its `Material`s: what every renderer and baker consumes, validated.
 
-Loading from files (`load_mesh`) lives in :mod:`reliefkit.scene.loader`.
+Loading from files (`load_mesh`) lives in :mod:`reliefkit.io.meshes`.
 """
 
 from __future__ import annotations

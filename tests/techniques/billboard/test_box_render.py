@@ -9,7 +9,7 @@ import pytest
 from scipy.ndimage import distance_transform_edt
 
 from reliefkit.colorspace import srgb_decode
-from reliefkit.core.technique import Technique, drawable_spec, load_all, register, unregister
+from reliefkit.core.technique import Technique, drawable_spec, register, unregister
 from reliefkit.errors import GPUError
 from reliefkit.render import render
 from reliefkit.scene.camera import Camera
@@ -31,7 +31,6 @@ SIZE = (96, 96)
 def boxes_drawable(gl):
     """Renders boxes through `render()`: the package's registration once it has one, else a
     throwaway technique carrying only this drawable (the shaders stay in `billboard:`)."""
-    load_all()
     if drawable_spec(volumetric_boxes())[1] is not None:
         yield
         return

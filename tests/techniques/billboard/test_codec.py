@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from billboard_scenes import flat, quads, stacked
 
+from reliefkit.builtins import registry
 from reliefkit.errors import FormatError, UsageError
-from reliefkit.io.rk import _codec_for_object, load, save, write_rk
+from reliefkit.io.rk import load, save, write_rk
 from reliefkit.techniques.billboard.bake import bake_billboard_cloud
 from reliefkit.techniques.billboard.box_bake import bake_boxes
 from reliefkit.techniques.billboard.boxes import BillboardBoxes
@@ -29,7 +30,7 @@ def test_the_same_bake_writes_the_same_bytes(gl, tmp_path):
 
 def rewritten(tmp_path, rep, change) -> object:
     """``rep`` written with ``change(arrays, params)`` applied, as a forger would."""
-    codec = _codec_for_object(rep)
+    codec = registry().codecs().for_object(rep)
     arrays, params = codec.to_arrays(rep)
     arrays = {k: np.array(v) for k, v in arrays.items() if v is not None}
     change(arrays, params)

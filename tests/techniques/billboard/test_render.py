@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reliefkit.colorspace import srgb_decode
-from reliefkit.core.technique import Technique, drawable_spec, load_all, register, unregister
+from reliefkit.core.technique import Technique, drawable_spec, register, unregister
 from reliefkit.errors import GPUError
 from reliefkit.render import render
 from reliefkit.render.frame import window_depth
@@ -27,7 +27,6 @@ RED, GREEN, BLUE, WHITE = (230, 40, 30), (30, 200, 60), (40, 60, 220), (240, 240
 def billboard(gl):
     """Renders clouds through `render()`: the package's own registration once it has one,
     else a throwaway technique carrying only this drawable, removed afterwards."""
-    load_all()
     probe = one_rectangle(np.full((1, 8, 8, 4), 255, np.uint8))
     if drawable_spec(probe)[1] is not None:
         yield

@@ -8,7 +8,7 @@ import pytest
 from scipy.ndimage import gaussian_filter
 
 from reliefkit.errors import UsageError
-from reliefkit.techniques.relief.safety import safety_radii, zero_radius_fraction
+from reliefkit.techniques.relief.safety import safety_radii
 from reliefkit.techniques.relief.safety_check import CHECK_FLOOR, check_safety
 
 
@@ -201,12 +201,6 @@ def test_work_counts_one_visit_per_sample(directions, offsets):
     assert work["scans"] <= work["visits"] <= work["pieces"]
     assert work["scanned_pieces"] >= work["scans"]
     assert np.array_equal(s, safety_radii(h, directions=directions, offsets=offsets))
-
-
-def test_zero_radius_fraction():
-    assert zero_radius_fraction(np.array([[0, 1], [2, 0]], np.uint8)) == 0.5
-    with pytest.raises(UsageError):
-        zero_radius_fraction(np.zeros((0, 3)))
 
 
 def test_bad_arguments():

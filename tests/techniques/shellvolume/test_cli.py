@@ -10,6 +10,7 @@ import pytest
 import trimesh
 from helpers import assert_one_line_error, run_cli
 
+from reliefkit.builtins import registry
 from reliefkit.io.rk import load
 from reliefkit.techniques.shellvolume.representation import TexturedShell
 
@@ -145,7 +146,7 @@ def test_a_texture_without_voxels_is_refused(fur_rk, tmp_path):
     from reliefkit.io import rk
 
     rep = load(fur_rk)
-    codec = rk._codec_for_object(rep)  # noqa: SLF001 - forging needs the codec's arrays
+    codec = registry().codecs().for_object(rep)  # forging needs the codec's arrays
     arrays, params = codec.to_arrays(rep)
     arrays = {k: v for k, v in arrays.items() if v is not None}
     arrays["texture_rgba"] = np.zeros((0, 16, 16, 4), np.float32)

@@ -33,8 +33,22 @@ from pathlib import Path
 import numpy as np
 
 from ...bench.report import save_figure, write_report
+from ...bench.timing import time_render
+from ...gl.context import gl_info
+from ...io.meshes import load_mesh
+from ...io.rk import array_bytes
+from ...metrics import compare
+from ...render import render
+from ...scene.assets import make_asset
+from ...scene.mesh import RenderMesh, vertex_normals
+from ...scene.views import bounds_radius, orbit_bounds
 from ...units import format_bytes
+from .bake import bake_billboard_cloud
+from .box_bake import bake_boxes
+from .box_reference import wrong_hits
 from .boxes import VARIANTS
+from .cloud import build_billboard_cloud
+from .lod import switch_distance
 
 MESH_ENV = "RELIEFKIT_BENCH_MESH"
 #: A pixel changes when a channel of its sRGB8 picture moves by more than this.
@@ -76,13 +90,9 @@ class BenchConfig:
 
 def load_assets(cfg: BenchConfig, log) -> tuple[dict, list[str]]:
     """The meshes by name, and notes on what was left out."""
-    from ...scene.assets import make_asset
-
     meshes = {name: make_asset(name) for name in cfg.assets}
     notes = []
     if cfg.mesh_path and Path(cfg.mesh_path).is_file():
-        from ...scene.loader import load_mesh
-
         mesh = load_mesh(cfg.mesh_path)
         meshes[Path(cfg.mesh_path).stem] = mesh
         log(f"real mesh {cfg.mesh_path}: {mesh.triangle_count:,} triangles")
@@ -101,8 +111,6 @@ def subdivided(mesh, times: int):
     diagonal, so the same epsilon; one colour): a large mesh whose planes are comparable."""
     import trimesh
 
-    from ...scene.mesh import RenderMesh, vertex_normals
-
     if times == 0:
         return mesh
     points, faces = mesh.world_positions, mesh.indices
@@ -115,8 +123,6 @@ def subdivided(mesh, times: int):
 
 
 def mesh_bytes(mesh) -> int:
-    from ...io.rk import array_bytes
-
     return sum(array_bytes(mesh).values())
 
 
@@ -138,8 +144,6 @@ def decimated(mesh, target_bytes: int):
         return None
     from scipy.spatial import cKDTree
 
-    from ...scene.mesh import RenderMesh, vertex_normals
-
     points = mesh.world_positions
     reduction = min(1.0 - target_bytes / full, 0.999)
     new_points, faces = fast_simplification.simplify(points, mesh.indices.astype(np.int64),
@@ -160,9 +164,6 @@ def decimated(mesh, target_bytes: int):
 
 def bake_all(mesh, cfg: BenchConfig) -> tuple[dict, dict]:
     """The BBC and the three DMBBC variants with the same planes; their bake seconds."""
-    from .bake import bake_billboard_cloud
-    from .box_bake import bake_boxes
-
     texel = diagonal(mesh) / cfg.texel_divisor
     reps, seconds = {}, {}
     start = time.perf_counter()
@@ -199,16 +200,11 @@ def tables(name: str, mesh, reps: dict, seconds: dict) -> tuple[dict, dict, dict
 # -- quality at three distances -------------------------------------------------------------
 
 def camera_at(mesh, azimuth, distance_radii, size, cfg: BenchConfig):
-    from ...scene.views import orbit_bounds
-
     return orbit_bounds(mesh.bounds, azimuth, cfg.elevation, distance_radii, (size, size))
 
 
 def switch_radii(mesh, rep, size: int) -> float:
     """The switch distance (`lod.switch_distance`) in bounding radii from the centre."""
-    from ...scene.views import bounds_radius
-    from .lod import switch_distance
-
     cam = camera_at(mesh, 0.0, 3.0, size, BenchConfig())
     return switch_distance(cam, rep.epsilon) / bounds_radius(mesh.bounds)
 
@@ -216,10 +212,6 @@ def switch_radii(mesh, rep, size: int) -> float:
 def quality(name, mesh, reps: dict, decimations: dict, cfg: BenchConfig) -> list[dict]:
     """Mask IoU, SSIM and PSNR of every representation against the mesh, per distance
     (mean over the azimuths)."""
-    from ...metrics import compare
-    from ...render import render
-    from ...scene.views import bounds_radius
-
     radius = bounds_radius(mesh.bounds)
     shown = {"bbc": reps["bbc"], **{v: reps[v] for v in VARIANTS}, **decimations}
     rows = []
@@ -243,10 +235,6 @@ def quality(name, mesh, reps: dict, decimations: dict, cfg: BenchConfig) -> list
 
 def marches(name, mesh, reps: dict, cfg: BenchConfig) -> list[dict]:
     """At medium distance, first azimuth: iterations, wrong hits and frame time per march."""
-    from ...bench.timing import time_render
-    from ...render import render
-    from .box_reference import wrong_hits
-
     camera = camera_at(mesh, cfg.azimuths[0], cfg.distances[1], cfg.size, cfg)
     rows = []
     for variant in VARIANTS:
@@ -288,8 +276,6 @@ def equal_error(rows: list[dict]) -> list[dict]:
 # -- Fig. 6: frame time against distance --------------------------------------------------
 
 def fig6(name, mesh, reps: dict, cfg: BenchConfig) -> list[dict]:
-    from ...bench.timing import time_render
-
     switch = switch_radii(mesh, reps["volumetric"], cfg.size)
     rows = []
     for dist in np.geomspace(cfg.distances[0], 1.5 * switch, cfg.fig6_points):
@@ -310,8 +296,6 @@ def bumpy_sphere(subdivisions: int):
     assets keep their coarse faces' planes)."""
     import trimesh
 
-    from ...scene.mesh import RenderMesh, vertex_normals
-
     sphere = trimesh.creation.icosphere(subdivisions=subdivisions)
     points = np.asarray(sphere.vertices, np.float64)
     waves = np.random.default_rng(7).normal(size=(6, 3)) * 3.0
@@ -326,9 +310,6 @@ def bumpy_sphere(subdivisions: int):
 def generation(cfg: BenchConfig, log) -> list[dict]:
     """The plane search's time (best of ``generation_tries``) on the large subdivided asset
     and on the bumpy sphere."""
-    from ...scene.assets import make_asset
-    from .cloud import build_billboard_cloud
-
     rows = []
     for mesh in (subdivided(make_asset(cfg.big_asset), cfg.big_subdivisions),
                  bumpy_sphere(cfg.curved_subdivisions)):
@@ -371,8 +352,6 @@ def dolly(name, mesh, reps: dict, cfg: BenchConfig) -> dict:
     (the motion), and just inside the switch distance the boxes (flattened to almost nothing,
     their colours handed over to the BBC's) against the BBC from the same camera (the pop
     without motion)."""
-    from ...render import render
-
     vol = reps["volumetric"]
     switch = switch_radii(mesh, vol, cfg.size)
     steps = np.geomspace(0.3 * switch, 1.5 * switch, cfg.dolly_frames)
@@ -407,8 +386,6 @@ def dolly(name, mesh, reps: dict, cfg: BenchConfig) -> dict:
 # -- the run ------------------------------------------------------------------------------------
 
 def run(cfg: BenchConfig, log=print) -> dict:
-    from ...gl.context import gl_info
-
     info = gl_info()
     results = {"machine": {"renderer": info["renderer"], "gl": info["version"],
                            "cpu": platform.processor() or platform.machine(),

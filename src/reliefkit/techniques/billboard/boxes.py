@@ -15,9 +15,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.transforms import MAX_COORDINATE
+from ...core.transforms import MAX_COORDINATE, transform_points, unit_cube_corners
 from ...errors import UsageError
 from ...scene.views import source_box
+from ...units import format_bytes
 from .representation import BillboardCloud
 
 VARIANTS = ("volumetric", "shell", "thick-shell")
@@ -102,8 +103,6 @@ class BillboardBoxes:
     @property
     def bounds(self) -> np.ndarray:
         """World bounding box of every box."""
-        from ...core.transforms import transform_points, unit_cube_corners
-
         points = np.concatenate([transform_points(b.box_to_world, unit_cube_corners())
                                  for b in self.boxes])
         return np.stack([points.min(axis=0), points.max(axis=0)])
@@ -127,8 +126,6 @@ class BillboardBoxes:
 
     def bake_report(self) -> list[str]:
         """What `reliefkit bake` says of fresh boxes: their variant and memory (Table 2)."""
-        from ...units import format_bytes
-
         memory = self.memory_bytes()
         maps = ", ".join(f"{name} {format_bytes(memory[name])}"
                          for name in ("color", "normal", "distance", "displacement")

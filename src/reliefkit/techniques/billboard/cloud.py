@@ -22,7 +22,6 @@ import numpy as np
 
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
-from .density import add_faces
 from .rectangles import min_area_rectangle, plane_basis
 
 PENALTY_WEIGHT = 10.0   # w_penalty of Décoret et al. 2003, section 4.2
@@ -277,6 +276,8 @@ class _Grid:
     def _update(self, idx: np.ndarray, sign: float) -> None:
         """Add ``sign`` x the increments of faces idx (`density.add_faces`). Each distinct
         vertex is projected once per direction (neighbouring faces share them)."""
+        from .density import add_faces  # numba: slow to import
+
         idx = idx[~self.faces.degenerate[idx]]        # zero area: no density, no penalty
         if not idx.size:
             return

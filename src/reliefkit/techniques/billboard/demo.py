@@ -3,14 +3,13 @@ volumetric displacement-mapped billboard clouds with the same planes."""
 
 from __future__ import annotations
 
+from ...bake import bake
 from ...core.technique import DemoTile
+from ...scene.assets import make_asset
 
 
 def _baked(asset: str, kind: str, **params):
     def make():
-        from ...bake import bake
-        from ...scene.assets import make_asset
-
         return bake(make_asset(asset), kind, **params)
 
     return make

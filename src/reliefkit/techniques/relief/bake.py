@@ -134,7 +134,7 @@ def bake_through(mesh: RenderMesh, box_to_world: np.ndarray, depth_size, color_s
                            box_to_world=box_to_world, clip_bounds=clip_bounds,
                            source_bounds=mesh.bounds, params=dict(params or {}))
     if wants_radii(safety, depth_size, octants):
-        from .safety import safety_radii
+        from .safety import safety_radii  # numba: slow to import
 
         tolerance = far_tolerance(box_to_world, tolerance)  # a frustum's h is not uniform
         relief.safety = safety_radii(height, tolerance=tolerance, progress=progress,
@@ -185,7 +185,7 @@ def relief_from_heights(heights, color=None, size=HEIGHTMAP_BOX, *,
     relief = ReliefTexture(height=h, color=color8, normal=normal, box_to_world=box_to_world,
                            params={"projection": "orthographic", "source": "heightmap"})
     if wants_radii(safety, relief.depth_resolution, octants):
-        from .safety import safety_radii
+        from .safety import safety_radii  # numba: slow to import
 
         relief.safety = safety_radii(h, tolerance=tolerance, progress=progress,
                                      octants=octants)

@@ -15,9 +15,20 @@ from pathlib import Path
 import numpy as np
 
 from ...bench.report import machine, machine_line, save_figure, write_report
+from ...bench.timing import time_render, time_renders
+from ...io.meshes import load_mesh
+from ...io.rk import array_bytes
+from ...render import render
+from ...scene.assets import DEMO_NAMES, make_asset
+from ...scene.views import orbit_bounds
 from ...units import format_bytes
-from .bake import DEFAULT_TOLERANCE
+from .bake import DEFAULT_TOLERANCE, bake_relief
+from .cone import relaxed_cone_ratios
+from .frustum import bake_relief_cube, bake_relief_frustum
+from .maxmip import max_pyramid
+from .reference import wrong_hits
 from .render import METHODS, ReliefRenderOptions, drawn_method
+from .safety import WORK_COUNTERS, safety_radii
 
 #: Two medians of the same program differ by up to this much here (llvmpipe on 2 cores).
 TIMING_NOISE = 0.05
@@ -57,9 +68,6 @@ class BenchConfig:
 
 def load_model(name: str):
     """A demo asset by name, or a mesh file (``--mesh``)."""
-    from ...scene.assets import DEMO_NAMES, make_asset
-    from ...scene.loader import load_mesh
-
     return make_asset(name) if name in DEMO_NAMES else load_mesh(name)
 
 
@@ -70,8 +78,6 @@ def model_label(name: str) -> str:
 
 def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
     """Orbit camera at ``elevation`` whose view of the box fills ``fill`` of the image."""
-    from ...scene.views import orbit_bounds
-
     corners = np.array([[bounds[i & 1][0], bounds[(i >> 1) & 1][1], bounds[(i >> 2) & 1][2]]
                         for i in range(8)])
     lo, hi = 0.5, 20.0
@@ -87,14 +93,6 @@ def fit_camera(bounds, size, elevation=45.0, azimuth=35.0, fill=0.95):
 
 def table1(cfg: BenchConfig, log) -> list[dict]:
     """Frame time per method and for the mesh, iterations per covered pixel (Table 1)."""
-    from ...bench.timing import time_render, time_renders
-    from ...io.rk import array_bytes
-    from ...render import render
-    from .bake import bake_relief
-    from .cone import relaxed_cone_ratios
-    from .maxmip import max_pyramid
-    from .safety import safety_radii
-
     safety_radii(np.zeros((8, 8), np.float32))  # compile before measuring
     relaxed_cone_ratios(np.eye(8, dtype=np.float32))
     rows = []
@@ -142,12 +140,6 @@ def table1(cfg: BenchConfig, log) -> list[dict]:
 
 def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
     """Fig. 12: tolerance vs mean radius vs iterations vs silhouette (wrong-hit) error."""
-    from ...bench.timing import time_render
-    from ...render import render
-    from .bake import bake_relief
-    from .reference import wrong_hits
-    from .safety import safety_radii
-
     mesh = load_model(cfg.tolerance_model)
     relief = bake_relief(mesh, depth_res=cfg.tolerance_res, safety=False)
     camera = fit_camera(mesh.bounds, cfg.correctness_size, elevation=20.0)
@@ -178,12 +170,6 @@ def tolerance_study(cfg: BenchConfig, log) -> list[dict]:
 
 def correctness(cfg: BenchConfig, log) -> list[dict]:
     """Wrong-hit fraction of each method against the exact reference, grazing views too."""
-    from ...render import render
-    from ...scene.views import orbit_bounds
-    from .bake import bake_relief
-    from .frustum import bake_relief_cube, bake_relief_frustum
-    from .reference import wrong_hits
-
     rows = []
     # the orthographic reliefs, then a reverse frustum and a cube of six (their projective
     # h is where a tolerance in h units went wrong; relief.md)
@@ -284,8 +270,6 @@ def check_targets(results: dict) -> list[dict]:
 
 
 def markdown(results: dict) -> str:
-    from .safety import WORK_COUNTERS
-
     lines = [machine_line(results["machine"]) + " Images "
              f"{results['config']['size'][0]}x{results['config']['size'][1]}, "
              f"median of {results['config']['repeats']} draws.", "",

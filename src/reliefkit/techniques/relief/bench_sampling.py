@@ -18,7 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from ...bench.report import machine, machine_line, save_figure, write_report
-from .bake import DEFAULT_TOLERANCE
+from ...scene.assets import make_asset
+from .bake import DEFAULT_TOLERANCE, bake_relief
+from .safety import safety_radii
+from .safety_check import check_safety
 
 #: (directions, offsets, margin); the first is `safety_radii`'s default.
 SAMPLINGS = ((64, 4, 0.25), (32, 4, 0.25), (64, 2, 0.5), (32, 2, 0.5), (16, 2, 0.5),
@@ -49,9 +52,6 @@ def study_field(height, samplings, *, tolerance: float, rays: int, seed: int) ->
     ``ratio`` is a sampling's time over the first sampling's; ``excess`` the deepest
     violating dip past the tolerance, as a fraction of the tolerance (0 without violations).
     """
-    from .safety import safety_radii
-    from .safety_check import check_safety
-
     rows = []
     for directions, offsets, margin in samplings:
         work = {}
@@ -71,10 +71,6 @@ def study_field(height, samplings, *, tolerance: float, rays: int, seed: int) ->
 
 
 def run(cfg: SamplingConfig, log=print) -> dict:
-    from ...scene.assets import make_asset
-    from .bake import bake_relief
-    from .safety import safety_radii
-
     safety_radii(np.zeros((8, 8), np.float32))  # compile before measuring
     results = {"machine": machine(),
                "config": {"rays": cfg.rays, "seed": cfg.seed, "tolerance": cfg.tolerance},

@@ -3,22 +3,20 @@ none bakes safety radii (the demo spent 46% of its time on them)."""
 
 from __future__ import annotations
 
+from ...bake import bake
 from ...core.technique import DemoTile
+from ...scene.assets import make_asset
+from ...scene.light import DirectionalLight
 
 
 def _baked(asset: str, kind: str, **params):
     def make():
-        from ...bake import bake
-        from ...scene.assets import make_asset
-
         return bake(make_asset(asset), kind, **params)
 
     return make
 
 
 def demo_tiles() -> list[DemoTile]:
-    from ...scene.light import DirectionalLight
-
     terrain_view, vehicle_view, blob_view = (30.0, 35.0, 2.2), (40.0, 20.0, None), (35, 25, 2.5)
     low_sun = DirectionalLight(direction=(-0.85, 0.35, 0.25))
     return [

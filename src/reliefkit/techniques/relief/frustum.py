@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...bake.project import axis_frame, cube_face_frames
+from ...bake.project import axis_frame, cube_face_frames, project_mesh
 from ...core.transforms import translation
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
@@ -111,8 +111,6 @@ def cube_frusta(mesh: RenderMesh, margin: float = 0.02, near_fraction: float = 0
     covered texel, floored to 1/32 of the half cube (the outermost surface of every texel
     lies beyond the cut: nothing is lost). `bake.far_tolerance` then scales the tolerance.
     """
-    from ...bake.project import project_mesh
-
     lo, hi = mesh.bounds
     centre = (lo + hi) / 2
     half = float((hi - lo).max()) / 2 * (1 + margin)

@@ -15,11 +15,12 @@ build it on the GPU for dynamic heightfields; a relief texture's field never cha
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import maximum_filter
 
 
 def max_pyramid(height: np.ndarray) -> list[np.ndarray]:
     """[level 0 (P, P), ..., (1, 1)] float32, P the power of two >= the field's sides."""
+    from scipy.ndimage import maximum_filter  # scipy: slow to import
+
     h = np.asarray(height, dtype=np.float32)
     base = maximum_filter(h, size=3, mode="nearest")
     side = pyramid_side(h.shape)

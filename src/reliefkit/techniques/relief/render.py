@@ -27,7 +27,6 @@ from ...render.plan import (
     ViewUpdate,
 )
 from ...render.proxy import Proxy, aabb_planes, box_planes, convex_proxy, cull_face
-from .cone import relaxed_cone_ratios
 from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
@@ -125,6 +124,8 @@ def relief_plan(relief: ReliefTexture, options: ReliefRenderOptions,
         textures["u_height_safety"] = Texture(packed, filter="nearest",
                                               what="height and safety")
     if method == "cone":
+        from .cone import relaxed_cone_ratios  # numba: slow to import
+
         textures["u_cone"] = Texture(relaxed_cone_ratios(relief.height), filter="nearest",
                                      what="cone ratios")
     top_level = 0

@@ -90,7 +90,6 @@ __all__ = [
     "TOLERANCE_SLACK",
     "WORK_COUNTERS",
     "safety_radii",
-    "zero_radius_fraction",
 ]
 
 NUMERIC_FLOOR = 1e-9
@@ -810,11 +809,3 @@ def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,
         work.update(zip(WORK_COUNTERS, per_texel.tolist(), strict=True))
     radii = bounds.astype(dtype)
     return radii if octants else radii[0]
-
-
-def zero_radius_fraction(safety) -> float:
-    """Fraction of texels whose safety radius is 0 (the renderer must clamp or step exactly)."""
-    s = np.asarray(safety)
-    if s.size == 0:
-        raise UsageError("safety is empty")
-    return float(np.count_nonzero(s == 0)) / s.size

@@ -12,7 +12,6 @@ from ...core.technique import Baker, BenchSuite, CompareMetric, CompareVariant, 
 from . import render
 from .bakers import ShellVolumeParams, bake_shell
 from .codec import CODECS
-from .order import visibility_order
 from .representation import TexturedShell
 from .shell import ShellVolume, build_shell
 from .textures import TEXTURES, VolumeTexture
@@ -39,6 +38,7 @@ def _against_reference(frame, rep, camera):
     violations on the frame's rays where the shell was sorted."""
     import numpy as np
 
+    from .order import visibility_order
     from .order_check import ordering_violations
     from .reference import reference_render
 
@@ -127,3 +127,13 @@ TECHNIQUE = Technique(
 
 __all__ = ["TECHNIQUE", "TEXTURES", "ShellVolume", "TexturedShell", "VolumeTexture",
            "build_shell", "visibility_order"]
+
+
+def __getattr__(name: str):
+    """`visibility_order` is imported on first use: it loads numba, which declaring the
+    technique (the command line's help) does not need."""
+    if name == "visibility_order":
+        from .order import visibility_order
+
+        return visibility_order
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -10,6 +10,8 @@ from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_t
 from ...bake.uv_atlas import kept_atlas
 from ...core.params import param
 from ...errors import FormatError, UsageError
+from ...io.inputs import DEMO_PREFIX, load_input
+from ...scene.mesh import RenderMesh
 from .representation import TexturedShell, check_tetrahedron_count
 from .shell import fitted_thickness, unusable_triangles
 from .textures import TEXTURES, load_texture_npy, texture_from_mesh
@@ -51,9 +53,6 @@ def make_texture(spec: str, size, thickness: float, progress=None):
     if spec.lower().endswith(".npy"):
         return load_texture_npy(spec)
     from pathlib import Path
-
-    from ...io.inputs import DEMO_PREFIX, load_input
-    from ...scene.mesh import RenderMesh
 
     if not spec.startswith(DEMO_PREFIX) and not Path(spec).is_file():
         # a name with a suffix is a file's, so a missing input (exit 1); else a bad value
@@ -112,7 +111,6 @@ def usable_part(mesh):
                          "space and in uv; there is nothing to extrude")
     if not bad.any():
         return mesh, 0
-    from ...scene.mesh import RenderMesh
 
     kept = np.asarray(mesh.indices)[~bad]
     return RenderMesh(mesh.world_positions, kept, mesh.normals, mesh.colors, mesh.uvs,

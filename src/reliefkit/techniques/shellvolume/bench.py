@@ -32,8 +32,24 @@ from pathlib import Path
 import numpy as np
 
 from ...bench.report import machine, machine_line
+from ...bench.timing import time_render
+from ...errors import UsageError
 from ...io.atomic import atomic_path
-from ...scene.assets.surfaces import TEAPOT_SHELL
+from ...pictures import contact_sheet, save_image
+from ...render import render
+from ...scene.assets import make_asset
+from ...scene.assets.surfaces import TEAPOT_SHELL, sphere
+from ...scene.camera import Camera
+from ...scene.views import orbit_bounds
+from .filtering import mip_pyramid, naive_pyramid, slab_transmittance
+from .order import RESOLUTION, visibility_order
+from .order_check import ordering_violations
+from .peers import vtk_available, vtk_depth_sort
+from .reference import reference_render
+from .render import MAX_PEELS
+from .representation import TexturedShell
+from .shell import build_shell
+from .textures import TEXTURES
 
 #: Table 1's scenes: base -> (texture, tile over the uvs). Thickness: `THICKNESS` of the
 #: base's bounding-box diagonal, except where `FIXED_THICKNESS` gives one.
@@ -97,10 +113,6 @@ def diagonal(bounds) -> float:
 
 def scene(name: str, cfg: BenchConfig):
     """(base mesh, TexturedShell) of a Table 1 scene, as ``bake --as shell-volume`` makes it."""
-    from ...scene.assets import make_asset
-    from .representation import TexturedShell
-    from .textures import TEXTURES
-
     base = make_asset(name)
     texture_name, tile = SCENES[name]
     thickness = FIXED_THICKNESS.get(name, THICKNESS * diagonal(base.bounds))
@@ -110,8 +122,6 @@ def scene(name: str, cfg: BenchConfig):
 
 
 def scene_camera(rep, cfg: BenchConfig, size: int | None = None):
-    from ...scene.views import orbit_bounds
-
     size = size or cfg.size
     return orbit_bounds(rep.bounds, cfg.azimuth, cfg.elevation, None, (size, size))
 
@@ -122,8 +132,6 @@ def texture_label(texture) -> str:
 
 
 def _median_sort(shell, camera, method, resolution, repeats) -> tuple[float, object]:
-    from .order import visibility_order
-
     runs = [visibility_order(shell, camera, method=method, resolution=resolution)
             for _ in range(max(1, repeats))]
     return statistics.median(r.seconds for r in runs), runs[-1]
@@ -135,9 +143,6 @@ def table1(cfg: BenchConfig, log) -> tuple[list[dict], list[tuple[str, np.ndarra
     """Per scene and sample count: the frame time with and without the half-opacity passes,
     as a ratio to the base mesh drawn opaque; the sort's time and share. And the contact
     sheet's tiles."""
-    from ...bench.timing import time_render
-    from ...render import render
-
     rows, tiles = [], []
     for name in cfg.scenes:
         base, rep = scene(name, cfg)
@@ -187,8 +192,6 @@ def table1(cfg: BenchConfig, log) -> tuple[list[dict], list[tuple[str, np.ndarra
 
 def visibility_order_warm(shell, camera) -> None:
     """Compile / load numba's cache before timing a sort."""
-    from .order import visibility_order
-
     visibility_order(shell, camera, resolution=16)
 
 
@@ -197,11 +200,6 @@ def visibility_order_warm(shell, camera) -> None:
 def sorting(cfg: BenchConfig, log) -> list[dict]:
     """SXMPVO (A-buffer at the image resolution, as the renderer sorts) and the centroid
     sort on sphere shells of increasing size."""
-    from ...scene.assets.surfaces import sphere
-    from ...scene.camera import Camera
-    from .order import RESOLUTION
-    from .shell import build_shell
-
     rows = []
     for segments, rings in cfg.large_spheres:
         base = sphere(segments, rings)
@@ -232,8 +230,6 @@ def sorting(cfg: BenchConfig, log) -> list[dict]:
 def random_views(rng, count: int, centre, reach: float, rays: int) -> list:
     """Random orbits around a point near ``centre``, the eye outside the shape: perspective
     with a random field of view, a quarter orthographic (as tests/.../test_order.py)."""
-    from ...scene.camera import Camera
-
     cameras = []
     for _ in range(count):
         target = tuple(np.asarray(centre) + rng.uniform(-0.2, 0.2, 3) * reach)
@@ -251,13 +247,6 @@ ORDER_SHELLS = ("as built",)
 
 
 def ordering(cfg: BenchConfig, log) -> list[dict]:
-    from ...errors import UsageError
-    from ...scene.assets import make_asset
-    from .order import visibility_order
-    from .order_check import ordering_violations
-    from .peers import vtk_available, vtk_depth_sort
-    from .shell import build_shell
-
     has_vtk, vtk_reason = vtk_available()
     methods = ("sxmpvo", "centroid", "vtk")
     rows = []
@@ -325,10 +314,6 @@ def peeling(cfg: BenchConfig, log) -> list[dict]:
     draw's wall time (`frame.stats["draw_seconds"]`: every pass waits on its occlusion
     query, so the draw is synchronous; one frame, as a capped peel can take a minute); the
     sorted frame's is `time_render`'s median."""
-    from ...bench.timing import time_render
-    from ...render import render
-    from .render import MAX_PEELS
-
     rows = []
     for name in cfg.peel_scenes:
         _, rep = scene(name, cfg)
@@ -362,8 +347,6 @@ def _premultiplied(color) -> np.ndarray:
 # -- 5. GPU vs the CPU reference ------------------------------------------------------------
 
 def reference_cameras(rep, size: int) -> dict:
-    from ...scene.camera import Camera
-
     lo, hi = rep.bounds
     centre, extent = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo))
     common = {"size": (size, size)}
@@ -374,9 +357,6 @@ def reference_cameras(rep, size: int) -> dict:
 
 
 def against_reference(cfg: BenchConfig, log) -> dict:
-    from ...render import render
-    from .reference import reference_render
-
     _, rep = scene(cfg.reference_scene, cfg)
     cameras = reference_cameras(rep, cfg.reference_size)
     rows = []
@@ -411,9 +391,6 @@ def against_reference(cfg: BenchConfig, log) -> dict:
 def filtering(cfg: BenchConfig) -> list[dict]:
     """§5.2: the mean transmittance straight through the slab at each level, its largest
     drift from level 0, for the opacity-compositing pyramid and for naive averaging."""
-    from .filtering import mip_pyramid, naive_pyramid, slab_transmittance
-    from .textures import TEXTURES
-
     thin = np.zeros((16, 8, 8, 4), np.float32)
     thin[5] = (1.0, 0.5, 0.2, 0.99)
     cases = [("thin opaque layer (16x8x8, one layer alpha 0.99)", thin, 16.0),
@@ -646,8 +623,6 @@ def write(results: dict, out: Path) -> list[Path]:
     with atomic_path(paths[1]) as tmp:
         tmp.write_text(markdown(data))
     if tiles:
-        from ...pictures import contact_sheet, save_image
-
         sheet = out / "shellvolume-bench.png"
         save_image(contact_sheet(tiles, columns=min(len(tiles), 3),
                                  title="shellvolume: Table 1 scenes"), sheet)

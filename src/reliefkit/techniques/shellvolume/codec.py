@@ -25,6 +25,7 @@ from ...io.mesh_codec import (
     surface_to_arrays,
 )
 from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
+from ...scene.mesh import Material, RenderMesh
 from .representation import TexturedShell
 from .textures import MAX_VOXELS, VolumeTexture
 
@@ -54,8 +55,6 @@ def _to_arrays(rep: TexturedShell) -> tuple[dict, dict]:
 
 
 def _from_arrays(arrays: dict, params: dict) -> TexturedShell:
-    from ...scene.mesh import Material, RenderMesh
-
     params = dict(params)
     name, tile = params.pop("texture", None), params.pop("tile", None)
     length = params.pop("alpha_length", 1.0)

@@ -3,7 +3,9 @@ Earth-like ground, ellipsoids in a medium, uniform absorption, a chain, rocks)."
 
 from __future__ import annotations
 
+from ...bake import bake
 from ...core.technique import DemoTile
+from ...scene.assets import make_asset
 
 #: (texture, tile U, V): how each of Figure 1's textures repeats over the sphere.
 FIGURE_1 = (("fur", (8, 4)), ("clouds", (2, 1)), ("ellipsoids", (4, 2)),
@@ -13,9 +15,6 @@ THICKNESS = 0.15  # of the unit sphere's radius
 
 def _shell(texture: str, tile):
     def make():
-        from ...bake import bake
-        from ...scene.assets import make_asset
-
         return bake(make_asset("sphere"), "shell-volume", texture=texture,
                     thickness=THICKNESS, tile=tuple(float(t) for t in tile))
 

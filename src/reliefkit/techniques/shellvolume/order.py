@@ -55,9 +55,7 @@ import numpy as np
 from numba import njit
 
 from ...errors import UsageError
-
-#: Methods `visibility_order` knows.
-METHODS = ("sxmpvo", "centroid")
+from .sorts import METHODS
 
 #: Default A-buffer samples along the image's longer side.
 RESOLUTION = 256

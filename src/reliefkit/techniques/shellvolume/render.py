@@ -36,8 +36,8 @@ from ...render.plan import (
     ViewUpdate,
 )
 from .filtering import mip_pyramid, naive_pyramid
-from .order import METHODS, OrderCells, order_cells, visibility_order
 from .representation import TET_TEXELS, TETS_PER_ROW, TexturedShell
+from .sorts import METHODS
 from .textures import density_floor, density_normals, marched_volume
 
 PROGRAM = "shellvolume:shell.glsl"
@@ -195,6 +195,8 @@ def shell_plan(rep: TexturedShell, shell, options: ShellRenderOptions) -> DrawPl
     hook = None
     if transparent and not peel:
         # the A-buffer samples the frame's own pixel rays: the order is exact on them
+        from .order import order_cells  # numba: slow to import
+
         cells = order_cells(shell)
         hook = ViewHook(f"{__name__}:visibility_hook", {
             "cells": {f.name: getattr(cells, f.name) for f in fields(cells)},
@@ -279,6 +281,8 @@ def shell_textures(rep: TexturedShell, shell, origin) -> tuple[dict, dict]:
 def visibility_hook(plan, camera, light, *, cells: dict, method: str) -> ViewUpdate:
     """The view hook of a sorted shell: its tetrahedra front to back from ``camera`` as the
     instance order, and the sort's statistics."""
+    from .order import OrderCells, visibility_order  # numba: slow to import
+
     order = visibility_order(OrderCells(**cells), camera, method=method,
                              resolution=max(camera.size))
     return ViewUpdate(attributes={"in_tet": order.order.astype(np.int32)},

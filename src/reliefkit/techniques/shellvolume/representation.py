@@ -14,6 +14,7 @@ import numpy as np
 
 from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
 from .shell import ShellVolume, build_shell
 from .textures import VolumeTexture
@@ -101,7 +102,6 @@ class TexturedShell:
         phase = 2 * np.pi * (time + 1.5 * (p[:, 0] + 0.7 * p[:, 1] + 0.4 * p[:, 2]) / extent)
         offset = (WAVE_AMPLITUDE * self.thickness * np.sin(phase))[:, None] * \
             np.asarray(base.normals, np.float64)
-        from ...scene.mesh import RenderMesh
 
         moved = RenderMesh(p + offset, base.indices, base.normals, base.colors, base.uvs,
                            name=base.name)

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import ndimage
 
+from ...bake.voxelize import voxelize
 from ...errors import FormatError, UsageError
 from ...io.npy import npy_header
 
@@ -181,6 +181,7 @@ def _check_size(size):
 
 def _noise(rng, shape, sigma, wrap_w=False):
     """Smooth noise in [0,1]: Gaussian-filtered white noise, wrapped in u and v."""
+    from scipy import ndimage  # scipy: slow to import
     field = rng.random(shape)
     modes = ["wrap"] * field.ndim
     if field.ndim == 3 and not wrap_w:
@@ -353,8 +354,6 @@ def texture_from_mesh(mesh, size=(32, 32, 16), progress=None) -> VolumeTexture:
     Voxels the surface (or, for a closed mesh, the interior) covers at least half are solid
     (alpha 1) with the mesh's colour; normals are the mesh's, in voxel units.
     """
-    from ...bake.voxelize import voxelize
-
     width, height, depth = _check_size(size)
     lo, hi = (np.asarray(b, np.float64) for b in mesh.bounds)
     extent = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1e-30))

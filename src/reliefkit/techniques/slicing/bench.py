@@ -31,7 +31,21 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import metrics
 from ...bench.report import machine, machine_line, write_report
+from ...bench.timing import time_render
+from ...render.draw import render
+from ...scene.assets import make_asset, terrain_heights
+from ...scene.camera import Camera
+from ...scene.views import orbit_bounds
+from . import peers
+from .bakers import DepthObjectParams, bake_depth_object
+from .displacement_bake import DisplacementParams, bake_displacement
+from .displacement_demo import DONUT_SLICES, furry_donut
+from .displacement_reference import wrong_hits
+from .measure import against_reference
+from .reference import exact_intersection, voxel_carve
+from .representation import VisualHull
 
 TARGET_IOU, TARGET_RMS = 0.98, 1.0     # depth object at 256² per face vs the exact reference
 TARGET_WRONG = 0.005                   # some slice count per mode reaches this
@@ -74,26 +88,18 @@ class BenchConfig:
 # -- helpers -----------------------------------------------------------------------------------
 
 def _baked(cfg: BenchConfig, asset: str):
-    from ...scene.assets import make_asset
-    from .bakers import DepthObjectParams, bake_depth_object
-    from .representation import VisualHull
-
     mesh = make_asset(asset)
     rep = bake_depth_object(mesh, DepthObjectParams(res=cfg.res))
     return mesh, rep, VisualHull.of(rep.images)
 
 
 def _orbit(rep, view, size, distance=1.6):
-    from ...scene.camera import Camera
-
     centre = tuple(rep.bounds.mean(axis=0))
     return Camera.orbit(centre, view[0], view[1], distance * rep.images.side, size=(size, size))
 
 
 def _covering(rep, pixels: int, size: int, view=(35.0, 25.0)):
     """An orthographic camera in a ``size``² viewport where the cube spans about ``pixels``."""
-    from ...scene.camera import Camera
-
     centre = tuple(rep.bounds.mean(axis=0))
     side = rep.images.side
     return Camera.orbit(centre, view[0], view[1], 3.0 * side, size=(size, size),
@@ -113,9 +119,6 @@ def _variants(cfg: BenchConfig):
 
 
 def _scores(frame, mesh_frame, rep, camera, reference) -> dict:
-    from ... import metrics
-    from .measure import against_reference
-
     ref = against_reference(frame, rep.images, camera, reference=reference)
     position = metrics.position_error(frame, mesh_frame)
     return {"mesh_iou": metrics.mask_iou(frame, mesh_frame),
@@ -128,9 +131,6 @@ def _scores(frame, mesh_frame, rep, camera, reference) -> dict:
 # -- sections ----------------------------------------------------------------------------------
 
 def quality(cfg: BenchConfig, log) -> list[dict]:
-    from ...render.draw import render
-    from .reference import exact_intersection
-
     rows = []
     for asset in cfg.assets:
         mesh, rep, hull = _baked(cfg, asset)
@@ -157,10 +157,6 @@ def quality(cfg: BenchConfig, log) -> list[dict]:
 
 def convergence(cfg: BenchConfig, log) -> list[dict]:
     """Wrong pixels against the exact reference as the slices grow (blob, first view)."""
-    from ...render.draw import render
-    from .measure import against_reference
-    from .reference import exact_intersection
-
     _, rep, _ = _baked(cfg, cfg.assets[0])
     cam = _orbit(rep, cfg.views[0], cfg.size)
     reference = exact_intersection(rep.images, cam)
@@ -183,9 +179,6 @@ def convergence(cfg: BenchConfig, log) -> list[dict]:
 
 def texturing(cfg: BenchConfig, log) -> dict:
     """§4.2 on the vehicle, ray cast (the geometry exact, so texturing alone differs)."""
-    from ... import metrics
-    from ...render.draw import render
-
     mesh, rep, _ = _baked(replace(cfg, res=cfg.res), "vehicle")
     variants = {f"{t}{'' if v else ', no visibility'}": {"texturing": t, "visibility": v}
                 for v in (True, False) for t in ("blend3", "nearest")}
@@ -210,9 +203,6 @@ def texturing(cfg: BenchConfig, log) -> dict:
 
 def fig12(cfg: BenchConfig, log) -> dict:
     """Frame time vs coverage at fixed slices, vs slices at fixed coverage; ray cast beside."""
-    from ...bench.timing import time_render
-    from ...render.draw import render
-
     _, rep, _ = _baked(cfg, cfg.assets[0])
     coverage_rows, slice_rows = [], []
     for pixels in cfg.coverages:
@@ -243,9 +233,6 @@ def fig12(cfg: BenchConfig, log) -> dict:
 
 def passes(cfg: BenchConfig, log) -> list[dict]:
     """One pass testing every image vs the stencil multi-pass, same picture (§4.1)."""
-    from ...bench.timing import time_render
-    from ...render.draw import render
-
     rows = []
     _, rep, hull = _baked(cfg, cfg.assets[0])
     for name, obj in (("depth object", rep), ("visual hull", hull)):
@@ -268,15 +255,11 @@ def passes(cfg: BenchConfig, log) -> list[dict]:
 
 def peer(cfg: BenchConfig, log) -> dict:
     """Open3D's voxel carving on the same images (peers.py), or why it cannot run here."""
-    from . import peers
-
     available, reason = peers.open3d_status()
     out: dict = {"available": available, "reason": reason, "rows": []}
     if not available:
         return out
     import time
-
-    from .reference import voxel_carve
 
     for asset in cfg.assets:
         _, rep, hull = _baked(cfg, asset)
@@ -305,15 +288,6 @@ DISPLACEMENT_MODES = (("surface, fill", {"slicing": "surface", "alpha_test": "fi
 
 def displacement(cfg: BenchConfig, log) -> dict:
     """§3 on the demo terrain (one polygon: the exact reference applies) and the donut."""
-    from ... import metrics
-    from ...bench.timing import time_render
-    from ...render.draw import render
-    from ...scene.assets import terrain_heights
-    from ...scene.views import orbit_bounds
-    from .displacement_bake import DisplacementParams, bake_displacement
-    from .displacement_demo import DONUT_SLICES, furry_donut
-    from .displacement_reference import wrong_hits
-
     terrain = bake_displacement(terrain_heights(cfg.terrain_res),
                                 DisplacementParams(displacement_scale=0.4))
     rows = []

@@ -29,7 +29,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...bake.project import CUBE_FACES, axis_frame, project_mesh
+from ...core.transforms import MAX_COORDINATE
 from ...errors import UsageError
+from ...gl import targets
+from ...gl.textures import MAX_TEXTURE_ARRAY_BYTES
+from ...io.rk import DEFAULT_MAX_BYTES
+from ...units import format_bytes
 
 #: Growth of the bounding cube on every side, as a fraction of the mesh's largest extent.
 MARGIN = 0.02
@@ -133,8 +138,6 @@ class DepthImages:
 def check_side(side: float) -> None:
     """Refuse a cube side outside [`MIN_SIDE`, `MAX_COORDINATE`] (no float32 draw, and no
     float64 inverse, holds it)."""
-    from ...core.transforms import MAX_COORDINATE
-
     if not (np.isfinite(side) and MIN_SIDE <= side <= MAX_COORDINATE):
         raise UsageError(f"the depth images' cube side must be within [{MIN_SIDE:g}, "
                          f"{MAX_COORDINATE:g}] world units, got {side:g}; scale the mesh")
@@ -173,10 +176,6 @@ def check_size(n: int) -> None:
     """Refuse, before anything is allocated, six N x N images that no .rk file could hold
     (`io.rk.DEFAULT_MAX_BYTES`) or whose colours no GPU texture array could (they are
     uploaded as one when drawn), with the estimate and the largest N that fits."""
-    from ...gl.textures import MAX_TEXTURE_ARRAY_BYTES
-    from ...io.rk import DEFAULT_MAX_BYTES
-    from ...units import format_bytes
-
     arrays, colours = 6 * n * n * TEXEL_BYTES, 6 * n * n * 16
     if arrays <= DEFAULT_MAX_BYTES and colours <= MAX_TEXTURE_ARRAY_BYTES:
         return
@@ -193,10 +192,7 @@ def check_memory(n: int, stage: str) -> None:
     """Refuse, before anything is allocated, a ``stage`` ("bake" or "render") of six N x N
     images whose host-memory peak (`PEAK_TEXEL_BYTES`) exceeds `gl.targets.host_limit`,
     with the estimate and the largest N that fits."""
-    from ...gl.targets import host_limit
-    from ...units import format_bytes
-
-    per_texel, limit = PEAK_TEXEL_BYTES[stage], host_limit()
+    per_texel, limit = PEAK_TEXEL_BYTES[stage], targets.host_limit()
     needed = 6 * n * n * per_texel
     if needed > limit:
         largest = int((limit / (6 * per_texel)) ** 0.5)

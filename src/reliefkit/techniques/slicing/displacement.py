@@ -31,6 +31,7 @@ import numpy as np
 
 from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas, linear_tint
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh, vertex_normals
 from ...scene.views import source_box
 
 MAX_TEXELS = 8192 * 8192
@@ -184,8 +185,6 @@ class DisplacementMap:
         every base triangle cut into ``subdivisions``^2 triangles, each vertex moved by
         height(uv) * scale along the linearly interpolated normal (the volume's own
         parametrisation), coloured from the colour texture."""
-        from ...scene.mesh import RenderMesh, vertex_normals
-
         n = int(subdivisions)
         if n < 1 or n > 256:
             raise UsageError(f"subdivisions must be in [1, 256], got {subdivisions!r}")

@@ -21,9 +21,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
+from ...bake.project import axis_frame, dilate, project_mesh
 from ...bake.uv_atlas import kept_atlas
+from ...colorspace import srgb_decode
 from ...core.params import param
-from ...errors import UsageError
+from ...errors import FormatError, UsageError
+from ...io.npy import npy_header
+from ...scene.heightmap import check_file, is_heightmap, load_heightmap
+from ...scene.mesh import RenderMesh
 from .displacement import DisplacementMap
 from .displacement_textures import (
     TEXTURES,
@@ -62,8 +67,6 @@ class DisplacementParams:
 def square_base(name: str = "square"):
     """One polygon (two triangles): a SQUARE x SQUARE square in the xz plane, y up, uvs
     u = (x + 1) / 2, v = (z + 1) / 2."""
-    from ...scene.mesh import RenderMesh
-
     half = SQUARE / 2
     positions = np.array([[-half, 0, -half], [half, 0, -half], [half, 0, half],
                           [-half, 0, half]], np.float64)
@@ -75,8 +78,6 @@ def square_base(name: str = "square"):
 
 def box_base(box_to_world: np.ndarray, name: str):
     """The bottom face h = 0 of a box (u, v, h) -> world as one polygon, uvs = (u, v)."""
-    from ...scene.mesh import RenderMesh
-
     corners = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64)
     world = corners @ box_to_world[:3, :2].T + box_to_world[:3, 3]
     up = box_to_world[:3, 2] / np.linalg.norm(box_to_world[:3, 2])
@@ -100,8 +101,6 @@ def _file_texture(spec: str):
     """(colour, height) of a file: the paper's displacement texture (an RGBA .png, or an
     (H, W, 4) .npy of linear floats, with the displacement in alpha) or a grey heightmap
     (.png or a 2D .npy; colours from the terrain palette)."""
-    from ...scene.heightmap import check_file, is_heightmap, load_heightmap
-
     if not is_heightmap(spec):
         raise UsageError(f"--displacement {spec}: not one of {', '.join(TEXTURES)}, nor a "
                          "heightmap or displacement texture (.png or .npy)")
@@ -118,10 +117,6 @@ def _rgba_texture(spec: str):
     """An RGBA displacement texture's (linear colour with alpha 1, height = alpha), or None
     for a file without an alpha channel (then it is a heightmap)."""
     from pathlib import Path
-
-    from ...colorspace import srgb_decode
-    from ...errors import FormatError
-    from ...io.npy import npy_header
 
     path = Path(spec)
     if path.suffix.lower() == ".png":
@@ -197,8 +192,6 @@ def bake_displacement(source, p: DisplacementParams, progress=None) -> Displacem
 def _usable(mesh):
     """The mesh without triangles that have no area in space or in uv (its materials kept),
     and how many were left out."""
-    from ...scene.mesh import RenderMesh
-
     tris = np.asarray(mesh.indices, np.int64)
     p = mesh.world_positions[tris]
     uv = np.asarray(mesh.uvs, np.float64)[tris]
@@ -218,8 +211,6 @@ def _usable(mesh):
 
 def _projected(mesh, p: DisplacementParams, tile) -> DisplacementMap:
     """The mesh seen from above (+y) through its bounding box, onto the box's bottom face."""
-    from ...bake.project import axis_frame, project_mesh
-
     if tile != (1.0, 1.0):
         raise UsageError("--tile needs --displacement (a projected mesh covers its polygon "
                          "once)")
@@ -243,7 +234,6 @@ def _projected(mesh, p: DisplacementParams, tile) -> DisplacementMap:
     h = max(2, int(round(p.res * extent[1] / longest)))
     proj = project_mesh(mesh, box, (w, h))
     color = np.clip(np.asarray(proj.color, np.float32), 0, 1).copy()
-    from ...bake.project import dilate
 
     (color_rgb,) = dilate(proj.mask, color[..., :3])
     color[..., :3] = color_rgb

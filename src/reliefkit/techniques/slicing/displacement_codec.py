@@ -23,6 +23,7 @@ from ...io.mesh_codec import (
     surface_to_arrays,
 )
 from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
+from ...scene.mesh import Material, RenderMesh
 from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
 ARRAYS = BASE_MESH_ARRAYS | {
@@ -58,8 +59,6 @@ def _check_shapes(shapes: dict) -> None:
 
 
 def _from_arrays(arrays: dict, params: dict) -> DisplacementMap:
-    from ...scene.mesh import Material, RenderMesh
-
     params = dict(params)
     scale, tile, wrap = (params.pop(k, None) for k in OWN)
     if not (_number(scale) and scale > 0):

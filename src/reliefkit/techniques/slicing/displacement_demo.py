@@ -5,6 +5,10 @@ from a grazing angle with each slicing."""
 from __future__ import annotations
 
 from ...core.technique import DemoTile
+from ...scene.assets.surfaces import torus
+from .displacement import DisplacementMap
+from .displacement_bake import square_base
+from .displacement_textures import bumps, fur
 
 DONUT_QUADS = 25   # 25 x 25 quads: the paper's 625 polygons
 DONUT_SLICES = 20  # the paper used 15-25
@@ -14,10 +18,6 @@ DONUT_TILE = (8.0, 4.0)
 
 def furry_donut(res: int = 64, scale: float = DONUT_SCALE, tile=DONUT_TILE):
     """Fig. 1: a 25 x 25 torus with the fur texture tiled over it."""
-    from ...scene.assets.surfaces import torus
-    from .displacement import DisplacementMap
-    from .displacement_textures import fur
-
     base = torus(major_segments=DONUT_QUADS, minor_segments=DONUT_QUADS)
     color, height = fur(res=res)
     return DisplacementMap(base, color, height, scale, tuple(tile), True,
@@ -25,10 +25,6 @@ def furry_donut(res: int = 64, scale: float = DONUT_SCALE, tile=DONUT_TILE):
 
 
 def bumpy_square(res: int = 64):
-    from .displacement import DisplacementMap
-    from .displacement_bake import square_base
-    from .displacement_textures import bumps
-
     color, height = bumps(res=res)
     return DisplacementMap(square_base(), color, height, 0.4, (1.0, 1.0), False,
                            {"source": "square", "texture": "bumps"})

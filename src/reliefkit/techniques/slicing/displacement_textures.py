@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import UsageError
+from ...units import format_bytes
 
 #: Texels generated at a time: the textures are made a band of rows at a time, so their
 #: float64 temporaries stay this size whatever the resolution.
@@ -110,8 +111,6 @@ def make_texture(name: str, res: int):
                          f"{', '.join(TEXTURES)}, or give a heightmap .png/.npy)")
     texels = int(res) ** 2
     if texels > MAX_TEXELS:
-        from ...units import format_bytes
-
         minutes = SECONDS_PER_MTEXEL * texels / 1e6 / 60
         raise UsageError(f"a {name} texture of {res}x{res} texels would take up to about "
                          f"{minutes:.0f} minutes here and {format_bytes(TEXEL_BYTES * texels)} "

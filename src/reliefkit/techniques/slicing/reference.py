@@ -26,11 +26,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ...bake.project import axis_frame
 from ...core.transforms import transform_points
 from ...errors import UsageError
 from ...reference.heightfield import clip_box
 from ...scene.camera import pixel_segments
-from .depth_images import DepthImages
+from .depth_images import FACE_INDEX, DepthImages
 
 # the face whose outward normal is -a (lower bound of q_a) / +a (upper bound), per axis a
 _LOWER_FACE = (1, 3, 5)
@@ -270,7 +271,6 @@ def carved_fraction(images: DepthImages) -> np.ndarray:
     object, i.e. what the other images carve away (open or paper-thin surfaces seen edge-on
     by them: a ground plane, a sheet). Closed solids give about 0."""
     occupied = occupied_columns(images)
-    from .depth_images import FACE_INDEX
 
     out = np.zeros(6)
     for face, k in FACE_INDEX.items():
@@ -280,7 +280,6 @@ def carved_fraction(images: DepthImages) -> np.ndarray:
         axis = "xyz".index(face[-1])
         column = occupied[axis]  # indexed by the other two axes in order
         rows, cols = np.nonzero(mask)
-        from ...bake.project import axis_frame
 
         frame = axis_frame(face)
         corner = 0.5 - 0.5 * frame.sum(axis=0)

@@ -13,9 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...bake.project import axis_frame
 from ...errors import UsageError
 from ...scene.views import source_box
-from .depth_images import DepthImages, visual_hull
+from .depth_images import FACE_INDEX, DepthImages, visual_hull
 
 #: `DepthObject.bake_report` warns when more of one image's silhouette than this is carved
 #: away by the other images (`reference.carved_fraction`).
@@ -58,9 +59,6 @@ class DepthObject:
         four images across that axis cover, grown by half a texel (a silhouette misses at
         most that much, where no texel centre is covered); the cube's if no image sees
         anything."""
-        from ...bake.project import axis_frame
-        from .depth_images import FACE_INDEX
-
         n = self.resolution
         lo, hi = np.ones(3), np.zeros(3)
         for face, k in FACE_INDEX.items():
@@ -86,7 +84,7 @@ class DepthObject:
         return (0, 2, 4) if self.hull else tuple(range(6))
 
     def bake_report(self) -> list[str]:
-        from .reference import carved_fraction
+        from .reference import carved_fraction  # numba: slow to import
 
         n = self.resolution
         covered = [f"{100 * float(m.mean()):.0f}%" for m in self.images.mask]

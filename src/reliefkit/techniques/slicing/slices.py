@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...core.transforms import transform_points
 from ...errors import UsageError
 
 #: The unit cube's corners, bit a of corner index i giving coordinate a.
@@ -407,8 +408,6 @@ AUTO_MIN, AUTO_MAX = 2, 2048
 def pixel_world_size(camera, point) -> float:
     """World length that one pixel spans at ``point`` (in the image plane's vertical), from
     the camera's own matrices (so any camera kind)."""
-    from ...core.transforms import transform_points
-
     p = np.asarray(point, dtype=np.float64)
     view = np.asarray(camera.view, dtype=np.float64)
     eye_p = transform_points(view, p[None])[0]

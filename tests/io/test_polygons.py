@@ -11,7 +11,7 @@ import pytest
 from helpers import inside_polygon, shoelace, triangles_covering
 from scipy.spatial.transform import Rotation
 
-from reliefkit.scene.loader.polygons import triangulate_polygon
+from reliefkit.io.meshes.polygons import triangulate_polygon
 
 
 def keyhole(n_arc: int = 24) -> np.ndarray:

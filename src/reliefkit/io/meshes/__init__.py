@@ -20,7 +20,7 @@ import warnings
 from pathlib import Path
 
 from ...errors import MeshError
-from ..mesh import RenderMesh
+from ...scene.mesh import RenderMesh
 from .badfile import MAX_FILE_BYTES, BadFile, read_regular, regular_file_size
 from .fans import triangulate_fans
 from .gltf import check_glb, check_gltf

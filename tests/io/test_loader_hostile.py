@@ -22,9 +22,9 @@ import pytest
 import trimesh
 from PIL import Image
 
-import reliefkit.scene.loader as loader_package
+import reliefkit.io.meshes as loader_package
 from reliefkit.errors import MeshError
-from reliefkit.scene.loader import badfile, load_mesh
+from reliefkit.io.meshes import badfile, load_mesh
 
 TRIANGLE_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 NOT_REGULAR = "is not a regular file"
@@ -38,7 +38,7 @@ needs_fifo = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs os.mkfi
 CHILD = """
 import sys
 from reliefkit.errors import MeshError
-from reliefkit.scene.loader import load_mesh
+from reliefkit.io.meshes import load_mesh
 try:
     mesh = load_mesh(sys.argv[1])
 except MeshError as exc:

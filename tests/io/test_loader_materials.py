@@ -14,7 +14,7 @@ import trimesh
 from PIL import Image
 
 from reliefkit.io.inputs import describe
-from reliefkit.scene.loader import DEFAULT_COLOR, load_mesh
+from reliefkit.io.meshes import DEFAULT_COLOR, load_mesh
 from reliefkit.scene.mesh import Material, RenderMesh
 
 QUAD_UV = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])

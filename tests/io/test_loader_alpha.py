@@ -18,7 +18,7 @@ from PIL import Image
 
 from reliefkit.errors import MeshError
 from reliefkit.io import rk
-from reliefkit.scene.loader import DEFAULT_COLOR, load_mesh
+from reliefkit.io.meshes import DEFAULT_COLOR, load_mesh
 from reliefkit.scene.mesh import Material, RenderMesh
 
 QUAD_UV = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
@@ -228,7 +228,7 @@ def test_textures_pil_cannot_open_keep_the_colour_with_one_warning(tmp_path, cap
 
 
 def test_warnings_of_a_load_that_failed_do_not_reach_the_next(tmp_path):
-    from reliefkit.scene.loader import materials
+    from reliefkit.io.meshes import materials
 
     materials.SurfaceReader(srgb=True).warnings.append("left by a failed load")
     materials.note_texture_problem("x.png", "could not be opened")

@@ -1,4 +1,4 @@
-"""Tests for `reliefkit.scene.loader.load_mesh`: every format, colours, textures, bad input.
+"""Tests for `reliefkit.io.meshes.load_mesh`: every format, colours, textures, bad input.
 
 All input files are generated in tmp_path (with trimesh's exporters or written by hand).
 """
@@ -14,7 +14,7 @@ import trimesh
 from PIL import Image
 
 from reliefkit.errors import MeshError
-from reliefkit.scene.loader import SUPPORTED_EXTENSIONS, load_mesh
+from reliefkit.io.meshes import SUPPORTED_EXTENSIONS, load_mesh
 from reliefkit.scene.mesh import vertex_normals
 
 

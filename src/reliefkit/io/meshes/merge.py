@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import MeshError
-from ..mesh import Material, RenderMesh
+from ...scene.mesh import Material, RenderMesh
 from .badfile import BadFile
 from .materials import take_warnings
 from .normals import usable_normals

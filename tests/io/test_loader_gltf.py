@@ -18,7 +18,7 @@ import pytest
 import trimesh
 
 from reliefkit.errors import MeshError
-from reliefkit.scene.loader import load_mesh
+from reliefkit.io.meshes import load_mesh
 
 
 def expect_error(path, *words):
@@ -79,7 +79,7 @@ def load_in_a_fresh_process(path, *, without_draco=False) -> tuple[str, str]:
         "import sys",
         f"if {without_draco}: sys.modules['DracoPy'] = None  # as if it were not installed",
         "from reliefkit.errors import MeshError",
-        "from reliefkit.scene.loader import load_mesh",
+        "from reliefkit.io.meshes import load_mesh",
         "try:",
         "    print('loaded', load_mesh(sys.argv[1]).triangle_count)",
         "except MeshError as exc:",

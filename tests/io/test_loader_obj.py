@@ -12,7 +12,7 @@ import trimesh
 from helpers import inside_polygon, shoelace, triangles_covering
 from PIL import Image
 
-from reliefkit.scene.loader import load_mesh
+from reliefkit.io.meshes import load_mesh
 
 # ------------------------------------------------------------------------- texture paths
 

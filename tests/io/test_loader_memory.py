@@ -1,9 +1,9 @@
-"""Plain OBJ files read with numpy (:mod:`reliefkit.scene.loader.plain_obj`): the same meshes
+"""Plain OBJ files read with numpy (:mod:`reliefkit.io.meshes.plain_obj`): the same meshes
 and the same errors as the general path, in a few times the file's size.
 
 The general path (`check_obj` and trimesh's OBJ parser) is the reference: every file here is
 loaded twice, once as `load_mesh` reads it and once with the plain reader patched out of
-`_parsed` (it looks the name up in the package, `reliefkit.scene.loader.read_plain_obj`),
+`_parsed` (it looks the name up in the package, `reliefkit.io.meshes.read_plain_obj`),
 and the two outcomes must be identical: the same `RenderMesh` array for array, or the same
 `MeshError` message. Files are written by hand or generated (seeded) in tmp_path.
 """
@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 import trimesh
 
-import reliefkit.scene.loader as loader_package
+import reliefkit.io.meshes as loader_package
 from reliefkit.errors import MeshError
-from reliefkit.scene.loader import badfile, load_mesh, plain_obj
-from reliefkit.scene.loader.plain_obj import read_plain_obj
+from reliefkit.io.meshes import badfile, load_mesh, plain_obj
+from reliefkit.io.meshes.plain_obj import read_plain_obj
 
 # ------------------------------------------------------------------------------ helpers
 

@@ -28,7 +28,7 @@ import trimesh
 from PIL import Image
 
 from ...colorspace import srgb_decode
-from ..mesh import ALPHA_MODES, Material
+from ...scene.mesh import ALPHA_MODES, Material
 from .badfile import BadFile
 
 #: Linear base colour of a surface whose file gives none.

@@ -13,7 +13,7 @@ import numpy as np
 import trimesh
 
 from ...core.transforms import MAX_COORDINATE
-from ..mesh import Material
+from ...scene.mesh import Material
 from .badfile import BadFile, check_range
 from .materials import SurfaceReader, decode_colors, is_face_colored
 from .normals import file_normals

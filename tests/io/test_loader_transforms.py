@@ -15,7 +15,7 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from reliefkit.scene.loader import load_mesh
+from reliefkit.io.meshes import load_mesh
 
 
 @pytest.fixture(autouse=True)

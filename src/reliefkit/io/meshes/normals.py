@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from ..mesh import vertex_normals
+from ...scene.mesh import vertex_normals
 
 
 def file_normals(geometry: trimesh.Trimesh) -> np.ndarray | None:

@@ -1,0 +1,63 @@
+"""The composition root: the one place that puts the built-ins into the registry.
+
+`registry()` registers the core's ``mesh`` kind and ground-truth drawable and every technique
+of ``reliefkit.techniques.TECHNIQUES`` in `reliefkit.core.technique.REGISTRY`, once per
+process, and hands the tables derived from it to the layers below: the .rk reader's kinds
+(`reliefkit.io.rk.use_codecs`) and the shader loader's namespaces
+(`reliefkit.gl.shaders.use_namespaces`). Those layers never reach back up for them. Every
+entry point (the public API in ``reliefkit/__init__``, the CLI, compare) calls `registry()`
+before it looks anything up; the benches and the demo sheet run from the CLI.
+
+Importing this module is light: it loads none of numba, scipy or trimesh. The techniques
+import those where they run them, and their benches, demo tiles and references when those
+are called (`tests/test_cli_startup.py`).
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+
+from .bake import bake as _bake
+from .core.technique import REGISTRY, Registry
+from .gl import shaders
+from .io import rk
+from .io.mesh_codec import MESH_CODEC
+from .render import render as _render
+from .render.mesh import MESH_DRAWABLE
+from .techniques import TECHNIQUES
+
+__all__ = ["registry", "bake", "load", "render", "save"]
+
+_lock = threading.Lock()
+_filled = False
+
+
+def registry() -> Registry:
+    """The registry with every built-in in it (registered on the first call)."""
+    global _filled
+    with _lock:
+        if not _filled:
+            REGISTRY.add_core(codecs=(MESH_CODEC,), drawables=(MESH_DRAWABLE,))
+            for tech in TECHNIQUES:
+                REGISTRY.register(tech)
+            rk.use_codecs(REGISTRY.codecs)
+            shaders.use_namespaces(REGISTRY.shader_namespaces)
+            _filled = True
+    return REGISTRY
+
+
+def _with_builtins(function):
+    """The public ``reliefkit.NAME`` of a function that looks things up in the registry."""
+    @functools.wraps(function)
+    def public(*args, **kwargs):
+        registry()
+        return function(*args, **kwargs)
+
+    return public
+
+
+bake = _with_builtins(_bake)
+load = _with_builtins(rk.load)
+render = _with_builtins(_render)
+save = _with_builtins(rk.save)
