@@ -12,8 +12,10 @@ from reliefkit.builtins import registry
 from reliefkit.io import rk
 from reliefkit.scene.assets import make_asset
 
-HEAVY = ("numba", "trimesh", "scipy", "networkx", "matplotlib", "moderngl",
-         "fast_simplification", "open3d", "vtk", "imageio")
+# moderngl is not among them: importing it takes about 16 ms and makes no context (the
+# executor's module imports it; `render()` makes the context when it first draws)
+HEAVY = ("numba", "trimesh", "scipy", "networkx", "matplotlib", "fast_simplification",
+         "open3d", "vtk", "imageio")
 
 RUN = """
 import contextlib, io, json, sys
