@@ -135,6 +135,32 @@ def test_nothing_imports_the_cli(path):
                 or m.startswith("reliefkit.cli.")}
 
 
+# the draw path's users of GL: the GL layer, the one executor and its multi-pass kinds; and
+# outside the draw path the GPU bake passes and the frame-timing harness
+GL_USERS = (PACKAGE / "gl", PACKAGE / "render" / "executor.py", PACKAGE / "render" / "multipass",
+            PACKAGE / "bake", PACKAGE / "bench" / "timing.py")
+# what only the GL layer and the executor may use to make or draw GL objects
+GL_MAKERS = ("moderngl", "reliefkit.gl.shaders", "reliefkit.gl.stencil", "reliefkit.gl.timing",
+             "reliefkit.render.executor", "reliefkit.render.multipass")
+
+
+def uses_gl(path: Path) -> set[str]:
+    return {m for m in imported_modules(path)
+            if any(m == g or m.startswith(g + ".") for g in GL_MAKERS)}
+
+
+@pytest.mark.parametrize("path", modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_only_the_executor_and_the_gl_layer_touch_gl(path):
+    """Drawables describe (draw plans), one executor draws: no technique, and nothing in
+    the core outside `GL_USERS` and the code that runs a render, makes GL objects."""
+    if any(path == u or u in path.parents for u in GL_USERS):
+        return
+    allowed = {PACKAGE / "render" / "draw.py": "reliefkit.render.executor",  # runs a render
+               PACKAGE / "builtins.py": "reliefkit.gl.shaders"}.get(path)  # the root fills
+    used = {m for m in uses_gl(path) if not (allowed and m.startswith(allowed))}
+    assert not used, f"{path.name} uses {sorted(used)}"
+
+
 def test_the_rules_see_violations(tmp_path, monkeypatch):
     """The checker itself: a module that imports and names relief is caught."""
     bad = PACKAGE / "bad_module_for_the_test.py"
@@ -144,6 +170,9 @@ def test_the_rules_see_violations(tmp_path, monkeypatch):
     idents, consts = names_used(bad)
     identifiers, strings = declared_names()
     assert "ReliefTexture" in idents & identifiers and "relief-cube" in consts & strings
+    monkeypatch.setattr(Path, "read_text", lambda self, encoding=None: (
+        "import moderngl\nfrom .gl.shaders import program\n"))
+    assert uses_gl(bad) == {"moderngl", "reliefkit.gl.shaders", "reliefkit.gl.shaders.program"}
 
 
 def test_every_option_class_is_declared_with_param():

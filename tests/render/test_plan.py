@@ -61,7 +61,7 @@ def _round_trip(plans):
 
 @pytest.mark.parametrize("obj", _objects(), ids=[*IDS, "mesh:tree"])
 def test_every_drawable_describes_its_draws_as_plans_that_round_trip(gl, obj):
-    (drawable,) = make_drawables(gl, [obj], {})
+    (drawable,) = make_drawables([obj], {})
     assert drawable.plans and all(isinstance(p, DrawPlan) for p in drawable.plans)
     back = _round_trip(drawable.plans)
     for k, (plan, read) in enumerate(zip(drawable.plans, back, strict=True)):
@@ -70,7 +70,7 @@ def test_every_drawable_describes_its_draws_as_plans_that_round_trip(gl, obj):
 
 def test_shared_arrays_and_textures_stay_shared(gl):
     mesh = make_asset("vehicle")
-    (drawable,) = make_drawables(gl, [mesh], {})
+    (drawable,) = make_drawables([mesh], {})
     back = _round_trip(drawable.plans)
     assert len({id(p.geometry) for p in back}) == len({id(p.geometry) for p in drawable.plans})
     doc, arrays = to_json(drawable.plans)
@@ -83,7 +83,7 @@ def test_plans_read_back_draw_the_same_frame(gl, tech_kind):
     rep = sample(*tech_kind)
     camera = orbit_bounds(rep.bounds, 30.0, 35.0, 2.4, size=(48, 40))
     light = DirectionalLight()
-    (drawable,) = make_drawables(gl, [rep], {})
+    (drawable,) = make_drawables([rep], {})
     expected = render(rep, camera, light=light)
     drawable.plans = _round_trip(drawable.plans)
     from reliefkit.render.draw import Scene
@@ -104,7 +104,7 @@ def test_a_view_hook_names_only_reliefkit_functions():
 
 def test_executor_uploads_shared_textures_once(gl):
     mesh = make_asset("vehicle")
-    (drawable,) = make_drawables(gl, [mesh], {})
+    (drawable,) = make_drawables([mesh], {})
     executor = Executor(gl)
     try:
         executor.upload(drawable.plans)

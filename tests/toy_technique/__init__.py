@@ -156,7 +156,7 @@ TECHNIQUE = Technique(
     codecs=(CODEC,),
     representations=(ToyQuad,),
     bakers=(Baker("toy-quad", "the bounding rectangle of a mesh", ToyBakeParams, bake_quad),),
-    drawables=(DrawableSpec(ToyQuad, ToyDrawable, ToyRenderOptions, planned=True),),
+    drawables=(DrawableSpec(ToyQuad, ToyDrawable, ToyRenderOptions),),
     compare_variants=(CompareVariant("flat", {"method": "flat"}),
                       CompareVariant("checker", {"method": "checker"})),
     compare_metrics=(CompareMetric("alpha", _mean_alpha, ("mean_alpha",)),),

@@ -51,22 +51,19 @@ class Baker:
 
 @dataclass(frozen=True)
 class DrawableSpec:
-    """How to draw instances of ``cls``: ``factory(ctx, obj, options, instrument)``.
+    """How to draw instances of ``cls``: ``factory(obj, options, instrument)``, no GL.
 
     ``options`` is the dataclass of its render options (or None); ``factory`` gets an
     instance. ``instrument`` asks for the iteration-counting variant (the core reads the
-    counters back, see `reliefkit.gl.targets`). The drawable returned has ``draw(camera,
-    light)``, optionally ``finish(frame)``, ``release()``, ``transparent`` (bool) and
-    ``extra_attachments`` (int).
+    counters back, see `reliefkit.gl.targets`). The drawable returned has ``plans`` (its
+    `render.plan.DrawPlan` list, which the executor draws), optionally
+    ``extra_attachments`` (int), ``sort_distance(camera)`` (transparent drawables) and
+    ``finish(frame, stats)`` (``stats``: its view hooks' for that frame).
     """
 
     cls: type
     factory: Callable
     options: type | None = None
-    #: the factory takes ``(obj, options, instrument)``, no context, and returns a drawable
-    #: whose ``plans`` (`render.plan.DrawPlan`) the executor draws, with optionally
-    #: ``finish(frame, stats)``, ``sort_distance(camera)`` and ``extra_attachments``
-    planned: bool = False
 
     @property
     def option_list(self) -> tuple[Option, ...]:

@@ -20,7 +20,7 @@ from ..gl.targets import check_msaa, draw_passes
 from ..scene.light import DirectionalLight
 from .executor import Executor
 from .frame import frame_from_passes
-from .registry import make_drawables, release_all
+from .registry import make_drawables
 
 
 class Scene:
@@ -34,12 +34,10 @@ class Scene:
         self.ctx = ctx or get_context()
         self.count_iterations = count_iterations
         self.executor = Executor(self.ctx)
-        self.drawables = make_drawables(self.ctx, self.objects, options,
-                                        instrument=count_iterations)
+        self.drawables = make_drawables(self.objects, options, instrument=count_iterations)
         try:
             for drawable in self.drawables:
-                if _planned(drawable):
-                    self.executor.upload(drawable.plans)
+                self.executor.upload(drawable.plans)
         except BaseException:
             self.release()
             raise
@@ -52,7 +50,6 @@ class Scene:
 
     def release(self) -> None:
         self.executor.release()
-        release_all(self.drawables)
 
     @property
     def extra_attachments(self) -> int:
@@ -62,11 +59,8 @@ class Scene:
     def draw(self, drawable, camera, light, stats: dict) -> None:
         """One drawable into the bound framebuffer; its view hooks' statistics into
         ``stats``."""
-        if _planned(drawable):
-            for plan in drawable.plans:
-                stats.update(self.executor.draw(plan, camera, light))
-        else:
-            drawable.draw(camera, light)
+        for plan in drawable.plans:
+            stats.update(self.executor.draw(plan, camera, light))
 
     def draw_opaque(self, camera, light) -> None:
         """The opaque drawables into the bound framebuffer (what benchmarks time)."""
@@ -99,12 +93,8 @@ class Scene:
             _iteration_stats(frame, images.extra[0])
         for drawable in self.drawables:
             finish = getattr(drawable, "finish", None)
-            if finish is None:
-                continue
-            if _planned(drawable):
+            if finish is not None:
                 finish(frame, stats[id(drawable)])
-            else:
-                finish(frame)
         return frame
 
 
@@ -130,14 +120,8 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
     return frames if isinstance(camera, list | tuple) else frames[0]
 
 
-def _planned(drawable) -> bool:
-    return hasattr(drawable, "plans")
-
-
 def _transparent(drawable) -> bool:
-    if _planned(drawable):
-        return any(plan.render_pass == "transparent" for plan in drawable.plans)
-    return getattr(drawable, "transparent", False)
+    return any(plan.render_pass == "transparent" for plan in drawable.plans)
 
 
 def _multisampled_frame_color(camera, images) -> np.ndarray:

@@ -107,4 +107,4 @@ def material_uniforms(material: Material) -> dict:
 
 
 #: The core's ground-truth drawable; the composition root (`reliefkit.builtins`) registers it.
-MESH_DRAWABLE = DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions, planned=True)
+MESH_DRAWABLE = DrawableSpec(RenderMesh, MeshDrawable, MeshRenderOptions)

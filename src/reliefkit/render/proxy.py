@@ -10,12 +10,12 @@ fragments.
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import UsageError
+from .plan import Raster
 
 
 @dataclass(frozen=True)
@@ -31,31 +31,13 @@ class Proxy:
         return self.positions.astype(np.float64) + self.origin
 
 
-GL_DEPTH_CLAMP = 0x864F
-
-
-@contextmanager
-def proxy_raster_state(ctx):
-    """Face culling on, and depth clamped instead of clipped at the near and far planes,
-    for drawing proxies (set ``ctx.cull_face`` to `cull_face` for each).
-
-    A proxy may reach beyond the camera's near-far range, which hugs the object (a reverse
-    frustum baked without clipping is wider than its mesh): clipping would cut holes where
-    its drawn faces lie beyond far, although the surface inside is in range. A face clamped
-    to the far plane has the depth the Z-buffer is cleared to, so the test passes on equal
-    depths while proxies are drawn.
-    """
-    import moderngl
-
-    ctx.enable(moderngl.CULL_FACE)
-    ctx.enable_direct(GL_DEPTH_CLAMP)
-    ctx.depth_func = "<="
-    try:
-        yield
-    finally:
-        ctx.depth_func = "<"  # moderngl's default, which the other passes use
-        ctx.disable_direct(GL_DEPTH_CLAMP)
-        ctx.disable(moderngl.CULL_FACE)
+#: How proxies are drawn: back faces culled (`cull_face` per view says which), depth
+#: clamped instead of clipped at the near and far planes, and the test passing on equal
+#: depths. A proxy may reach beyond the camera's near-far range, which hugs the object (a
+#: reverse frustum baked without clipping is wider than its mesh): clipping would cut holes
+#: where its drawn faces lie beyond far, although the surface inside is in range; a face
+#: clamped to the far plane has the depth the Z-buffer is cleared to.
+PROXY_RASTER = Raster(depth_func="<=", depth_clamp=True, cull="back")
 
 
 def cull_face(proxy: Proxy, camera) -> str:

@@ -26,7 +26,7 @@ def render_options(obj) -> tuple:
     return _spec_for(obj)[1].option_list
 
 
-def make_drawables(ctx, objects, options: dict, *, instrument: bool = False) -> list:
+def make_drawables(objects, options: dict, *, instrument: bool = False) -> list:
     """Drawables for ``objects``, each given the options it declares; unknown options fail."""
     found = [_spec_for(obj) for obj in objects]
     declared = {opt.name for _, spec in found for opt in spec.option_list}
@@ -37,23 +37,9 @@ def make_drawables(ctx, objects, options: dict, *, instrument: bool = False) -> 
                          f"{', '.join(sorted({type(o).__name__ for o in objects}))} "
                          f"(options: {offered})")
     drawables = []
-    try:
-        for (owner, spec), obj in zip(found, objects, strict=True):
-            mine = {k: v for k, v in options.items()
-                    if k in {opt.name for opt in spec.option_list}}
-            opts = _params.make(spec.options, mine, f"{owner} render option") \
-                if spec.options is not None else None
-            drawables.append(spec.factory(obj, opts, instrument) if spec.planned
-                             else spec.factory(ctx, obj, opts, instrument))
-    except BaseException:
-        release_all(drawables)
-        raise
+    for (owner, spec), obj in zip(found, objects, strict=True):
+        mine = {k: v for k, v in options.items() if k in {opt.name for opt in spec.option_list}}
+        opts = _params.make(spec.options, mine, f"{owner} render option") \
+            if spec.options is not None else None
+        drawables.append(spec.factory(obj, opts, instrument))
     return drawables
-
-
-def release_all(drawables) -> None:
-    """Release drawables that own GL objects themselves (those that draw without plans)."""
-    for drawable in drawables:
-        release = getattr(drawable, "release", None)
-        if release:
-            release()

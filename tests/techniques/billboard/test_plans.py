@@ -4,16 +4,14 @@ hand-over decided per view), by render modules that create no GL objects themsel
 
 from __future__ import annotations
 
-import ast
 import json
 from dataclasses import fields
-from pathlib import Path
 
 import numpy as np
 import pytest
 from billboard_scenes import stacked
 
-from reliefkit.core.technique import load_all
+from reliefkit.core.technique import technique
 from reliefkit.render import render
 from reliefkit.render.frame import Frame
 from reliefkit.render.plan import from_json, to_json
@@ -26,7 +24,7 @@ SIZE = (64, 48)
 
 @pytest.fixture(scope="module")
 def scenes(gl):
-    samples = {t.name: t for t in load_all()}["billboard"].samples()
+    samples = technique("billboard").samples()
     shells = {variant: bake_boxes(stacked(), variant, epsilon=0.05, texel_size=0.1)
               for variant in ("shell", "thick-shell")}
     # three orbit distances in bounding radii (from inside the sample's box on): boxes
@@ -89,28 +87,3 @@ def test_plans_survive_json_and_draw_the_same_frames(scenes, name, monkeypatch):
     monkeypatch.setattr(cls, "__init__", from_file)
     for a, b in zip(direct, render(rep, cameras, **options), strict=True):
         assert_same_frames(a, b)
-
-
-def imports(module) -> set[str]:
-    """Absolute names of what ``module`` imports, relative imports resolved."""
-    package = module.__name__.split(".")[:-1]
-    out = set()
-    for node in ast.walk(ast.parse(Path(module.__file__).read_text(encoding="utf-8"))):
-        if isinstance(node, ast.Import):
-            out |= {alias.name for alias in node.names}
-        elif isinstance(node, ast.ImportFrom):
-            base = package[:len(package) - node.level + 1] if node.level else []
-            target = ".".join([*base, *([node.module] if node.module else [])])
-            out |= {target} | {f"{target}.{alias.name}" for alias in node.names}
-    return out
-
-
-def test_render_modules_create_no_gl_objects():
-    """The executor draws; the technique only describes (docs/architecture.md)."""
-    forbidden = ("moderngl", "reliefkit.gl.shaders", "reliefkit.gl.textures",
-                 "reliefkit.gl.objects", "reliefkit.gl.stencil", "reliefkit.gl.context",
-                 "reliefkit.gl.uniforms.set_uniforms",
-                 "reliefkit.gl.targets.use_transparent_blending")
-    for module in (cloud_render, box_render):
-        assert not {name for name in imports(module) if name.startswith(forbidden)}, \
-            module.__name__

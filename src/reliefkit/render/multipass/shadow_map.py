@@ -16,8 +16,9 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from ...core.transforms import translation
 from ..plan import Raster
-from ..shadows import render_shadow_map
+from ..shadows import SHADOW_SIZE, light_camera
 
 
 def draw_shadow_mapped(executor, plan, camera, light, uniforms: dict, textures: dict) -> dict:
@@ -52,7 +53,6 @@ def shadow_inputs(executor, plan, light, params) -> tuple[dict, dict]:
         finally:
             outer.use()
         executor.keep(depth)
-        shadow_uniforms.pop("u_shadow_map", None)  # bound with the plan's textures
         if params.get("sampler", "compare") == "depth":
             depth.compare_func = ""
             depth.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -60,3 +60,32 @@ def shadow_inputs(executor, plan, light, params) -> tuple[dict, dict]:
             shadow_uniforms["u_shadow_bias"] = float(params["bias"])
         executor.cache[key] = shadow_uniforms, {"u_shadow_map": depth}
     return executor.cache[key]
+
+
+def render_shadow_map(ctx, bounds, light, origin, draw_depth, size: int = SHADOW_SIZE):
+    """Draw ``draw_depth(light_camera)`` into a depth texture from the light; returns the
+    texture (the caller releases it) and the uniforms of shadow_map.glsl for geometry
+    stored relative to ``origin`` (float64 world point). Leaves the framebuffer and the
+    enabled state to the caller to restore."""
+    cam = light_camera(bounds, light, size)
+    depth = ctx.depth_texture(cam.size)
+    fbo = ctx.framebuffer(depth_attachment=depth)
+    try:
+        fbo.use()
+        fbo.viewport = (0, 0, *cam.size)
+        fbo.clear(depth=1.0)
+        ctx.enable_only(moderngl.DEPTH_TEST)  # both faces cast: open meshes and leaves too
+        draw_depth(cam)
+    except BaseException:
+        depth.release()
+        raise
+    finally:
+        fbo.release()
+    depth.compare_func = "<="  # sampler2DShadow: each lookup is a depth test, filtered
+    depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    depth.repeat_x = depth.repeat_y = False
+    world_texel = 2.0 * cam.ortho_height / size
+    light_matrix = np.asarray(cam.proj) @ np.asarray(cam.view) @ translation(
+        np.asarray(origin, np.float64))
+    return depth, {"u_light_matrix": light_matrix, "u_shadow_texel": float(world_texel),
+                   "u_shadow_bias": float(world_texel / (cam.far - cam.near))}

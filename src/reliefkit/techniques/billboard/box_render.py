@@ -64,12 +64,11 @@ from ...render.plan import (
     DrawPlan,
     Geometry,
     Program,
-    Raster,
     Texture,
     ViewHook,
     ViewUpdate,
 )
-from ...render.proxy import Proxy, box_planes, convex_proxy, cull_face
+from ...render.proxy import PROXY_RASTER, Proxy, box_planes, convex_proxy, cull_face
 from ...scene.camera import Camera
 from .boxes import BillboardBox, BillboardBoxes
 from .lod import flatten_factor
@@ -165,9 +164,6 @@ def _min_sphere_step(scale: float, margin: float) -> float:
     return math.floor(margin / scale + 1.0) * scale - margin
 
 
-#: Proxies are drawn culled (`cull_face` per view) with depth clamped and tested with "<="
-#: (`render.proxy`).
-PROXY_RASTER = Raster(depth_func="<=", depth_clamp=True, cull="back")
 #: Where ``u_bbc_color`` and ``u_bbc_normal`` point without lod auto: units no texture of a
 #: box uses (the shader declares them, and two sampler types may not share a unit).
 _NO_CLOUD_UNITS = {"u_bbc_color": 4, "u_bbc_normal": 5}
@@ -298,4 +294,4 @@ def _atlas_uniforms(cloud, k: int) -> dict:
 
 def drawable_spec() -> DrawableSpec:
     """The `DrawableSpec` of `BillboardBoxes` for the package's Technique."""
-    return DrawableSpec(BillboardBoxes, BillboardBoxesDrawable, BoxRenderOptions, planned=True)
+    return DrawableSpec(BillboardBoxes, BillboardBoxesDrawable, BoxRenderOptions)

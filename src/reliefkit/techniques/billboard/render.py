@@ -89,5 +89,4 @@ class BillboardCloudDrawable:
 
 def drawable_spec() -> DrawableSpec:
     """How the technique draws its clouds (the package's `Technique` declares it)."""
-    return DrawableSpec(BillboardCloud, BillboardCloudDrawable, BillboardRenderOptions,
-                        planned=True)
+    return DrawableSpec(BillboardCloud, BillboardCloudDrawable, BillboardRenderOptions)

@@ -107,10 +107,8 @@ TECHNIQUE = Technique(
         Baker("relief-cube", "six reverse frusta splitting the bounding cube (§4.2)",
               ReliefCubeParams, bake_cube),
     ),
-    drawables=(DrawableSpec(ReliefTexture, ReliefDrawable, ReliefRenderOptions,
-                            planned=True),
-               DrawableSpec(ReliefObject, ReliefObjectDrawable, ReliefRenderOptions,
-                            planned=True)),
+    drawables=(DrawableSpec(ReliefTexture, ReliefDrawable, ReliefRenderOptions),
+               DrawableSpec(ReliefObject, ReliefObjectDrawable, ReliefRenderOptions)),
     compare_variants=tuple(
         CompareVariant(m, {"method": m}, _robust_draws if m == "robust" else (lambda rep: True))
         for m in METHODS),

@@ -21,21 +21,23 @@ from ...render.plan import (
     DrawPlan,
     Geometry,
     Program,
-    Raster,
     Texture,
     ViewHook,
     ViewUpdate,
 )
-from ...render.proxy import Proxy, aabb_planes, box_planes, convex_proxy, cull_face
+from ...render.proxy import (
+    PROXY_RASTER,
+    Proxy,
+    aabb_planes,
+    box_planes,
+    convex_proxy,
+    cull_face,
+)
 from .maxmip import max_pyramid
 from .representation import ReliefObject, ReliefTexture
 
 METHODS = ("binary", "exact", "robust", "maxmip", "cone")
 PROGRAM = "relief:relief.glsl"
-#: how proxies are drawn (`render.proxy`): depth clamped, not clipped, and tested with
-#: "<=" (a face clamped to the far plane has the cleared depth); `proxy_view` picks the
-#: faces to cull per camera
-PROXY_RASTER = Raster(depth_func="<=", depth_clamp=True, cull="back")
 
 
 @dataclass(frozen=True)

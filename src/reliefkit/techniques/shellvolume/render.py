@@ -302,5 +302,4 @@ def cycles_warning(cycles: int) -> str:
 
 def drawable_spec() -> DrawableSpec:
     """How the technique draws its shells (the package's `Technique` declares it)."""
-    return DrawableSpec(TexturedShell, TexturedShellDrawable, ShellRenderOptions,
-                        planned=True)
+    return DrawableSpec(TexturedShell, TexturedShellDrawable, ShellRenderOptions)

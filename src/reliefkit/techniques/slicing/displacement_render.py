@@ -185,5 +185,4 @@ def slices_view(plan, camera, light, *, displacement, layers, volume, slicing, s
 
 
 def drawable_spec() -> DrawableSpec:
-    return DrawableSpec(DisplacementMap, DisplacementDrawable, DisplacementRenderOptions,
-                        planned=True)
+    return DrawableSpec(DisplacementMap, DisplacementDrawable, DisplacementRenderOptions)

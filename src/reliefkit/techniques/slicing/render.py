@@ -48,12 +48,11 @@ from ...render.plan import (
     Geometry,
     MultiPass,
     Program,
-    Raster,
     Texture,
     ViewHook,
     ViewUpdate,
 )
-from ...render.proxy import Proxy, box_planes, convex_proxy, cull_face
+from ...render.proxy import PROXY_RASTER, Proxy, box_planes, convex_proxy, cull_face
 from .depth_images import FACE_INDEX, check_memory
 from .representation import DepthObject
 from .slices import auto_slice_count, orthogonal_slices, screen_slices, view_direction
@@ -164,7 +163,7 @@ class DepthObjectDrawable:
             program=Program(PROGRAM, defines | {"RAYCAST": True}),
             geometry=_geometry(proxy.positions, cube, proxy.triangles),
             uniforms=uniforms | {"u_visible_depth": visible_depth(rep.resolution)},
-            raster=Raster(depth_func="<=", depth_clamp=True, cull="back"),
+            raster=PROXY_RASTER,
             origin=tuple(float(x) for x in proxy.origin),
             per_view=ViewHook(f"{__name__}:ray_cast_view", {
                 "cube_to_world": rep.images.cube_to_world, "planes": proxy.planes,
@@ -301,8 +300,7 @@ def slices_view(plan, camera, light, *, cube_to_world, resolution, slicing, slic
 
 
 def drawable_spec() -> DrawableSpec:
-    return DrawableSpec(DepthObject, DepthObjectDrawable, DepthObjectRenderOptions,
-                        planned=True)
+    return DrawableSpec(DepthObject, DepthObjectDrawable, DepthObjectRenderOptions)
 
 
 __all__ = ["DepthObjectDrawable", "DepthObjectRenderOptions", "PROGRAMS", "drawable_spec"]
