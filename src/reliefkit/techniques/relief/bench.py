@@ -179,12 +179,15 @@ def correctness(cfg: BenchConfig, log) -> list[dict]:
         relief = bakers[kind](mesh, depth_res=cfg.correctness_res, tolerance=cfg.tolerance,
                               safety=True)  # robust_jump reads them at every size
         name = model_label(name)
-        for az, el in cfg.correctness_views:
-            camera = orbit_bounds(relief.bounds, az, el, 2.2, cfg.correctness_size)
+        cameras = [orbit_bounds(relief.bounds, az, el, 2.2, cfg.correctness_size)
+                   for az, el in cfg.correctness_views]
+        # every view of a method in one call: one upload (the cone map computed once)
+        frames = {method: render(relief, cameras, method=method) for method in METHODS}
+        for k, ((az, el), camera) in enumerate(zip(cfg.correctness_views, cameras,
+                                                   strict=True)):
             row = {"model": name + kind, "azimuth": az, "elevation": el}
             for method in METHODS:
-                frame = render(relief, camera, method=method)
-                row[method] = wrong_hits(frame, relief, camera)["wrong_fraction"]
+                row[method] = wrong_hits(frames[method][k], relief, camera)["wrong_fraction"]
             rows.append(row)
             log(f"correctness: {name}{kind} el {el}: " + ", ".join(
                 f"{m} {row[m]:.4%}" for m in METHODS))
