@@ -134,24 +134,22 @@ def quality(cfg: BenchConfig, log) -> list[dict]:
     rows = []
     for asset in cfg.assets:
         mesh, rep, hull = _baked(cfg, asset)
-        for view in cfg.views:
-            cam = _orbit(rep, view, cfg.size)
-            log(f"quality: {asset} at {view[0]:g},{view[1]:g}")
-            mesh_frame = render(mesh, cam)
-            reference = exact_intersection(rep.images, cam)
-            hull_reference = exact_intersection(hull.images, cam)
-            for label, options in _variants(cfg):
-                frame = render(rep, cam, **options)
-                rows.append({"asset": asset, "view": list(view), "object": "depth object",
-                             "variant": label} | _scores(frame, mesh_frame, rep, cam,
-                                                          reference))
-            for label, options in (("ray cast", {"slicing": "raycast"}),
-                                   ("orthogonal auto", {"slicing": "orthogonal",
-                                                        "alpha_test": POINT})):
-                frame = render(hull, cam, **options)
-                rows.append({"asset": asset, "view": list(view), "object": "visual hull",
-                             "variant": label} | _scores(frame, mesh_frame, hull, cam,
-                                                          hull_reference))
+        log(f"quality: {asset} from {len(cfg.views)} views")
+        cams = [_orbit(rep, view, cfg.size) for view in cfg.views]
+        mesh_frames = render(mesh, cams)  # each list of views in one call: one upload
+        references = [exact_intersection(rep.images, cam) for cam in cams]
+        hull_references = [exact_intersection(hull.images, cam) for cam in cams]
+        drawn = [("depth object", rep, references, label, render(rep, cams, **options))
+                 for label, options in _variants(cfg)]
+        drawn += [("visual hull", hull, hull_references, label, render(hull, cams, **options))
+                  for label, options in (("ray cast", {"slicing": "raycast"}),
+                                         ("orthogonal auto", {"slicing": "orthogonal",
+                                                              "alpha_test": POINT}))]
+        for k, (view, cam) in enumerate(zip(cfg.views, cams, strict=True)):
+            for what, obj, refs, label, frames in drawn:
+                rows.append({"asset": asset, "view": list(view), "object": what,
+                             "variant": label} | _scores(frames[k], mesh_frames[k], obj, cam,
+                                                          refs[k]))
     return rows
 
 
