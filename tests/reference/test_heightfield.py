@@ -1,5 +1,5 @@
 """The exact ray vs bilinear-patch heightfield intersection against brute force and analytic
-answers (reliefkit.reference.heightfield)."""
+answers (reliefkit.reference.heightfield: its kernels, one ray at a time)."""
 
 from __future__ import annotations
 
@@ -8,15 +8,54 @@ import pytest
 
 from reliefkit.errors import UsageError
 from reliefkit.reference.heightfield import (
-    cells_visited,
-    intersect_ray,
+    as_height,
+    clip_box,
+    crossings_between,
+    first_hit_in,
     intersect_rays,
-    max_penetration,
-    ray_crossings,
+    max_depth_below,
     surface_height,
+    walk_segments,
 )
 
 TOL = 1e-6
+
+
+# ---------------------------------------------------------------------------------------------
+# one ray through the kernels
+# ---------------------------------------------------------------------------------------------
+def _ray(origin, direction) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(origin, dtype=np.float64), np.asarray(direction, dtype=np.float64)
+
+
+def intersect_ray(height, origin, direction) -> float:
+    """The first hit of one ray (`intersect_rays`)."""
+    return float(intersect_rays(height, [origin], [direction])[0])
+
+
+def ray_crossings(height, origin, direction, t0, t1) -> np.ndarray:
+    """Every crossing of one ray with the surface on [t0, t1] (`crossings_between`)."""
+    return crossings_between(as_height(height), *_ray(origin, direction), float(t0), float(t1))
+
+
+def max_penetration(height, origin, direction, t0, t1) -> float:
+    """Largest depth of one ray below the surface on [t0, t1] (`max_depth_below`)."""
+    return float(max_depth_below(as_height(height), *_ray(origin, direction), float(t0),
+                                 float(t1)))
+
+
+def cells_visited(height, origin, direction, t_max: float | None = None) -> int:
+    """Cells the exact walk (`walk_segments`) visits from the box entry to the first hit,
+    the box exit or ``t_max``."""
+    h = as_height(height)
+    o, d = _ray(origin, direction)
+    t0, t1 = clip_box(o, d, 0.0, np.inf)
+    if t0 > t1:
+        return 0
+    end = min(t1, first_hit_in(h, o, d, t0, t1), np.inf if t_max is None else float(t_max))
+    if end == t0:
+        return 1
+    return int(walk_segments(*h.shape, o, d, t0, end)[3])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -105,11 +144,13 @@ def test_surface_interpolates_centres_and_clamps():
 
 def test_bad_input_is_a_usage_error():
     with pytest.raises(UsageError):
-        intersect_ray(np.array([[np.nan]]), [0, 0, 1], [0, 0, -1])
+        intersect_rays(np.array([[np.nan]]), [[0, 0, 1]], [[0, 0, -1]])
     with pytest.raises(UsageError):
-        intersect_ray(np.zeros(3), [0, 0, 1], [0, 0, -1])
+        intersect_rays(np.zeros(3), [[0, 0, 1]], [[0, 0, -1]])
     with pytest.raises(UsageError):
-        intersect_ray(np.zeros((2, 2)), [0, 0], [0, 0, -1])
+        intersect_rays(np.zeros((2, 2)), [[0, 0, 1], [0, 0, 1]], [[0, 0, -1]])
+    with pytest.raises(UsageError):
+        intersect_rays(np.zeros((2, 2)), [[0, 0, np.inf]], [[0, 0, -1]])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -124,7 +165,6 @@ def test_matches_brute_force_on_random_fields(rng, shape, smooth):
     rays = _random_rays(rng, 48)
     got = intersect_rays(h, [o for o, _ in rays], [d for _, d in rays])
     for (o, d), t in zip(rays, got, strict=True):
-        assert intersect_ray(h, o, d) == t
         want = brute_force_hit(h, o, d)
         if np.isinf(want):
             assert np.isinf(t)

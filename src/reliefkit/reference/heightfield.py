@@ -44,11 +44,7 @@ __all__ = [
     "crossings_between",
     "max_depth_below",
     "surface_height",
-    "intersect_ray",
     "intersect_rays",
-    "ray_crossings",
-    "max_penetration",
-    "cells_visited",
 ]
 
 JIT_OPTIONS = {"cache": True, "error_model": "numpy", "nogil": True}
@@ -371,13 +367,6 @@ def as_height(height) -> np.ndarray:
     return arr
 
 
-def _as_vec3(v, label: str) -> np.ndarray:
-    arr = np.ascontiguousarray(np.asarray(v, dtype=np.float64).reshape(-1))
-    if arr.shape != (3,) or not np.isfinite(arr).all():
-        raise UsageError(f"{label} must be 3 finite numbers (u, v, h), got {v!r}")
-    return arr
-
-
 def surface_height(height, x, y):
     """Bilinear, border-clamped surface height at texel coordinates.
 
@@ -403,38 +392,23 @@ def surface_height(height, x, y):
     return out.reshape(xs.shape)
 
 
-def intersect_ray(height, origin, direction) -> float:
-    """Parameter ``t >= 0`` of the first hit of ``origin + t * direction`` with the surface.
+def intersect_rays(height, origins, directions) -> np.ndarray:
+    """Parameter ``t >= 0`` of the first hit of each ray ``origins[r] + t * directions[r]``
+    with the surface (numba, parallel over rays).
 
     Parameters
     ----------
     height : (H, W) array_like
         Heightfield in [0, 1].
-    origin, direction : sequence of 3 floats
-        The ray in box coordinates (u, v, h); ``direction`` need not be normalised.
-
-    Returns
-    -------
-    float
-        The smallest ``t >= 0`` inside the unit box where ``h <= S`` (the entry ``t`` when the
-        ray enters the box on or below the surface), or ``numpy.inf`` when the ray misses.
-    """
-    return float(_intersect(as_height(height), _as_vec3(origin, "origin"),
-                            _as_vec3(direction, "direction")))
-
-
-def intersect_rays(height, origins, directions) -> np.ndarray:
-    """Vectorised :func:`intersect_ray` (numba, parallel over rays).
-
-    Parameters
-    ----------
-    height : (H, W) array_like
     origins, directions : (N, 3) array_like
+        The rays in box coordinates (u, v, h); directions need not be normalised.
 
     Returns
     -------
     numpy.ndarray
-        (N,) float64 first-hit parameters, ``inf`` for misses.
+        (N,) float64: per ray the smallest ``t >= 0`` inside the unit box where ``h <= S``
+        (the entry ``t`` when the ray enters the box on or below the surface), ``inf`` for
+        misses.
     """
     h = as_height(height)
     o = np.ascontiguousarray(np.asarray(origins, dtype=np.float64).reshape(-1, 3))
@@ -446,51 +420,3 @@ def intersect_rays(height, origins, directions) -> np.ndarray:
     out = np.empty(o.shape[0])
     _intersect_many(h, o, d, out)
     return out
-
-
-def ray_crossings(height, origin, direction, t0, t1) -> np.ndarray:
-    """Every ``t`` in ``[t0, t1]`` (inside the box) where the ray crosses the surface.
-
-    A crossing is a sign change of ``F = h - S`` between "above" (``F > 0``) and "on or
-    below" (``F <= 0``). A ray that only touches the surface produces two crossings at (almost)
-    the same ``t`` with zero penetration between them (see :func:`max_penetration`).
-
-    Returns
-    -------
-    numpy.ndarray
-        Sorted crossing parameters (float64).
-    """
-    h = as_height(height)
-    return crossings_between(h, _as_vec3(origin, "origin"), _as_vec3(direction, "direction"),
-                      float(t0), float(t1))
-
-
-def max_penetration(height, origin, direction, t0, t1) -> float:
-    """Largest depth ``S - h`` of the ray below the surface on ``[t0, t1]`` (inside the box).
-
-    Exact per cell (endpoints and the extremum of the cell's quadratic). Negative when the
-    ray stays above the surface; ``-inf`` when the range misses the box.
-    """
-    h = as_height(height)
-    return float(max_depth_below(h, _as_vec3(origin, "origin"), _as_vec3(direction, "direction"),
-                            float(t0), float(t1)))
-
-
-def cells_visited(height, origin, direction, t_max: float | None = None) -> int:
-    """Number of cells (between centerlines) the exact walk visits until the first hit.
-
-    The walk starts at the box entry and stops at the first hit (or the box exit, or
-    ``t_max``); the count is the iteration count of the exact method of section 3.3.
-    """
-    h = as_height(height)
-    o = _as_vec3(origin, "origin")
-    d = _as_vec3(direction, "direction")
-    t0, t1 = clip_box(o, d, 0.0, np.inf)
-    if t0 > t1:
-        return 0
-    hit = first_hit_in(h, o, d, t0, t1)
-    end = min(t1, hit, np.inf if t_max is None else float(t_max))
-    if end == t0:
-        return 1
-    hh, ww = h.shape
-    return int(walk_segments(hh, ww, o, d, t0, end)[3])

@@ -16,8 +16,8 @@ from reliefkit.scene.camera import Camera
 from reliefkit.scene.light import DirectionalLight
 from reliefkit.techniques.billboard import box_render
 from reliefkit.techniques.billboard.box_reference import (
-    occupied_voxels,
     reference_trace,
+    texel_intervals,
     wrong_hits,
 )
 from reliefkit.techniques.billboard.boxes import MAX_DISTANCE, BillboardBox, BillboardBoxes
@@ -79,6 +79,19 @@ def distance_texture(occupied: np.ndarray, frame) -> np.ndarray:
     sides = np.linalg.norm(frame[:3, :3], axis=0)[::-1] / occupied.shape  # (w, v, u)
     dist = distance_transform_edt(~occupied, sampling=sides / sides.min())
     return np.minimum(np.floor(dist + 1e-6), MAX_DISTANCE).astype(np.uint8)
+
+
+def occupied_voxels(box: BillboardBox, variant: str, thickness: float | None = None):
+    """(D, H, W) bool: the voxels that meet the box's occupied set (what its distance texture
+    must measure from for sphere tracing to be safe). Volumetric: alpha >= 128; shells: the
+    voxels [k/D, (k+1)/D] that the texel's interval in w meets."""
+    occupied = box.color[..., 3] >= 128
+    if variant == "volumetric":
+        return occupied
+    lo, hi = texel_intervals(box, variant, thickness)
+    depth = box.resolution[2]
+    k = np.arange(depth)[:, None, None]
+    return occupied[None] & (lo[None] <= (k + 1) / depth) & (hi[None] >= k / depth)
 
 
 def random_colors(rng, shape) -> tuple[np.ndarray, np.ndarray]:

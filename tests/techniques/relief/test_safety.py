@@ -8,7 +8,7 @@ import pytest
 from scipy.ndimage import gaussian_filter
 
 from reliefkit.errors import UsageError
-from reliefkit.techniques.relief.safety import safety_radii
+from reliefkit.techniques.relief.safety import octant, safety_radii
 from reliefkit.techniques.relief.safety_check import CHECK_FLOOR, check_safety
 
 
@@ -245,8 +245,9 @@ def test_octants_are_told_apart_by_the_checker():
 
 
 def test_octant_of_a_direction():
-    from reliefkit.techniques.relief.safety import octant
-
     assert octant(True, 1.0, 0.0) == 0 and octant(True, 1.0, -0.5) == 1
     assert octant(True, -1.0, 0.5) == 2 and octant(True, -1.0, -0.5) == 3
     assert octant(False, 1.0, 0.5) == 4 and octant(False, -1.0, -0.5) == 7
+    # element-wise, as the checker picks each ray's radius
+    np.testing.assert_array_equal(octant(np.array([True, False, False]), [-1.0, 1.0, -1.0],
+                                         [0.5, -0.5, 0.0]), [2, 5, 6])

@@ -114,14 +114,14 @@ def test_topological_sort_breaks_a_cycle_and_counts_it():
     src = np.array([0, 1, 2, 2])
     dst = np.array([1, 2, 0, 3])
     depth = np.array([0.0, 1.0, 2.0, 3.0, 0.5])
-    order, broken = topological_order(5, src, dst, depth)
+    order, broken, _ = topological_order(by_depth(depth), (src, dst))
     assert full_permutation(order, 5)
     assert broken == 1
     pos = np.argsort(order)
     kept = [(s, d) for s, d in zip(src, dst, strict=True) if pos[s] < pos[d]]
     assert len(kept) == 3
     assert pos[2] < pos[3]
-    assert np.array_equal(order, topological_order(5, src, dst, depth)[0])
+    assert np.array_equal(order, topological_order(by_depth(depth), (src, dst))[0])
 
 
 def test_acyclic_graph_keeps_every_relation():
@@ -130,7 +130,7 @@ def test_acyclic_graph_keeps_every_relation():
     src = rng.integers(0, n, 800)
     dst = rng.integers(0, n, 800)
     keep = src < dst  # acyclic by construction
-    order, broken = topological_order(n, src[keep], dst[keep], rng.random(n))
+    order, broken, _ = topological_order(by_depth(rng.random(n)), (src[keep], dst[keep]))
     pos = np.argsort(order)
     assert broken == 0 and (pos[src[keep]] < pos[dst[keep]]).all()
 
@@ -162,16 +162,14 @@ def test_gap_relations_are_needed_when_ties_break_badly(torus_shell):
     separate them (the reference's own rays at 64, or a fine 512 buffer)."""
     camera = Camera.orbit((0, 0, 0), 35, 20, 4.5, size=(64, 64))
     worst = -centroid_depths(torus_shell, camera)
-    count = len(torus_shell.tets)
     src, dst = adjacent_relations(torus_shell, camera)
-    adjacency_only, _ = topological_order(count, src, dst, worst)
+    adjacency_only, _, _ = topological_order(by_depth(worst), (src, dst))
     bad, _ = violations(torus_shell, camera, adjacency_only)
     assert bad > 0
     for resolution in (64, 512):
         src, dst = abuffer_relations(torus_shell, camera, resolution)
         a_src, a_dst = adjacent_relations(torus_shell, camera)
-        order, broken = topological_order(count, np.concatenate([a_src, src]),
-                                          np.concatenate([a_dst, dst]), worst)
+        order, broken, _ = topological_order(by_depth(worst), (a_src, a_dst), (src, dst))
         fixed, _ = violations(torus_shell, camera, order)
         print(f"adversarial ties: adjacency only {bad}, with A-buffer {resolution}: {fixed}")
         assert fixed == 0 and broken == 0
@@ -256,6 +254,11 @@ def test_random_views_sxmpvo_exact_centroid_not(name):
     assert ce_bad > 0
 
 
+def by_depth(depth):
+    """The visiting order `topological_order` takes: nearest first, ties by index."""
+    return np.argsort(depth, kind="stable")
+
+
 def reference_order(count, src, dst, depth):
     """The previous implementation's traversal, in plain numpy and Python: relations made
     distinct with np.unique, successors by lexsort (nearest last), roots farthest first."""
@@ -312,9 +315,10 @@ def test_topological_order_matches_the_reference_with_cycles():
     for n, m in ((50, 400), (300, 1500), (40, 40)):
         src, dst = rng.integers(0, n, m), rng.integers(0, n, m)
         depth = rng.integers(0, 5, n).astype(float)  # many ties: broken by index
-        order, broken = topological_order(n, src, dst, depth)
-        ref, ref_broken, _ = reference_order(n, src, dst, depth)
+        order, broken, edges = topological_order(by_depth(depth), (src, dst))
+        ref, ref_broken, ref_edges = reference_order(n, src, dst, depth)
         assert np.array_equal(order, ref) and broken == ref_broken and broken > 0
+        assert edges == ref_edges
 
 
 def test_the_checker_counts_the_same_at_any_scale():

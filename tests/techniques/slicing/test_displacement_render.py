@@ -8,15 +8,12 @@ import numpy as np
 import pytest
 from slicing_scenes import assert_same_frames, frame_from_json_plans
 
+from reliefkit.core.transforms import homogeneous, invert_box
 from reliefkit.render import render
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.slicing.displacement import DisplacementMap
 from reliefkit.techniques.slicing.displacement_bake import square_base
-from reliefkit.techniques.slicing.displacement_reference import (
-    reference_colors,
-    reference_hits,
-    wrong_hits,
-)
+from reliefkit.techniques.slicing.displacement_reference import reference_hits, wrong_hits
 from reliefkit.techniques.slicing.displacement_textures import terrain_colors, waves
 
 RES = 32
@@ -34,6 +31,35 @@ def heights() -> np.ndarray:
 def rep():
     h = heights()
     return DisplacementMap(square_base(), terrain_colors(h), h, 0.5)
+
+
+def reference_colors(rep: DisplacementMap, camera, *, floor: bool = True) -> np.ndarray:
+    """(H, W, 3) the unlit linear colour at the exact first hits (`reference_hits`), NaN
+    where none: the texture's colour times the surface's tint at the hit's uv, from the base
+    triangle under it (`DisplacementMap.tint`)."""
+    mask, position = reference_hits(rep, camera, floor=floor)
+    uv = (homogeneous(position[mask]) @ invert_box(rep.one_polygon_box()).T)[:, :2]
+    color = np.full((*mask.shape, 3), np.nan)
+    color[mask] = rep.sample_color(uv[:, 0], uv[:, 1])[:, :3] * rep.tint(
+        uv, base_triangle_at(rep.base, uv))
+    return color
+
+
+def base_triangle_at(base, uv) -> np.ndarray:
+    """(N,) the base triangle whose uv triangle holds each of ``uv`` (N, 2), the nearest to
+    inside for points on no triangle (barycentric test, one triangle at a time)."""
+    tri_uv = np.asarray(base.uvs, np.float64)[np.asarray(base.indices, np.int64)]
+    best = np.zeros(len(uv), np.int64)
+    depth = np.full(len(uv), -np.inf)  # the smallest barycentric coordinate so far
+    for k, (a, b, c) in enumerate(tri_uv):
+        m = np.column_stack([b - a, c - a])
+        if abs(np.linalg.det(m)) < 1e-30:
+            continue
+        l1, l2 = np.linalg.solve(m, (uv - a).T)
+        inside = np.minimum(np.minimum(l1, l2), 1.0 - l1 - l2)
+        better = inside > depth
+        best[better], depth[better] = k, inside[better]
+    return best
 
 
 def camera(rep, az=30.0, el=40.0, size=96):

@@ -1,5 +1,6 @@
 """Open3D's voxel carving as a peer of `reference.voxel_carve` (the Open3D runs skip without
-open3d; the status, the camera emulation and the numpy model of Open3D's rule always run)."""
+open3d; the status, the camera emulation and the numpy model of Open3D's rule, `open3d_rule`
+here, always run)."""
 
 from __future__ import annotations
 
@@ -24,7 +25,6 @@ from reliefkit.techniques.slicing.peers import (
     face_cameras,
     open3d_agreement,
     open3d_carve,
-    open3d_rule,
     open3d_status,
 )
 from reliefkit.techniques.slicing.reference import voxel_carve
@@ -43,6 +43,56 @@ N = 32
 # (box: 12960 / (34 x 22 x 28) = 0.62) or the camera is wrong (a misplaced or mirrored
 # face carves away whole slabs).
 MIN_IOU = 0.75
+
+
+def open3d_rule(images: DepthImages, n: int, silhouettes: bool = False, *,
+                distance: float = DISTANCE) -> np.ndarray:
+    """Open3D's carving rule evaluated here in numpy with *exact orthographic* projection:
+    (n, n, n) bool [z, y, x], no Open3D needed.
+
+    A voxel survives image k when any of its 8 corners falls within the pixel centres'
+    rectangle and the bilinear value there (of the same float32 image `open3d_carve` passes:
+    metric depth ``distance + depth`` in cube sides, 0 off the mask; or the 0/1 mask) passes
+    (``d > 0`` and the corner's depth ``>= d``; or ``value > 0``): Open3D's
+    ``VoxelGrid::CarveDepthMap`` / ``CarveSilhouette`` with ``Image::FloatValueAt``. Its
+    difference from `open3d_carve` is only the distant pinhole's perspective (and float
+    rounding), which makes it the check that the camera emulation is right; its difference
+    from `voxel_carve` is the rule itself (any corner and bilinear, versus voxel centre and
+    nearest texel).
+    """
+    res = images.resolution
+    lattice = np.arange(n + 1) / n
+    z, y, x = np.meshgrid(lattice, lattice, lattice, indexing="ij")
+    corners = np.stack([x, y, z], axis=-1).reshape(-1, 3)
+    world = corners @ images.cube_to_world[:3, :3].T + images.cube_to_world[:3, 3]
+    keep = np.ones((n, n, n), bool)
+    for k in range(6):
+        to_box = np.linalg.inv(images.box_to_world[k])
+        uvh = world @ to_box[:3, :3].T + to_box[:3, 3]
+        px, py = uvh[:, 0] * res - 0.5, uvh[:, 1] * res - 0.5
+        within = (px >= 0) & (px <= res - 1) & (py >= 0) & (py <= res - 1)
+        if silhouettes:
+            values = images.mask[k].astype(np.float32)
+        else:
+            values = np.where(images.mask[k], distance + images.depth[k].astype(np.float64),
+                              0.0).astype(np.float32)
+        ui = np.clip(np.floor(np.clip(px, 0, res - 1)).astype(int), 0, res - 2)
+        vi = np.clip(np.floor(np.clip(py, 0, res - 1)).astype(int), 0, res - 2)
+        pu, pv = px - ui, py - vi
+        d = ((values[vi, ui] * (1 - pv) + values[vi + 1, ui] * pv) * (1 - pu)
+             + (values[vi, ui + 1] * (1 - pv) + values[vi + 1, ui + 1] * pv) * pu)
+        if silhouettes:
+            passes = within & (d > 0)
+        else:
+            passes = within & (d > 0) & (distance + 1.0 - uvh[:, 2] >= d)
+        passes = passes.reshape(n + 1, n + 1, n + 1)
+        voxel = np.zeros((n, n, n), bool)
+        for dz in (0, 1):
+            for dy in (0, 1):
+                for dx in (0, 1):
+                    voxel |= passes[dz:dz + n, dy:dy + n, dx:dx + n]
+        keep &= voxel
+    return keep
 
 
 def empty_images(res=4):
@@ -86,11 +136,11 @@ def test_missing_open3d_is_reported_not_raised(monkeypatch):
 def test_bad_arguments_are_usage_errors():
     with pytest.raises(UsageError):
         open3d_carve("not images", 4)
-    for n in (0, True, 2.5, 10_000):
-        with pytest.raises(UsageError):
-            open3d_rule(empty_images(), n)
+    for n in (0, True, 2.5, 10_000):  # refused before Open3D is needed
+        with pytest.raises(UsageError, match="grid size"):
+            open3d_carve(empty_images(), n)
     with pytest.raises(UsageError, match="2 x 2"):
-        open3d_rule(empty_images(res=1), 4)
+        open3d_carve(empty_images(res=1), 4)
     with pytest.raises(UsageError):
         face_cameras(empty_images(), distance=0.5)
 

@@ -25,7 +25,12 @@ from reliefkit.core.transforms import transform_points
 from reliefkit.errors import UsageError
 from reliefkit.scene.camera import Camera
 from reliefkit.techniques.slicing.depth_images import bake_depth_images, visual_hull
-from reliefkit.techniques.slicing.reference import exact_intersection, inside, voxel_carve
+from reliefkit.techniques.slicing.reference import (
+    exact_intersection,
+    inside,
+    occupied_columns,
+    voxel_carve,
+)
 
 N = 64
 
@@ -189,10 +194,27 @@ def test_reference_refuses_other_inputs(box_images):
         voxel_carve(box_images, 0)
 
 
+def occupied_voxels(images) -> np.ndarray:
+    """(N, N, N) bool [x, y, z]: the cube voxels where the nearest-texel object is not
+    empty (its box there meets the voxel with a positive or zero extent on every axis), all
+    N^3 at once from the column tables."""
+    n = images.resolution
+    b = images.column_bounds()  # (axis, lo/hi, i, j): x: [y, z], y: [x, z], z: [x, y]
+    edges = np.arange(n + 1) / n
+
+    def fits(lo, hi, cell_axis_shape):
+        lo_c = edges[:-1].reshape(cell_axis_shape)
+        hi_c = edges[1:].reshape(cell_axis_shape)
+        return np.maximum(lo, lo_c) <= np.minimum(hi, hi_c)
+
+    x = fits(b[0, 0][None, :, :], b[0, 1][None, :, :], (n, 1, 1))   # [x, y, z]
+    y = fits(b[1, 0][:, None, :], b[1, 1][:, None, :], (1, n, 1))
+    z = fits(b[2, 0][:, :, None], b[2, 1][:, :, None], (1, 1, n))
+    return x & y & z
+
+
 def test_occupied_voxels_hold_every_carved_voxel_centre(sphere_images):
     """A voxel whose centre is inside (the crude carve) meets the object's box there."""
-    from reliefkit.techniques.slicing.reference import occupied_voxels
-
     occupied = occupied_voxels(sphere_images).transpose(2, 1, 0)  # [z, y, x] like the carve
     carved = voxel_carve(sphere_images, N)
     assert carved.sum() > 1000
@@ -203,8 +225,6 @@ def test_occupied_voxels_hold_every_carved_voxel_centre(sphere_images):
 
 def test_occupied_columns_are_the_voxels_any_along_each_axis(sphere_images, cup_images):
     """The bake report's per-column occupancy (N^2 memory) is the N^3 occupancy reduced."""
-    from reliefkit.techniques.slicing.reference import occupied_columns, occupied_voxels
-
     for images in (sphere_images, cup_images, visual_hull(cup_images)):
         voxels = occupied_voxels(images)
         columns = occupied_columns(images)

@@ -7,10 +7,8 @@ from reliefkit.errors import UsageError
 from reliefkit.scene.camera import Camera, MatrixCamera
 from reliefkit.techniques.slicing.slices import (
     best_axis,
-    orthogonal_count,
     orthogonal_slices,
     screen_slices,
-    surface_slices,
 )
 
 
@@ -238,48 +236,11 @@ def test_orthogonal_on_a_sheared_box_uses_the_slice_plane_normals():
         assert stack.slice_areas().sum() * stack.spacing == pytest.approx(volume)
 
 
-def test_orthogonal_count_scales_by_the_displacement_edge_ratio():
-    # the paper's example: edge 2, maximum displacement 0.5 -> 4x the slices for b and c
-    box = np.diag([2.0, 2.0, 0.5, 1.0])
-    assert orthogonal_count(box, 2, 16, 1.0) == 16
-    assert orthogonal_count(box, 0, 16, 1.0) == 64
-    assert orthogonal_count(box, 1, 16, 1.0) == 64
-    # the displacement only filling half the box height doubles it again
-    assert orthogonal_count(np.diag([2.0, 2.0, 1.0, 1.0]), 0, 16, 0.5) == 64
-    assert orthogonal_count(np.diag([1.0, 1.0, 4.0, 1.0]), 0, 10) == 3  # ceil(2.5)
-    assert orthogonal_count(np.diag([1.0, 1.0, 40.0, 1.0]), 0, 10) == 1
-    for bad in [(0, 1.0), (16, 0.0), (16, 1.5), (16, float("nan"))]:
-        with pytest.raises(UsageError):
-            orthogonal_count(box, 0, *bad)
-    with pytest.raises(UsageError):
-        orthogonal_count(box, 3, 16)
-
-
-@pytest.mark.parametrize("make", BOXES.values(), ids=BOXES.keys())
-def test_surface_slices_from_base_to_top(make):
-    box = make()
-    stack = surface_slices(box, 5)
-    assert stack.axis == 2
-    np.testing.assert_allclose(stack.levels, [0, 0.25, 0.5, 0.75, 1.0])
-    for k in range(5):
-        q = stack.box[np.unique(stack.slice_triangles(k))]
-        np.testing.assert_allclose(q[:, 2], stack.levels[k])
-        assert len(q) == 4
-    np.testing.assert_array_equal(stack.front_to_back, [4, 3, 2, 1, 0])
-    np.testing.assert_array_equal(stack.back_to_front, [0, 1, 2, 3, 4])
-    # CCW about the +h side
-    t = stack.positions[stack.triangles]
-    h_dir = np.linalg.inv(box[:3, :3])[2]
-    assert (np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]) @ h_dir > 0).all()
-    np.testing.assert_allclose(surface_slices(box, 1).levels, [0.0])
-
-
 @pytest.mark.parametrize("count", [0, -3, 2.5, "4", True, None])
 def test_bad_counts_are_refused(count):
     cam = Camera.orbit((0.5, 0.5, 0.5), 10, 10, 4.0)
     for call in (lambda: screen_slices(unit_cube(), cam, count),
-                 lambda: orthogonal_slices(unit_cube(), cam, count),
-                 lambda: surface_slices(unit_cube(), count)):
+                 lambda: orthogonal_slices(unit_cube(), cam, count)):
         with pytest.raises(UsageError):
             call()
 

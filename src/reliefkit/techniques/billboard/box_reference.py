@@ -31,19 +31,6 @@ class ReferenceHits(NamedTuple):
     t: np.ndarray
 
 
-def occupied_voxels(box: BillboardBox, variant: str, thickness: float | None = None):
-    """(D, H, W) bool: the voxels that meet the box's occupied set (what its distance texture
-    must measure from for sphere tracing to be safe). Volumetric: alpha >= 128; shells: the
-    voxels [k/D, (k+1)/D] that the texel's interval in w meets."""
-    occupied = box.color[..., 3] >= 128
-    if variant == "volumetric":
-        return occupied
-    lo, hi = texel_intervals(box, variant, thickness)
-    depth = box.resolution[2]
-    k = np.arange(depth)[:, None, None]
-    return occupied[None] & (lo[None] <= (k + 1) / depth) & (hi[None] >= k / depth)
-
-
 def texel_intervals(box: BillboardBox, variant: str, thickness: float | None):
     """(lo, hi), (H, W) each: every texel's occupied interval in w (empty texels included)."""
     disp = box.displacement.astype(np.float64) / 65535.0

@@ -18,7 +18,7 @@ three modes (``BoxRenderOptions.march``):
 Safety of the sphere step. The distance texel of cell c holds, as box_bake.py computes it,
 the world distance between c's centre and the nearest occupied voxel's centre in units of
 the smallest voxel side, rounded down (for the shells an occupied voxel is one that meets
-the texel's interval, `box_reference.occupied_voxels`). The paper subtracts half a voxel
+the texel's interval, `distance.occupancy`). The paper subtracts half a voxel
 diagonal; that is not enough when the occupied set is whole cells: a point p anywhere in c
 and a point q anywhere in an occupied cell o are at least |c - o| - (half diagonal of c) -
 (half diagonal of o) apart, so the safe world radius is ``stored * s_min - diagonal`` (the

@@ -700,14 +700,13 @@ def checked_height(height) -> np.ndarray:
     return h
 
 
-def octant(x_major: bool, major_sign: float, minor_sign: float) -> int:
-    """The octant (index into `_FRAMES`, 0..7) of a projected direction, as the renderer
+def octant(x_major, major_sign, minor_sign) -> np.ndarray:
+    """The octant (index into `_FRAMES`, 0..7) of projected directions, as the renderer
     picks it: x-major when ``|dx| >= |dy|``; the signs of the major and the minor component
     (a zero minor component counts as positive). The radii of octant k hold for every
-    direction of that octant, its boundary directions included."""
-    if x_major:
-        return 2 * int(major_sign < 0) + int(minor_sign < 0)
-    return 4 + 2 * int(major_sign < 0) + int(minor_sign < 0)
+    direction of that octant, its boundary directions included. Element-wise on arrays."""
+    return (4 * ~np.asarray(x_major, dtype=bool) + 2 * (np.asarray(major_sign) < 0)
+            + (np.asarray(minor_sign) < 0))
 
 
 def safety_radii(height, *, tolerance: float = 0.0, max_radius: int = 255,

@@ -24,7 +24,7 @@ from ...reference.heightfield import (
     surface_at,
     walk_segments,
 )
-from .safety import checked_height, hull_push, tangent_vertex
+from .safety import checked_height, hull_push, octant, tangent_vertex
 
 __all__ = ["CHECK_FLOOR", "Violation", "check_safety"]
 
@@ -330,9 +330,7 @@ def check_safety(height, safety, *, tolerance: float = 0.0, rays: int = 20000, s
     rows, cols, majors = params[:3]
     if s.ndim == 3:  # each ray checks the radius of its direction's octant
         signs, slopes = params[3], params[5]
-        # safety.octant, for all rays at once
-        octants = 4 * (majors != 0) + 2 * (signs < 0) + (signs * slopes < 0)
-        radii = s[octants, rows, cols]
+        radii = s[octant(majors == 0, signs, signs * slopes), rows, cols]
     else:
         radii = s[rows, cols]
     n = rows.shape[0]

@@ -110,7 +110,7 @@ def visibility_order(shell, camera, method: str = "sxmpvo",
     by_depth = _by_depth(centroid_depths(shell, camera))
     a_src, a_dst = adjacent_relations(shell, camera)
     g_src, g_dst = gaps.result()
-    order, broken, edges = _sort_graph(by_depth, a_src, a_dst, g_src, g_dst)
+    order, broken, edges = topological_order(by_depth, (a_src, a_dst), (g_src, g_dst))
     return VisibilityOrder(order, broken, edges, time.perf_counter() - start, method)
 
 
@@ -529,26 +529,21 @@ def _layer_pairs(starts, faces, t, tets, tie, src, dst, write):
 # --------------------------------------------------------------------------- step 3
 
 
-def topological_order(count: int, src: np.ndarray, dst: np.ndarray,
-                      depth: np.ndarray) -> tuple[np.ndarray, int]:
-    """Order `count` nodes so that every relation src -> dst (src first) holds, by a
-    depth-first traversal (reverse post-order). Repeated relations count once and a node
-    is not in front of itself (src == dst is ignored). Relations closing a cycle are
-    dropped; returns (order (count,) int32, how many were dropped). Roots and successors
-    are visited by `depth` (then index), so the result, dropped edges included, is
-    deterministic and unconstrained nodes come out nearest first."""
-    by_depth = _by_depth(np.asarray(depth, dtype=np.float64))
-    if len(by_depth) != count:
-        raise UsageError(f"depth must have {count} values, got {len(by_depth)}")
-    src = np.ascontiguousarray(src, dtype=np.int32)
-    dst = np.ascontiguousarray(dst, dtype=np.int32)
-    order, broken, _ = _sort_graph(by_depth, src, dst, src[:0], dst[:0])
-    return order, broken
+def topological_order(by_depth: np.ndarray, *relations) -> tuple[np.ndarray, int, int]:
+    """Order the nodes so that every relation src -> dst (src first) holds, by a depth-first
+    traversal (reverse post-order); returns (order (count,) int32, relations dropped to
+    break cycles, distinct relations).
 
-
-def _sort_graph(by_depth, a_src, a_dst, b_src, b_dst) -> tuple[np.ndarray, int, int]:
-    """(order, dropped, distinct relations) of the relations in both lists, nodes visited
-    in the `by_depth` order (see `topological_order`)."""
+    by_depth: (count,) the nodes nearest first, ties by index: roots and successors are
+    visited in that order, so the result, dropped edges included, is deterministic and
+    unconstrained nodes come out nearest first. relations: one or two (src, dst) lists
+    (two are read as they are, not concatenated). Repeated relations count once and a node
+    is not in front of itself (src == dst is ignored).
+    """
+    by_depth = np.ascontiguousarray(by_depth, dtype=np.int32)
+    empty = np.empty(0, np.int32)
+    lists = [tuple(np.ascontiguousarray(x, dtype=np.int32) for x in pair) for pair in relations]
+    (a_src, a_dst), (b_src, b_dst) = lists + [(empty, empty)] * (2 - len(lists))
     offsets, targets = _rank_graph(by_depth, a_src, a_dst, b_src, b_dst)
     post, broken = _dfs(offsets, targets)
     return _from_ranks(by_depth, post), int(broken), int(offsets[-1])

@@ -44,7 +44,7 @@ from .displacement_bake import DisplacementParams, bake_displacement
 from .displacement_demo import DONUT_SLICES, furry_donut
 from .displacement_reference import wrong_hits
 from .measure import against_reference
-from .reference import exact_intersection, voxel_carve
+from .reference import exact_intersection
 from .representation import VisualHull
 
 TARGET_IOU, TARGET_RMS = 0.98, 1.0     # depth object at 256² per face vs the exact reference
@@ -257,24 +257,17 @@ def peer(cfg: BenchConfig, log) -> dict:
     out: dict = {"available": available, "reason": reason, "rows": []}
     if not available:
         return out
-    import time
-
     for asset in cfg.assets:
-        _, rep, hull = _baked(cfg, asset)
+        _, rep, _ = _baked(cfg, asset)
         for n in cfg.carve_sizes:
             log(f"peer: open3d carving {asset} at {n}³")
-            for name, obj, silhouettes in (("depth", rep, False), ("silhouette", hull, True)):
-                occupancy, seconds = peers.open3d_carve(obj.images, n, silhouettes=silhouettes)
-                start = time.perf_counter()
-                ours = voxel_carve(obj.images, n)
-                ours_seconds = time.perf_counter() - start
-                both = np.logical_and(occupancy, ours).sum()
-                union = np.logical_or(occupancy, ours).sum()
-                out["rows"].append({"asset": asset, "n": n, "carve": name,
-                                    "iou": float(both / union) if union else 1.0,
-                                    "open3d_voxels": int(occupancy.sum()),
-                                    "voxels": int(ours.sum()), "open3d_seconds": seconds,
-                                    "voxel_carve_seconds": ours_seconds})
+            for name, silhouettes in (("depth", False), ("silhouette", True)):
+                a = peers.open3d_agreement(rep.images, n, silhouettes)
+                out["rows"].append({"asset": asset, "n": n, "carve": name, "iou": a.iou,
+                                    "open3d_voxels": a.voxels_open3d,
+                                    "voxels": a.voxels_reference,
+                                    "open3d_seconds": a.seconds_open3d,
+                                    "voxel_carve_seconds": a.seconds_reference})
     return out
 
 

@@ -74,35 +74,6 @@ def reference_hits(rep: DisplacementMap, camera, *, floor: bool) -> tuple[np.nda
     return mask.reshape(h, w), pos.reshape(h, w, 3)
 
 
-def reference_colors(rep: DisplacementMap, camera, *, floor: bool = True) -> np.ndarray:
-    """(H, W, 3) the unlit linear colour at the exact first hits (`reference_hits`), NaN
-    where none: the texture's colour times the surface's tint at the hit's uv, from the base
-    triangle under it (`DisplacementMap.tint`)."""
-    mask, position = reference_hits(rep, camera, floor=floor)
-    uv = (homogeneous(position[mask]) @ invert_box(rep.one_polygon_box()).T)[:, :2]
-    color = np.full((*mask.shape, 3), np.nan)
-    color[mask] = rep.sample_color(uv[:, 0], uv[:, 1])[:, :3] * rep.tint(
-        uv, base_triangle_at(rep.base, uv))
-    return color
-
-
-def base_triangle_at(base, uv) -> np.ndarray:
-    """(N,) the base triangle whose uv triangle holds each of ``uv`` (N, 2), the nearest to
-    inside for points on no triangle (barycentric test, one triangle at a time)."""
-    tri_uv = np.asarray(base.uvs, np.float64)[np.asarray(base.indices, np.int64)]
-    best = np.zeros(len(uv), np.int64)
-    depth = np.full(len(uv), -np.inf)  # the smallest barycentric coordinate so far
-    for k, (a, b, c) in enumerate(tri_uv):
-        m = np.column_stack([b - a, c - a])
-        if abs(np.linalg.det(m)) < 1e-30:
-            continue
-        l1, l2 = np.linalg.solve(m, (uv - a).T)
-        inside = np.minimum(np.minimum(l1, l2), 1.0 - l1 - l2)
-        better = inside > depth
-        best[better], depth[better] = k, inside[better]
-    return best
-
-
 def wrong_hits(frame, rep: DisplacementMap, camera, *, floor: bool | None = None,
                tolerance_texels: float = 1.0) -> dict:
     """Pixels where a slicing render disagrees with the exact reference: exactly one of them

@@ -14,8 +14,7 @@ gradient through):
   neighbours using the same direction continue each other's slices: h at the cell centres
   (k + 0.5) / K, u and v at the centres of equal cells over the base's uv range whose world
   spacing is that of the h slices (scale / K) at the median uv gradient. This is §3.4's
-  rule: the counts of b and c grow by the ratio of edge length to displacement
-  (`slices.orthogonal_count` gives the same count for a one-polygon box).
+  rule: the counts of b and c grow by the ratio of edge length to displacement.
 * ``screen`` (§3.3, the exact variant): planes perpendicular to the view direction (as
   `slices.view_direction` defines it) at the centres of equal intervals of world width
   scale / K over the volume's depth range, each cut exactly through every tetrahedron it

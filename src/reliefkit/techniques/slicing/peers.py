@@ -49,10 +49,10 @@ voxel layer more on every side of the object), plus up to a pixel more where bil
 filtering mixes a surface depth with a 0 ("no surface") neighbour (a smaller depth, so more
 is kept); on every test scene it contains `voxel_carve`'s occupancy.
 
-`open3d_rule` evaluates that rule here in numpy with exact orthographic projection: Open3D's
-output equals it voxel for voxel on the test scenes (IoU 1.0 for the
-box, sphere and cup at n = 32 with 64^2 images; >= 0.999 at n = 64, 128 with 128^2 images),
-which is what shows the camera emulation right. Against `voxel_carve` the extra voxels form
+The tests evaluate that rule in numpy with exact orthographic projection: Open3D's output
+equals it voxel for voxel on the test scenes (IoU 1.0 for the box, sphere and cup at n = 32
+with 64^2 images; >= 0.999 at n = 64, 128 with 128^2 images), which is what shows the camera
+emulation right. Against `voxel_carve` the extra voxels form
 a shell one voxel thick (IoU 0.72-0.85 at n = 32, 0.94-0.99 at n = 128), except where a
 depth image's edge pixels are mixed with an empty (0) neighbour: there that image keeps its
 whole column, so a few voxels (1-3 % of the disagreement on the sphere) lie farther off
@@ -210,58 +210,6 @@ def open3d_carve(images: DepthImages, n: int, silhouettes: bool = False, *,
             grid.carve_depth_map(image, params, keep_voxels_outside_image=False)
     seconds = time.perf_counter() - start
     return _occupancy(grid, n), seconds
-
-
-def open3d_rule(images: DepthImages, n: int, silhouettes: bool = False, *,
-                distance: float = DISTANCE) -> np.ndarray:
-    """Open3D's carving rule evaluated here in numpy with *exact orthographic* projection:
-    (n, n, n) bool [z, y, x], no Open3D needed.
-
-    A voxel survives image k when any of its 8 corners falls within the pixel centres'
-    rectangle and the bilinear value there (of the same float32 image `open3d_carve` passes:
-    metric depth ``distance + depth`` in cube sides, 0 off the mask; or the 0/1 mask) passes
-    (``d > 0`` and the corner's depth ``>= d``; or ``value > 0``): Open3D's
-    ``VoxelGrid::CarveDepthMap`` / ``CarveSilhouette`` with ``Image::FloatValueAt``. Its
-    difference from `open3d_carve` is only the distant pinhole's perspective (and float
-    rounding), which makes it the check that the camera emulation is right; its difference
-    from `voxel_carve` is the rule itself (any corner and bilinear, versus voxel centre and
-    nearest texel).
-    """
-    _check(images, n)
-    n = int(n)
-    res = images.resolution
-    lattice = np.arange(n + 1) / n
-    z, y, x = np.meshgrid(lattice, lattice, lattice, indexing="ij")
-    corners = np.stack([x, y, z], axis=-1).reshape(-1, 3)
-    world = corners @ images.cube_to_world[:3, :3].T + images.cube_to_world[:3, 3]
-    keep = np.ones((n, n, n), bool)
-    for k in range(6):
-        to_box = np.linalg.inv(images.box_to_world[k])
-        uvh = world @ to_box[:3, :3].T + to_box[:3, 3]
-        px, py = uvh[:, 0] * res - 0.5, uvh[:, 1] * res - 0.5
-        within = (px >= 0) & (px <= res - 1) & (py >= 0) & (py <= res - 1)
-        if silhouettes:
-            values = images.mask[k].astype(np.float32)
-        else:
-            values = np.where(images.mask[k], distance + images.depth[k].astype(np.float64),
-                              0.0).astype(np.float32)
-        ui = np.clip(np.floor(np.clip(px, 0, res - 1)).astype(int), 0, res - 2)
-        vi = np.clip(np.floor(np.clip(py, 0, res - 1)).astype(int), 0, res - 2)
-        pu, pv = px - ui, py - vi
-        d = ((values[vi, ui] * (1 - pv) + values[vi + 1, ui] * pv) * (1 - pu)
-             + (values[vi, ui + 1] * (1 - pv) + values[vi + 1, ui + 1] * pv) * pu)
-        if silhouettes:
-            passes = within & (d > 0)
-        else:
-            passes = within & (d > 0) & (distance + 1.0 - uvh[:, 2] >= d)
-        passes = passes.reshape(n + 1, n + 1, n + 1)
-        voxel = np.zeros((n, n, n), bool)
-        for dz in (0, 1):
-            for dy in (0, 1):
-                for dx in (0, 1):
-                    voxel |= passes[dz:dz + n, dy:dy + n, dx:dx + n]
-        keep &= voxel
-    return keep
 
 
 @dataclass(frozen=True)

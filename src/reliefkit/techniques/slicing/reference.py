@@ -206,27 +206,6 @@ def voxel_carve(images: DepthImages, n: int) -> np.ndarray:
     return inside(images, world)
 
 
-def occupied_voxels(images: DepthImages) -> np.ndarray:
-    """(N, N, N) bool [x, y, z]: the cube voxels where the nearest-texel object is not
-    empty (its box there meets the voxel with a positive or zero extent on every axis).
-    N^3 booleans: a check for small N (`occupied_columns` is the same per column in N^2)."""
-    _check(images)
-    n = images.resolution
-    b = images.column_bounds()  # (axis, lo/hi, i, j): x: [y, z], y: [x, z], z: [x, y]
-    edges = np.arange(n + 1) / n
-    lo_cell, hi_cell = edges[:-1], edges[1:]
-
-    def fits(lo, hi, cell_axis_shape):
-        lo_c = lo_cell.reshape(cell_axis_shape)
-        hi_c = hi_cell.reshape(cell_axis_shape)
-        return (np.maximum(lo, lo_c) <= np.minimum(hi, hi_c))
-
-    x = fits(b[0, 0][None, :, :], b[0, 1][None, :, :], (n, 1, 1))   # [x, y, z]
-    y = fits(b[1, 0][:, None, :], b[1, 1][:, None, :], (1, n, 1))
-    z = fits(b[2, 0][:, :, None], b[2, 1][:, :, None], (1, 1, n))
-    return x & y & z
-
-
 @njit(cache=True)
 def _fits(bounds, axis, v, n) -> bool:
     """Whether the object's interval along ``axis`` at voxel v's column meets the voxel."""
@@ -257,8 +236,10 @@ def _occupied_columns(bounds, n, out):
 
 def occupied_columns(images: DepthImages) -> np.ndarray:
     """(3, N, N) bool: per cube axis a, whether the column of voxels along a at the other
-    two voxel indices (in increasing axis order) holds any `occupied_voxels` voxel; computed
-    column by column (only the voxels within a's own interval), never as an N^3 array."""
+    two voxel indices (in increasing axis order) holds any voxel where the nearest-texel
+    object is not empty (its box there meets the voxel, with a zero or positive extent on
+    every axis); computed column by column (only the voxels within a's own interval), never
+    as an N^3 array."""
     _check(images)
     n = images.resolution
     out = np.zeros((3, n, n), bool)

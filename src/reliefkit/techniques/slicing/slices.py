@@ -7,14 +7,11 @@ coordinates (u, v, h) in [0, 1]^3, h being the displacement direction (see
 `depth_images`, whose ``box_to_world[k]`` and ``cube_to_world`` are such boxes). The box may
 be sheared and rotated; its 3x3 part must be invertible.
 
-Three slicings are provided, each returning a `SliceStack`:
+Two slicings are provided, each returning a `SliceStack`:
 
-* `surface_slices` (§3.1, the basic method): ``count`` planes h = const, h = 0 ... 1
-  inclusive (``linspace``; one slice is h = 0, the base).
 * `orthogonal_slices` (§3.2): planes q_a = const through the whole box for the box axis a
   whose slices are most perpendicular to the view, at the cell centres
-  q_a = (i + 0.5) / count, full cross-sections (quads). `orthogonal_count` scales the slice
-  count of a direction by the displacement/edge ratio (§3.4).
+  q_a = (i + 0.5) / count, full cross-sections (quads).
 * `screen_slices` (§3.3, the exact variant): planes perpendicular to the view direction,
   intersected exactly with the box (convex polygons of 3..6 vertices). For a perspective
   `Camera` the planes are perpendicular to the direction from the eye to the box centre
@@ -28,9 +25,8 @@ orthographic `Camera`, ``centre - eye`` for a perspective one, ``-view_dir`` for
 Slices of a stack are indexed k = 0 .. K-1 in increasing ``plane_offset``; the triangles
 are grouped by slice in that order (``first_triangle``), and ``front_to_back`` /
 ``back_to_front`` are the draw orders for the camera (nearest slice first / last). Polygons
-are triangle fans, counter-clockwise as seen from the camera for screen and orthogonal
-slices (i.e. counter-clockwise about ``plane_normal``, which points towards the viewer);
-surface slices are counter-clockwise about the box's +h side.
+are triangle fans, counter-clockwise as seen from the camera (i.e. counter-clockwise about
+``plane_normal``, which points towards the viewer).
 """
 
 from __future__ import annotations
@@ -294,13 +290,6 @@ def axis_normals(box_to_world) -> np.ndarray:
     return g / np.linalg.norm(g, axis=1, keepdims=True)
 
 
-def axis_thickness(box_to_world) -> np.ndarray:
-    """(3,) world distance between the box's two faces q_a = 0 and q_a = 1 (its edge length
-    along a for a box without shear)."""
-    a, _ = _box(box_to_world)
-    return 1.0 / np.linalg.norm(np.linalg.inv(a), axis=1)
-
-
 def best_axis(box_to_world, camera) -> int:
     """The box axis whose slices are most perpendicular to the view (§3.2): the largest
     |cos| between the slice planes' normal and the view direction. Ties (within `TIE`, e.g.
@@ -359,44 +348,6 @@ def orthogonal_slices(box_to_world, camera, count: int, axis: int | None = None)
     sign = -1.0 if float(g @ f) >= 0 else 1.0  # normal towards the viewer
     levels = (np.arange(count) + 0.5) / count
     return _axis_stack(a, o, axis, levels, sign)
-
-
-def surface_slices(box_to_world, count: int) -> SliceStack:
-    """``count`` slices h = const from h = 0 (the base) to h = 1 inclusive, the basic method
-    (§3.1). Slice k is at h = k / (count - 1); ``front_to_back`` is top (h = 1) first, i.e.
-    for a viewer above the surface, ``back_to_front`` from the base up."""
-    count = _count(count)
-    a, o = _box(box_to_world)
-    levels = np.linspace(0.0, 1.0, count) if count > 1 else np.zeros(1)
-    return _axis_stack(a, o, 2, levels, 1.0)
-
-
-def orthogonal_count(box_to_world, axis: int, edge_count: int,
-                     displacement_scale: float = 1.0) -> int:
-    """Slices to use along ``axis`` so that every direction gets the same world spacing (§3.4).
-
-    ``edge_count`` is the number of slices used for the base-aligned direction a (h = const);
-    ``displacement_scale`` in (0, 1] is the maximum displacement as a fraction of the box's
-    height. The paper scales the count of the directions b and c (u, v = const) by the ratio
-    of the base's edge length to the maximum displacement:
-
-        count(h) = edge_count
-        count(a) = ceil(edge_count * L_a / (displacement_scale * L_h))   for a = u, v
-
-    where L_a is the box's thickness along a (`axis_thickness`, the edge length for a box
-    without shear). E.g. an edge of 2 and a maximum displacement of 0.5 give 4x the slices;
-    each such slice is 1/4 as large, which keeps the fill rate about constant.
-    """
-    edge_count = _count(edge_count, "edge slice count")
-    if axis not in (0, 1, 2):
-        raise UsageError(f"slicing axis must be 0 (u), 1 (v) or 2 (h), got {axis!r}")
-    scale = float(displacement_scale)
-    if not (math.isfinite(scale) and 0 < scale <= 1):
-        raise UsageError(f"displacement scale must be in (0, 1], got {displacement_scale!r}")
-    if axis == 2:
-        return edge_count
-    thick = axis_thickness(box_to_world)
-    return max(1, math.ceil(edge_count * thick[axis] / (scale * thick[2]) - 1e-9))
 
 
 # --- how many slices --------------------------------------------------------------------------
