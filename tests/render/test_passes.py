@@ -123,3 +123,12 @@ def test_gpu_objects_are_released_when_a_draw_fails(gl, toy, monkeypatch):
     monkeypatch.undo()
     assert render(BACKDROP, CAMERA).mask.any()  # the context still works
     assert gl.error == "GL_NO_ERROR"
+
+
+def test_any_iterable_of_cameras_gives_a_list_of_frames(gl):
+    frames = render(BACKDROP, iter([CAMERA, CAMERA]))
+    assert len(frames) == 2
+    np.testing.assert_array_equal(frames[0].color, frames[1].color)
+    for bad in ([], 5, [CAMERA, "camera"]):
+        with pytest.raises(UsageError, match="a camera or"):
+            render(BACKDROP, bad)

@@ -101,8 +101,8 @@ class Scene:
 def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
            msaa: int = 1, **options):
     """Render a representation, a RenderMesh (ground truth), or a list of them, into a Frame;
-    with a list of cameras, into a list of Frames, uploading once (bit-identical to one
-    `render` per camera).
+    with a list (or any iterable) of cameras, into a list of Frames, uploading once
+    (bit-identical to one `render` per camera).
 
     ``count_iterations`` draws the instrumented variants and fills ``frame.stats`` with
     fragments and loop iterations per pixel (``frame.extra["iterations"]``). ``msaa`` (1, 2,
@@ -110,14 +110,19 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
     edge pixels get the covered fraction as alpha, every AOV stays single-sample, and
     transparent objects are composited single-sample over it.
     """
-    cameras = list(camera) if isinstance(camera, list | tuple) else [camera]
-    if not cameras:
-        raise UsageError("no camera to render from")
+    several = not hasattr(camera, "size")  # a list, tuple or any iterable of cameras
+    try:
+        cameras = list(camera) if several else [camera]
+    except TypeError:
+        raise UsageError(f"render needs a camera or a list of cameras, got "
+                         f"{type(camera).__name__}") from None
+    if not cameras or not all(hasattr(c, "size") for c in cameras):
+        raise UsageError("render needs a camera or a non-empty list of cameras")
     ctx = ctx or get_context()
     check_msaa(ctx, msaa)
     with Scene(obj, ctx=ctx, count_iterations=count_iterations, **options) as scene:
         frames = [scene.frame(cam, light, msaa=msaa) for cam in cameras]
-    return frames if isinstance(camera, list | tuple) else frames[0]
+    return frames if several else frames[0]
 
 
 def _transparent(drawable) -> bool:
