@@ -128,3 +128,17 @@ def test_msaa_is_checked(gl):
     if int(gl.info["GL_MAX_SAMPLES"]) < 8:
         with pytest.raises(GPUError, match="limit"):
             render(TRIANGLE, CAMERA, msaa=8)
+
+
+def test_a_multisampled_render_leaves_no_gl_error_behind(gl):
+    """The first msaa render of a process released its framebuffers while one was bound;
+    moderngl rebound it when the next framebuffer was made, and the pending
+    GL_INVALID_OPERATION was blamed on whatever the next command uploaded (--msaa with
+    --stats or --turntable failed on every input)."""
+    extra = gl.extra if isinstance(gl.extra, dict) else {}
+    old_home = extra.pop("home_fbo", None)  # as in a fresh process (kept alive: it is bound)
+    render(TRIANGLE, CAMERA, msaa=4)
+    assert gl.error == "GL_NO_ERROR"
+    assert render(TRIANGLE, CAMERA, msaa=4).mask.any()
+    if old_home is not None:
+        old_home.release()  # the new home is bound now

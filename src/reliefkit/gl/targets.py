@@ -179,6 +179,7 @@ def _multisampled_color(ctx, size, opaque: Callable[[], None], samples: int) -> 
         check_gl_error(ctx, "resolving the multisampled colour")
         mean, coverage = read_rgba(resolved, 0), read_rgba(resolved, 1)[..., 3:4]
     finally:
+        bind_home_framebuffer(ctx)  # never leave a released framebuffer bound
         for obj in reversed(made):
             obj.release()
     # samples not covered are cleared to 0: the mean colour over the covered ones is mean /

@@ -73,7 +73,7 @@ def _peel(executor, plan, camera, light, uniforms, textures) -> int:
             executor.draw_full_screen(plan.multipass.programs["layer"], {"u_layer": color},
                                       _COMPOSITE)
     finally:
+        outer.use()  # never leave a released framebuffer bound
         for obj in reversed(made):
             obj.release()
-        outer.use()
     return layers

@@ -83,9 +83,9 @@ def _search(executor, plan, camera, light, uniforms, textures, front) -> int:
                              textures={**textures, "u_search": search},
                              program_override=programs["final"])
     finally:
+        outer.use()  # never leave a released framebuffer bound
         for obj in reversed(made):
             obj.release()
-        outer.use()
     return passes + 1
 
 
