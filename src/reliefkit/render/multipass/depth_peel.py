@@ -13,7 +13,6 @@ plan samples the opaque depth and may be shadowed as the "opaque-depth" kind's
 
 from __future__ import annotations
 
-import time
 from dataclasses import replace
 
 import moderngl
@@ -27,11 +26,10 @@ _COMPOSITE = Raster(depth_test=False, depth_write=False, blend="under")
 
 
 def draw_depth_peeled(executor, plan, camera, light, uniforms: dict, textures: dict) -> dict:
-    start = time.perf_counter()
     with frame_inputs(executor, plan, light, uniforms, textures) as (uniforms, textures):
         layers = _peel(executor, plan, camera, light, uniforms, textures)
         check_gl_error(executor.ctx, f"drawing {plan.name}")
-    return {"peeled_layers": layers, "passes_seconds": time.perf_counter() - start}
+    return {"peeled_layers": layers}
 
 
 def _peel(executor, plan, camera, light, uniforms, textures) -> int:

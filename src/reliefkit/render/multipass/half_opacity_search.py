@@ -14,7 +14,6 @@ first, as the "opaque-depth" kind draws it (`opaque_depth.frame_inputs`; its par
 
 from __future__ import annotations
 
-import time
 from dataclasses import replace
 
 import moderngl
@@ -29,14 +28,13 @@ SEARCH_BINS = 16  # rank bins per pass: four RGBA attachments of the bins progra
 
 def draw_half_opacity_search(executor, plan, camera, light, uniforms: dict,
                              textures: dict) -> dict:
-    start = time.perf_counter()
     outer = executor.ctx.fbo
     with frame_inputs(executor, plan, light, uniforms, textures) as (uniforms, textures):
         front = read_rgba(outer, 0, top_row_first=False)[..., 3].astype(np.float64)
         executor.draw_viewed(plan, camera, light, extra_uniforms=uniforms, textures=textures)
         passes = _search(executor, plan, camera, light, uniforms, textures, front)
         check_gl_error(executor.ctx, f"drawing {plan.name}")
-    return {"half_opacity_passes": passes, "passes_seconds": time.perf_counter() - start}
+    return {"half_opacity_passes": passes}
 
 
 def _search(executor, plan, camera, light, uniforms, textures, front) -> int:

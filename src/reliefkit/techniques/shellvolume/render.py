@@ -163,9 +163,6 @@ class TexturedShellDrawable:
         self.plans = [shell_plan(rep, self.shell, self.options)]
 
     def finish(self, frame, stats: dict) -> None:
-        stats = dict(stats)
-        if "passes_seconds" in stats:  # the sort and the passes, as one draw's time
-            stats["draw_seconds"] = stats.pop("passes_seconds") + stats.get("sort_seconds", 0.0)
         frame.stats.update({"tetrahedra": len(self.shell.tets),
                             "samples": self.options.samples, "unlit": self.options.unlit,
                             "mip": self.options.mip, **stats})
