@@ -216,14 +216,13 @@ def quality(name, mesh, reps: dict, decimations: dict, cfg: BenchConfig) -> list
     shown = {"bbc": reps["bbc"], **{v: reps[v] for v in VARIANTS}, **decimations}
     rows = []
     for label, dist in zip(DISTANCE_NAMES, cfg.distances, strict=True):
-        scores = {key: [] for key in shown}
-        for az in cfg.azimuths:
-            camera = camera_at(mesh, az, dist, cfg.size, cfg)
-            truth = render(mesh, camera)
-            for key, rep in shown.items():
-                options = {"march": "sphere"} if key in VARIANTS else {}
-                scores[key].append(compare(render(rep, camera, **options), truth,
-                                           scene_size=radius))
+        cameras = [camera_at(mesh, az, dist, cfg.size, cfg) for az in cfg.azimuths]
+        truths = render(mesh, cameras)  # every azimuth in one call: one upload
+        scores = {}
+        for key, rep in shown.items():
+            options = {"march": "sphere"} if key in VARIANTS else {}
+            scores[key] = [compare(frame, truth, scene_size=radius) for frame, truth
+                           in zip(render(rep, cameras, **options), truths, strict=True)]
         row = {"asset": name, "distance": label, "radii": dist}
         for key, runs in scores.items():
             row[key] = {m: float(np.mean([r[m] for r in runs])) for m in ("iou", "ssim", "psnr")}

@@ -360,9 +360,12 @@ def against_reference(cfg: BenchConfig, log) -> dict:
     _, rep = scene(cfg.reference_scene, cfg)
     cameras = reference_cameras(rep, cfg.reference_size)
     rows = []
+    frames = {samples: dict(zip(cameras, render(rep, list(cameras.values()), unlit=True,
+                                                 mip=False, samples=samples), strict=True))
+              for samples in cfg.reference_samples}  # every projection in one call
     for projection, camera in cameras.items():
         for samples in cfg.reference_samples:
-            frame = render(rep, camera, unlit=True, mip=False, samples=samples)
+            frame = frames[samples][projection]
             ref = reference_render(rep.shell, rep.texture, camera, samples=samples)
             a, b = _premultiplied(frame.color), _premultiplied(ref.color)
             rows.append({"scene": cfg.reference_scene, "texture": texture_label(rep.texture),
