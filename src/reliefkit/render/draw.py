@@ -59,12 +59,14 @@ class Scene:
 
     def draw(self, drawable, camera, light, stats: dict) -> None:
         """One drawable into the bound framebuffer; its view hooks' and multi-pass kinds'
-        statistics into ``stats``, and ``draw_seconds``: the wall time of its draw calls,
-        hooks included (not the GPU's: llvmpipe draws as it is called, a GPU later)."""
+        statistics into ``stats``, and for a drawable that asks (``timed``) ``draw_seconds``:
+        the wall time of its draw calls, hooks included (not the GPU's: llvmpipe draws as it
+        is called, a GPU later)."""
         start = time.perf_counter()
         for plan in drawable.plans:
             stats.update(self.executor.draw(plan, camera, light))
-        stats["draw_seconds"] = time.perf_counter() - start
+        if getattr(drawable, "timed", False):
+            stats["draw_seconds"] = time.perf_counter() - start
 
     def draw_opaque(self, camera, light) -> None:
         """The opaque drawables into the bound framebuffer (what benchmarks time)."""
