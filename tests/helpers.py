@@ -121,3 +121,21 @@ def assert_one_line_error(result, *words, code=None):
     assert "Traceback" not in result.stderr
     for word in words:
         assert word in lines[0], lines[0]
+
+
+def assert_same_frames(got, expected) -> None:
+    """Two Frames bit-identical in every field: images, matrices and extra arrays (NaN where
+    both are, dtypes alike), stats and warnings."""
+    from dataclasses import fields
+
+    for field in fields(got):
+        x, y = getattr(got, field.name), getattr(expected, field.name)
+        if isinstance(x, dict) and field.name == "extra":
+            assert x.keys() == y.keys(), field.name
+            for key in x:
+                np.testing.assert_array_equal(x[key], y[key], err_msg=f"extra[{key}]",
+                                              strict=True)
+        elif isinstance(x, dict | list):
+            assert x == y, field.name
+        else:
+            np.testing.assert_array_equal(x, y, err_msg=field.name, strict=True)

@@ -99,18 +99,6 @@ def box_distance(points, lo, hi):
     return np.where(outside > 0, outside, np.maximum(inside, 0))
 
 
-def assert_same_frames(got, expected) -> None:
-    """Two Frames bit-identical: every image, matrix and extra array (NaN where both are),
-    and the same stats."""
-    for name in ("color", "mask", "depth", "position", "normal", "view", "proj", "viewport"):
-        np.testing.assert_array_equal(getattr(got, name), getattr(expected, name),
-                                      err_msg=name, strict=True)
-    assert got.extra.keys() == expected.extra.keys()
-    for name, array in got.extra.items():
-        np.testing.assert_array_equal(array, expected.extra[name], err_msg=name, strict=True)
-    assert got.stats == expected.stats
-
-
 def frame_from_json_plans(obj, camera, **options):
     """``obj`` drawn from ``camera`` by plans that went through JSON text and copied arrays
     (`render.plan.to_json`, `from_json`) instead of its drawable's own."""

@@ -5,15 +5,13 @@ hand-over decided per view), by render modules that create no GL objects themsel
 from __future__ import annotations
 
 import json
-from dataclasses import fields
 
-import numpy as np
 import pytest
 from billboard_scenes import stacked
+from helpers import assert_same_frames
 
 from reliefkit.core.technique import technique
 from reliefkit.render import render
-from reliefkit.render.frame import Frame
 from reliefkit.render.plan import from_json, to_json
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.billboard import bake_boxes, box_render
@@ -42,17 +40,6 @@ def scenes(gl):
 def views(rep, distances) -> list:
     return [orbit_bounds(rep.bounds, 30.0 + 70.0 * k, 25.0 - 20.0 * k, distance, size=SIZE)
             for k, distance in enumerate(distances)]
-
-
-def assert_same_frames(a: Frame, b: Frame) -> None:
-    for f in fields(Frame):
-        x, y = getattr(a, f.name), getattr(b, f.name)
-        if isinstance(x, dict):
-            assert x.keys() == y.keys(), f.name
-            for key in x:
-                np.testing.assert_array_equal(x[key], y[key], err_msg=f"{f.name}[{key}]")
-        else:
-            np.testing.assert_array_equal(x, y, err_msg=f.name)
 
 
 @pytest.mark.parametrize("name", ["cloud", "volumetric", "volumetric exact flattened",

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import assert_same_frames
 from slicing_scenes import (
     CUP_FLOOR,
     CUP_TOP,
-    assert_same_frames,
     box_mesh,
     cup_mesh,
     frame_from_json_plans,

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from slicing_scenes import assert_same_frames, frame_from_json_plans
+from helpers import assert_same_frames
+from slicing_scenes import frame_from_json_plans
 
 from reliefkit.core.transforms import homogeneous, invert_box
 from reliefkit.render import render
