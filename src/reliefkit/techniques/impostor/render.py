@@ -28,7 +28,7 @@ _TRIANGLES = np.array([0, 1, 2, 0, 2, 3], np.uint32)
 class ImpostorRenderOptions:
     """The render options of octahedral impostors."""
 
-    parallax_steps: int = param(2, "fixed-point steps that move each frame's lookup along "
+    parallax_steps: int = param(8, "fixed-point steps that move each frame's lookup along "
                                 "the ray to the depth it stores, so the blended frames agree "
                                 "on where the surface is (0: where the ray crosses each "
                                 "frame's plane)", kind="int", lo=0, hi=16)
@@ -42,7 +42,8 @@ def impostor_plan(rep: OctahedralImpostor, options: ImpostorRenderOptions,
     multipass = None
     if options.shadows:
         multipass = MultiPass("shadow-map", {"caster": Program(PROGRAM, {"SHADOW_MAP": True})},
-                              {"bounds": rep.bounds, "size": SHADOW_MAP_SIZE})
+                              {"bounds": rep.bounds, "size": SHADOW_MAP_SIZE,
+                               "bias": shadow_bias(rep)})
     return DrawPlan(
         name=f"octahedral impostor of {rep.grid} x {rep.grid} frames",
         program=Program(PROGRAM, {"COUNT_ITERATIONS": instrument,
@@ -57,6 +58,14 @@ def impostor_plan(rep: OctahedralImpostor, options: ImpostorRenderOptions,
                   "u_frame_radius": rep.frame_radius, "u_frame_texels": float(rep.frame),
                   "u_parallax_steps": options.parallax_steps},
         origin=tuple(float(x) for x in rep.center), multipass=multipass)
+
+
+def shadow_bias(rep: OctahedralImpostor) -> float:
+    """The shadow map's depth bias: what the impostor may put its surface off by (a frame
+    texel and a step of its uint8 depth), in the light camera's window depth
+    (`render.shadows.light_camera` spans 3 half diagonals of the box around the sphere)."""
+    uncertain = 2.0 * rep.frame_radius / rep.frame + 2.0 * rep.radius / 255.0
+    return float(uncertain / (3.0 * np.sqrt(3.0) * rep.radius))
 
 
 class ImpostorDrawable:

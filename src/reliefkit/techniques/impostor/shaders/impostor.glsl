@@ -1,10 +1,12 @@
 // Octahedral impostor: one camera-facing quad over the bounding sphere, billboarded in the
 // vertex shader. Per fragment, the three grid frames around the view direction on the
 // octahedral map (octahedral.py holds the same functions) are each looked up along the
-// pixel's ray, offset by the frame's stored depth (u_parallax_steps fixed-point steps, 0:
-// where the ray crosses the frame's plane), and blended by their barycentric weights times
-// their coverage. The blended coverage is tested at 0.5; the blended ray distance gives the
-// surface point (position, gl_FragDepth); the stored object-space normals light it.
+// pixel's ray where it meets the frame's stored depth (u_parallax_steps samples front to
+// back and a linear step between the two around the crossing; 0: where the ray crosses
+// the frame's plane), and blended by their barycentric weights times
+// their coverage. The blended coverage is tested at 0.5; the ray distances of the frames
+// that agree with the heaviest one give the surface point (position, gl_FragDepth); the
+// blended object-space normals light it.
 // SHADOWS: lit only where the light's shadow map (drawn with SHADOW_MAP: coverage and depth
 // only, the quad facing the light) sees it.
 //! defines: SHADOWS SHADOW_MAP
@@ -118,7 +120,10 @@ float height_at(vec2 uv) {
 }
 
 // Frame `cell` looked up along the ray origin + t dir (origin relative to the centre): its
-// coverage, colour and normal there and the ray distance t of its surface.
+// coverage, colour and normal there and the ray distance t of its surface. Without steps,
+// where the ray crosses the frame's plane; with u_parallax_steps, the ray is walked through
+// the frame's height range front to back, and between the last sample above the stored
+// surface and the first below it the crossing is interpolated linearly.
 void look_up(ivec2 cell, vec3 origin, vec3 dir, out float coverage, out vec3 color,
              out vec3 normal, out float t) {
     vec3 d = octahedral_decode(vec2(cell) * 2.0 / float(u_grid - 1) - 1.0);
@@ -127,14 +132,27 @@ void look_up(ivec2 cell, vec3 origin, vec3 dir, out float coverage, out vec3 col
     float facing = min(dot(dir, d), -0.05);  // the ray runs against the frame's direction
     float above = dot(origin, d);            // the ray origin's height above the frame
     t = -above / facing;                     // where the ray crosses the frame's plane
-    vec2 uv = frame_uv(cell, origin + t * dir, right, up);
-    for (int s = 0; s < u_parallax_steps; ++s) {
-        t = (height_at(uv) - above) / facing;  // the ray at the height found under it
-        uv = frame_uv(cell, origin + t * dir, right, up);
+    if (u_parallax_steps > 0) {
+        float step_height = 2.0 * u_radius / float(u_parallax_steps);
+        float ray_height = u_radius;         // the front of the frame's height range
+        float gap = u_radius;                // ray height - stored height, last sample
+        float previous_gap = gap;
+        for (int s = 0; s <= u_parallax_steps; ++s) {
+            t = (ray_height - above) / facing;
+            gap = ray_height - height_at(frame_uv(cell, origin + t * dir, right, up));
+            if (gap <= 0.0) break;
+            previous_gap = gap;
+            ray_height -= step_height;
+        }
+        if (gap <= 0.0 && previous_gap > 0.0 && ray_height < u_radius) {
+            float back = step_height * gap / (previous_gap - gap);  // < 0: step back up
+            t = (ray_height - back - above) / facing;
+        }
     }
+    vec2 uv = frame_uv(cell, origin + t * dir, right, up);
     t = (height_at(uv) - above) / facing;
     coverage = textureLod(u_color_atlas, uv, 0.0).a;
-    color = texture(u_color_atlas, uv).rgb;
+    color = texture(u_color_atlas, uv).rgb;  // mipmapped: control flow is uniform again
     normal = 2.0 * texture(u_normal_atlas, uv).rgb - 1.0;
 }
 
@@ -160,7 +178,12 @@ void main() {
 #endif
     }
     wa /= coverage;
-    vec3 world = v_world + dot(wa, t) * dir;
+    // The surface point: the frames' ray distances averaged over those that agree with the
+    // heaviest frame's to a few texels (averaging across an occluding edge, where frames
+    // see different surfaces, would float a surface between them).
+    float heaviest = wa.x >= max(wa.y, wa.z) ? t.x : (wa.y >= wa.z ? t.y : t.z);
+    vec3 agree = wa * step(abs(t - heaviest), vec3(4.0 * 2.0 * u_frame_radius / u_frame_texels));
+    vec3 world = v_world + dot(agree, t) / (agree.x + agree.y + agree.z) * dir;
     gl_FragDepth = window_depth(world);
 #if !defined SHADOW_MAP
     vec3 base = wa.x * c0 + wa.y * c1 + wa.z * c2;
