@@ -157,3 +157,17 @@ def test_shadows_fall_where_the_plate_hides_the_light(gl):
     assert hidden.sum() > 300
     assert (shadowed & hidden).sum() > 0.9 * hidden.sum()
     assert (reach[shadowed] < 0.35 + slack).all()
+
+
+def test_far_from_the_origin_it_draws_as_at_the_origin(gl):
+    """Georeferenced coordinates: the quad lives relative to the sphere's centre (the plan's
+    origin), so 1e7 units away the same view gives the same picture."""
+    offset = np.array([1e7, -3e6, 2e7])
+    near = sphere_impostor(CENTER, 1.0, grid=6, frame=32)
+    far = sphere_impostor(CENTER + offset, 1.0, grid=6, frame=32)
+    frames = [render(rep, Camera.orbit(rep.center, 37.0, 21.0, 3.0, size=(64, 64)))
+              for rep in (near, far)]
+    np.testing.assert_array_equal(frames[0].mask, frames[1].mask)
+    np.testing.assert_allclose(frames[0].color, frames[1].color, atol=1e-3)
+    m = frames[0].mask
+    np.testing.assert_allclose(frames[1].position[m] - offset, frames[0].position[m], atol=1e-4)
