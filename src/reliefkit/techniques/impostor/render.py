@@ -28,10 +28,11 @@ _TRIANGLES = np.array([0, 1, 2, 0, 2, 3], np.uint32)
 class ImpostorRenderOptions:
     """The render options of octahedral impostors."""
 
-    parallax_steps: int = param(8, "fixed-point steps that move each frame's lookup along "
-                                "the ray to the depth it stores, so the blended frames agree "
-                                "on where the surface is (0: where the ray crosses each "
-                                "frame's plane)", kind="int", lo=0, hi=16)
+    parallax_steps: int = param(8, "samples of each frame's depth along the ray, front to "
+                                "back, then a linear step to where the ray meets it, so the "
+                                "blended frames agree on where the surface is (0: the lookup "
+                                "where the ray crosses each frame's plane)", kind="int",
+                                lo=0, hi=16)
     shadows: bool = param(False, "shadows from a shadow map of the directional light, the "
                                  "impostor drawn from the light into it")
 
