@@ -19,7 +19,8 @@ def test_bake_render_and_stats(gl, tmp_path):
     assert done.returncode == 0, done.stderr
     counters = json.loads(stats.read_text())
     assert counters["impostor_frames"] == 36 and counters["covered"] > 500
-    assert counters["iterations_max"] == 3 * 3  # three frames, three steps each
+    # depth samples: three frames, each at most the three steps and the front
+    assert 3 <= counters["iterations_mean_covered"] <= counters["iterations_max"] <= 3 * 4
 
 
 def test_compare_scores_parallax_against_none_and_the_grid_position(gl, tmp_path):

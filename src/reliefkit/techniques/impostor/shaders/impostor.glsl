@@ -3,8 +3,8 @@
 // octahedral map (octahedral.py holds the same functions) are each looked up along the
 // pixel's ray where it meets the frame's stored depth (u_parallax_steps samples front to
 // back and a linear step between the two around the crossing; 0: where the ray crosses
-// the frame's plane), and blended by their barycentric weights times
-// their coverage. The blended coverage is tested at 0.5; the ray distances of the frames
+// the frame's plane), and blended by their barycentric weights times their coverage
+// (the instrumented pass counts the depth samples). The blended coverage is tested at 0.5; the ray distances of the frames
 // that agree with the heaviest one give the surface point (position, gl_FragDepth); the
 // blended object-space normals light it.
 // SHADOWS: lit only where the light's shadow map (drawn with SHADOW_MAP: coverage and depth
@@ -120,12 +120,13 @@ float height_at(vec2 uv) {
 }
 
 // Frame `cell` looked up along the ray origin + t dir (origin relative to the centre): its
-// coverage, colour and normal there and the ray distance t of its surface. Without steps,
+// coverage, colour and normal there and the ray distance t of its surface; `samples`
+// counts the depth samples taken. Without steps,
 // where the ray crosses the frame's plane; with u_parallax_steps, the ray is walked through
 // the frame's height range front to back, and between the last sample above the stored
 // surface and the first below it the crossing is interpolated linearly.
 void look_up(ivec2 cell, vec3 origin, vec3 dir, out float coverage, out vec3 color,
-             out vec3 normal, out float t) {
+             out vec3 normal, out float t, inout int samples) {
     vec3 d = octahedral_decode(vec2(cell) * 2.0 / float(u_grid - 1) - 1.0);
     vec3 right = normalize(cross(reference_up(d), d));
     vec3 up = cross(d, right);
@@ -140,6 +141,7 @@ void look_up(ivec2 cell, vec3 origin, vec3 dir, out float coverage, out vec3 col
         for (int s = 0; s <= u_parallax_steps; ++s) {
             t = (ray_height - above) / facing;
             gap = ray_height - height_at(frame_uv(cell, origin + t * dir, right, up));
+            ++samples;
             if (gap <= 0.0) break;
             previous_gap = gap;
             ray_height -= step_height;
@@ -164,14 +166,15 @@ void main() {
     vec3 origin = v_world - u_model_offset;
     vec3 dir = u_orthographic ? -u_view_dir : normalize(v_world - u_eye);
     vec3 a, c0, c1, c2, n0, n1, n2, t;
-    look_up(f0, origin, dir, a.x, c0, n0, t.x);
-    look_up(f1, origin, dir, a.y, c1, n1, t.y);
-    look_up(f2, origin, dir, a.z, c2, n2, t.z);
+    int samples = 0;
+    look_up(f0, origin, dir, a.x, c0, n0, t.x, samples);
+    look_up(f1, origin, dir, a.y, c1, n1, t.y, samples);
+    look_up(f2, origin, dir, a.z, c2, n2, t.z, samples);
     vec3 wa = w * a;
     float coverage = wa.x + wa.y + wa.z;
     if (coverage < 0.5) {
 #if defined COUNT_ITERATIONS && !defined SHADOW_MAP
-        write_counted_miss(3 * u_parallax_steps);
+        write_counted_miss(samples);
         return;
 #else
         discard;
@@ -194,7 +197,7 @@ void main() {
     lit = light_visibility(world - u_model_offset, dot(n, u_light_dir) >= 0.0 ? n : -n);
 #endif
     write_frame(vec4(shade_phong(base, n, towards_eye(world), lit), 1.0), world, n);
-    write_iterations(3 * u_parallax_steps, 0, true);
+    write_iterations(samples, 0, true);
 #endif
 }
 #endif
