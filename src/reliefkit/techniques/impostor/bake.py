@@ -1,6 +1,11 @@
 """Baking an octahedral impostor: the mesh drawn from every direction of the grid (one
 upload, many orthographic views), each frame's colour, normal and depth dilated into its
-padding and packed into one atlas per channel."""
+padding and packed into one atlas per channel.
+
+The views go through one `render.draw.Scene` rather than `render(mesh, cameras)`: the same
+single upload, but each Frame is packed and dropped before the next is drawn, so memory
+stays one frame plus the atlases (a list of 144 Frames of float64 positions would not).
+"""
 
 from __future__ import annotations
 
