@@ -30,6 +30,7 @@ _EXPORTS = {
                     ".techniques.shellvolume"),
     **dict.fromkeys(("DepthImages", "DepthObject", "DisplacementMap", "VisualHull",
                      "bake_depth_images"), ".techniques.slicing"),
+    **dict.fromkeys(("OctahedralImpostor", "bake_impostor"), ".techniques.impostor"),
 }
 __all__ = list(_EXPORTS)
 __version__ = "0.1.0"
