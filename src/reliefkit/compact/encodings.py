@@ -11,6 +11,7 @@ on every load (`levels`), so the file stays one level while the GPU gets a whole
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -228,3 +229,26 @@ def texture_bytes(array: np.ndarray, *, layered: bool = False, mipmaps: bool = F
         if not mipmaps or (h, w) == (1, 1):
             return int(total)
         level += 1
+
+
+# -- which array an encoding stands for ------------------------------------------------------
+
+_BY_ARRAY: dict[int, tuple[weakref.ref, EncodedImage]] = {}
+
+
+def decoded(encoded: EncodedImage) -> np.ndarray:
+    """The array ``encoded`` stands for, read-only and tied to it: `encoding_of` finds the
+    encoding again from the array alone, so a representation's codec and drawables pass it
+    on (`io.rk` stores it, `render.plan.Texture` uploads it) without holding it anywhere."""
+    array = encoded.decode()
+    array.flags.writeable = False
+    key = id(array)
+    _BY_ARRAY[key] = (weakref.ref(array, lambda _: _BY_ARRAY.pop(key, None)), encoded)
+    return array
+
+
+def encoding_of(array) -> EncodedImage | None:
+    """The encoding that `decoded` made ``array`` from, or None (a raw array, or one made
+    from it by any operation: a copy is not the decoded array)."""
+    entry = _BY_ARRAY.get(id(array))
+    return entry[1] if entry is not None and entry[0]() is array else None
