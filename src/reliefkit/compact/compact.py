@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.params import param
+from ..core.params import make, param
 from ..errors import UsageError
 from ..io.rk import CodecTable, codec_of
 from .encodings import EncodedImage, decoded, encode, encoding_of, texture_bytes
@@ -25,10 +25,17 @@ NORMAL_FORMATS = ("bc7", "bc1")
 HEIGHT_BITS = (16, 8, 32)
 
 
+COMPRESS = ("none", "bc")
+
+
 @dataclass(frozen=True)
 class CompressOptions:
-    """How `compress` encodes each role (``bake --compress bc`` takes them as flags)."""
+    """Whether `reliefkit.bake` compresses what it bakes (``bake --compress bc``) and how
+    `compress` encodes each role (the flags after it)."""
 
+    compress: str = param("none", "after baking: none, or bc (colour and normals block-"
+                          "compressed, heights quantized, as a GPU holds them; "
+                          "docs/compact.md)", choices=COMPRESS)
     color_format: str = param("bc7", "compressed colour: bc7 (8 bits a texel, keeps alpha) "
                               "or bc1 (4 bits, opaque colour only)", choices=COLOR_FORMATS)
     normal_format: str = param("bc7", "compressed normals: bc7 (8 bits a texel) or bc1 (4 "
@@ -83,9 +90,21 @@ def compress(representation, options: CompressOptions | None = None, *,
     return codec.from_arrays(arrays, dict(params))
 
 
+def bake_compression(options) -> CompressOptions:
+    """`reliefkit.bake`'s ``compress`` argument checked before anything is baked: its
+    fields (a dict or `CompressOptions`); encoding choices without ``compress="bc"`` are
+    refused."""
+    if not isinstance(options, CompressOptions):
+        options = make(CompressOptions, dict(options or {}), "bake --compress")
+    if options.compress == "none" and options != CompressOptions():
+        raise UsageError("--color-format, --normal-format and --height-bits choose how "
+                         "--compress bc encodes: add --compress bc")
+    return options
+
+
 def gpu_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str, tuple]:
-    """Per array: (format, bytes as a GPU holds it, bytes raw): the encoding's levels or the
-    array as it is (colour with its mip chain, as drawn)."""
+    """Per array: (format, bytes as a GPU holds it, bytes raw): the encoding and its levels,
+    or "raw" and the array as it is (colour and normals with a mip chain either way)."""
     codec = codec_of(representation, codecs=codecs)
     arrays, _ = codec.to_arrays(representation)
     out = {}
@@ -93,10 +112,10 @@ def gpu_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str, 
         if array is None:
             continue
         role = codec.arrays[name].role
-        mipmaps = role == "color"
+        mipmaps = role in ("color", "normal")
         raw = texture_bytes(np.asarray(array), layered=role is not None
                             and _layered(np.asarray(array), role), mipmaps=mipmaps)
         encoded = encoding_of(array)
         out[name] = (encoded.format, encoded.nbytes, raw) if encoded is not None \
-            else (str(np.asarray(array).dtype), raw, raw)
+            else ("raw", raw, raw)
     return out
