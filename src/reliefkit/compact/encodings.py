@@ -97,6 +97,8 @@ class EncodedImage:
         q = self._unorm(level)
         if self.dtype == "uint8":
             values = q.astype(np.uint8)
+        elif self.srgb:  # float linear colour stored sRGB-encoded: decoded as the GL does
+            values = _to_linear(q, self.format, True).astype(np.float32)
         else:
             top = np.float32(np.iinfo(q.dtype).max)
             values = (q.astype(np.float32) / top * np.float32(self.scale)
@@ -191,15 +193,18 @@ def _half(values: np.ndarray) -> np.ndarray:
 def encode(array: np.ndarray, fmt: str, *, layered: bool = False, srgb: bool = False,
            mipmaps: bool = False, scale: float = 1.0, bias: float = 0.0,
            keep_nonzero: bool = False) -> EncodedImage:
-    """``array`` (uint8 unorm, or float32 mapped to unorm by ``(a - bias) / scale``) encoded
-    in ``fmt``. ``keep_nonzero``: values above ``bias`` never quantize to 0 (a height of 0
-    means empty). Refuses BC1 for an alpha that is not 1 everywhere."""
+    """``array`` (uint8 unorm, or float32 mapped to unorm by ``(a - bias) / scale``; float32
+    ``srgb`` colour: linear, sRGB-encoded) encoded in ``fmt``. ``keep_nonzero``: values
+    above ``bias`` never quantize to 0 (a height of 0 means empty). Refuses BC1 for an alpha
+    that is not 1 everywhere."""
     array = np.asarray(array)
     dtype = str(array.dtype)
     check(fmt, tuple(int(n) for n in array.shape), dtype, layered)
     q_dtype = QUANTIZED.get(fmt, np.dtype(np.uint8))
     if dtype == "uint8":
         q = array
+    elif srgb:
+        q = _from_linear(array.astype(np.float64), fmt, True)
     else:
         top = np.iinfo(q_dtype).max
         unit = np.clip((array.astype(np.float64) - bias) / scale, 0.0, 1.0)

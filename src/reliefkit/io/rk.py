@@ -94,9 +94,10 @@ class ArraySpec:
     max_size : the most elements the kind accepts (its own limits, such as a texture's
         texels), or None; checked on the declared shape, before any data is inflated.
     role : what `reliefkit.compact.compress` may do to it: ``"color"`` (uint8 sRGB colour
-        with alpha: block-compressed), ``"normal"`` (unit vectors, float32 in [-1, 1] or
-        uint8 as (n + 1) / 2: block-compressed), ``"height"`` (float32 in [0, 1], 0 empty:
-        quantized), or None: stored exactly (positions, occupancy, derived data).
+        with alpha, or float32 linear colour: block-compressed sRGB), ``"normal"`` (unit
+        vectors, float32 in [-1, 1] or uint8 as (n + 1) / 2: block-compressed),
+        ``"height"`` (float32 in [0, 1], 0 empty: quantized), or None: stored exactly
+        (positions, occupancy, derived data).
     """
 
     dtypes: tuple[str, ...]
@@ -498,12 +499,15 @@ class _Member:
     encoding: dict | None = None
 
     @property
+    def array_shape(self) -> tuple[int, ...]:
+        """The shape of the array it stands for (an encoded one: decoded)."""
+        return self.shape if self.encoding is None else tuple(self.encoding["shape"])
+
+    @property
     def nbytes(self) -> int:
         """Bytes of the array it stands for in memory (an encoded one: decoded)."""
-        if self.encoding is not None:
-            shape, dtype = self.encoding["shape"], np.dtype(self.encoding["dtype"])
-            return math.prod(shape) * dtype.itemsize
-        return math.prod(self.shape) * self.dtype.itemsize
+        dtype = self.dtype if self.encoding is None else np.dtype(self.encoding["dtype"])
+        return math.prod(self.array_shape) * dtype.itemsize
 
 
 def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None = None):
@@ -606,7 +610,7 @@ def _inspect(archive: _Archive, max_bytes: int | None, codecs: CodecTable):
     members = {name: _inspect_member(archive, codec, name, entry, spans[f"{name}.npy"])
                for name, entry in entries.items()}
     if codec.check_shapes is not None:
-        codec.check_shapes({name: member.shape for name, member in members.items()})
+        codec.check_shapes({name: member.array_shape for name, member in members.items()})
     total = sum(m.nbytes for m in members.values())
     if max_bytes is not None and total > max_bytes:
         raise FormatError(f"arrays declare {total / 2**30:.2f} GiB, over the "

@@ -333,7 +333,15 @@ def _check_size(ctx, tex: Texture) -> None:
 
 def _as_encoded(ctx, tex: Texture) -> bool:
     """Whether ``tex`` is uploaded in its encoded form (else its array, the decoded values)."""
-    return tex.encoded is not None and encoded_supported(ctx, tex.encoded, tex.target, tex.srgb)
+    return tex.encoded is not None and encoded_supported(ctx, tex.encoded, tex.target,
+                                                         _encoded_srgb(tex))
+
+
+def _encoded_srgb(tex: Texture) -> bool:
+    """Whether the GL decodes ``tex``'s encoding from sRGB: as it decodes the array (uint8
+    sampled sRGB), or, for a float array, as the encoding stored it (linear colour kept
+    sRGB-encoded), so both sample the same values."""
+    return tex.srgb if tex.encoded.dtype == "uint8" else tex.encoded.srgb
 
 
 def _upload_texture(ctx, tex: Texture):
@@ -341,7 +349,7 @@ def _upload_texture(ctx, tex: Texture):
     repeat = tex.wrap[0] == "repeat"
     if _as_encoded(ctx, tex):
         gl_tex = encoded_texture(ctx, tex.encoded, target=tex.target, what=tex.what,
-                                 filter=tex.filter, srgb=tex.srgb, mipmaps=tex.mipmaps,
+                                 filter=tex.filter, srgb=_encoded_srgb(tex), mipmaps=tex.mipmaps,
                                  repeat=repeat)
     elif tex.target == "2d" and tex.levels is not None:
         gl_tex = texture_levels(ctx, list(tex.levels), what=tex.what)
