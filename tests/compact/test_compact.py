@@ -30,7 +30,8 @@ COLOR_TOLERANCE = 2 / 255
 
 
 def encoded_samples():
-    """(technique, kind) of the samples with at least one array that has a role."""
+    """(technique, kind) of the samples that hold an array with a role (the others have
+    nothing to compress: the depth object's sample, a shell volume without a surface)."""
     out = []
     for tech, kind in technique_samples():
         rep = sample(tech, kind)
@@ -38,7 +39,8 @@ def encoded_samples():
             codec = codec_of(rep)
         except FormatError:
             continue
-        if any(spec.role for spec in codec.arrays.values()):
+        arrays, _ = codec.to_arrays(rep)
+        if any(codec.arrays[n].role for n, a in arrays.items() if a is not None):
             out.append((tech, kind))
     return out
 
