@@ -16,7 +16,7 @@ from reliefkit import render
 from reliefkit.compact.compact import CompressOptions, compress
 from reliefkit.compact.encodings import encoding_of
 from reliefkit.errors import FormatError
-from reliefkit.io.rk import codec_of, load, save
+from reliefkit.io.rk import array_bytes, codec_of, load, save
 from reliefkit.scene.views import orbit_bounds
 
 #: Views where the colour's texels are magnified (level 0 only): from above, close.
@@ -109,6 +109,7 @@ def test_a_compressed_relief_file_shrinks_by_its_formats_bits(tmp_path):
         blocks_area = -(-height // 4) * 4 * -(-width // 4) * 4 if fmt.startswith("bc") \
             else height * width
         assert member_data_bytes(compact_path, name) == blocks_area * BYTES_PER_TEXEL[fmt]
+        assert array_bytes(compact)[name] == blocks_area * BYTES_PER_TEXEL[fmt]
         assert member_data_bytes(raw_path, name) == array.nbytes
     assert compact_path.stat().st_size < raw_path.stat().st_size
 

@@ -339,9 +339,12 @@ def _check_source_hash(value) -> None:
 
 
 def array_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str, int]:
-    """Bytes of each array a representation stores (its memory, uncompressed), by name."""
+    """Bytes of each array a representation stores (its memory, uncompressed; an encoded
+    array: its encoded level 0, as the file stores it), by name."""
     arrays, _ = _table(codecs).for_object(representation).to_arrays(representation)
-    return {name: int(np.asarray(a).nbytes) for name, a in arrays.items() if a is not None}
+    return {name: int(np.asarray(a).nbytes if encoding_of(a) is None
+                      else encoding_of(a).data.size)
+            for name, a in arrays.items() if a is not None}
 
 
 def save(path, representation, *, source_hash: str | None = None,
