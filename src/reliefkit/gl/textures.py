@@ -323,8 +323,9 @@ def encoded_texture(ctx, encoded, *, target: str = "2d", what: str = "texture",
     """Upload a `reliefkit.compact.encodings.EncodedImage` as it is: block formats through
     glCompressedTexImage (moderngl has no compressed upload: it makes the texture object,
     whose levels are then redefined compressed), one call per mip level; ``u8``/``u16`` as
-    normalized textures. ``mipmaps``: every level of the encoding (they are encoded per
-    level: the GL cannot build them). Sizes are checked before anything is allocated."""
+    normalized textures (level 0 only). ``mipmaps``: every level of a block encoding (they
+    are encoded per level: the GL cannot build them). Sizes are checked before anything is
+    allocated."""
     import moderngl
 
     if not encoded_supported(ctx, encoded, target, srgb):
@@ -335,7 +336,7 @@ def encoded_texture(ctx, encoded, *, target: str = "2d", what: str = "texture",
     size = (width, height) if target == "2d" else (width, height, layers)
     make = {"2d": ctx.texture, "3d": ctx.texture3d, "2d_array": ctx.texture_array}[target]
     quantized = _QUANTIZED_DTYPES.get(encoded.format)
-    levels = encoded.levels if mipmaps else encoded.levels[:1]
+    levels = encoded.levels if mipmaps and not quantized else encoded.levels[:1]
     if quantized:
         tex = make(size, comps, np.ascontiguousarray(levels[0]), dtype=quantized)
     else:

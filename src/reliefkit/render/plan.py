@@ -95,6 +95,9 @@ class Texture:
                 any(w not in WRAPS for w in self.wrap):
             raise ValueError(f"{self.what}: bad texture state {self.target}, {self.filter}, "
                              f"{self.wrap}")
+        if self.encoded is not None and tuple(self.encoded.shape) != self.array.shape:
+            raise ValueError(f"{self.what}: its encoding stands for a {self.encoded.shape} "
+                             f"array, not {self.array.shape}")
 
 
 @dataclass(frozen=True)
