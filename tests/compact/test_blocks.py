@@ -81,3 +81,25 @@ def test_each_format_keeps_its_known_error(rng, fmt):
     noise_decoded = blocks.decode(fmt, blocks.encode(fmt, noise), 64, 64)
     assert np.abs(noise_decoded.astype(int) - noise).mean() <= NOISE_MEAN[fmt]
     assert len(blocks.encode(fmt, image)) == 64 * 64 * blocks.FORMATS[fmt].bits_per_texel // 8
+
+
+class LimitedContext:
+    """A context with every format and a 64 x 64 texture limit; allocating fails the test."""
+
+    info = {"GL_MAX_TEXTURE_SIZE": 64, "GL_MAX_ARRAY_TEXTURE_LAYERS": 2048,
+            "GL_MAX_3D_TEXTURE_SIZE": 64}
+    extensions = {"GL_ARB_texture_compression_bptc", "GL_EXT_texture_compression_s3tc",
+                  "GL_ARB_texture_compression_rgtc"}
+
+    def texture(self, *args, **kwargs):
+        raise AssertionError("allocated a texture that should have been refused")
+
+    texture_array = texture3d = texture
+
+
+def test_an_encoded_texture_over_the_limits_is_refused_before_allocating():
+    from reliefkit.errors import GPUError
+
+    encoded = encode(np.zeros((8, 128, 4), np.uint8), "bc7")
+    with pytest.raises(GPUError, match="a 128x8 texture exceeds this GPU's limit of 64x64"):
+        encoded_texture(LimitedContext(), encoded, what="atlas")

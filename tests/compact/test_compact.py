@@ -198,3 +198,24 @@ def test_encoded_plans_round_trip_through_json_and_draw_the_same_frame(gl, tech_
         frame = scene.frame(camera, light)
     np.testing.assert_array_equal(frame.color, expected.color)
     np.testing.assert_array_equal(frame.depth, expected.depth)
+
+
+def test_safety_radii_are_those_of_the_quantized_heights():
+    from reliefkit.techniques.relief.safety import safety_radii
+
+    rep = sample("relief", "relief")
+    compact = compress(rep, CompressOptions(height_bits=8))
+    expected = safety_radii(compact.height, tolerance=rep.params["safety_tolerance"])
+    assert not np.array_equal(expected, rep.safety)  # 8-bit heights move a radius here
+    np.testing.assert_array_equal(compact.safety, expected)
+
+
+def test_without_the_format_the_decoded_arrays_are_uploaded(gl, monkeypatch):
+    from reliefkit.render import executor
+
+    compact = compress(sample("relief", "relief"))
+    camera = orbit_bounds(compact.bounds, 30.0, 25.0, size=(64, 64))
+    monkeypatch.setattr(executor, "encoded_supported", lambda *args: False)
+    got, expected = render(compact, camera), render(raw_twin(compact), camera)
+    for name in ("color", "mask", "depth", "normal"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(expected, name))
