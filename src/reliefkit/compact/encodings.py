@@ -71,7 +71,7 @@ class EncodedImage:
         if not self.mipmaps:
             return (self.data,)
         out = [self.data]
-        source = _to_linear(self._unorm(0, self.data), self.format, self.srgb)
+        source = _to_linear(self._unorm(0, self.data), self.srgb)
         while max(source.shape[1:3]) > 1:
             source = _half(source)
             out.append(_encode_unorm(_from_linear(source, self.format, self.srgb), self.format))
@@ -98,7 +98,7 @@ class EncodedImage:
         if self.dtype == "uint8":
             values = q.astype(np.uint8)
         elif self.srgb:  # float linear colour stored sRGB-encoded: decoded as the GL does
-            values = _to_linear(q, self.format, True).astype(np.float32)
+            values = _to_linear(q, True).astype(np.float32)
         else:
             top = np.float32(np.iinfo(q.dtype).max)
             values = (q.astype(np.float32) / top * np.float32(self.scale)
@@ -165,7 +165,8 @@ def _encode_unorm(q: np.ndarray, fmt: str) -> np.ndarray:
     return np.concatenate(out)
 
 
-def _to_linear(q: np.ndarray, fmt: str, srgb: bool) -> np.ndarray:
+def _to_linear(q: np.ndarray, srgb: bool) -> np.ndarray:
+    """Unorm integers -> [0, 1] floats, sRGB colour channels decoded to linear light."""
     values = q.astype(np.float64) / np.iinfo(q.dtype).max
     if srgb:
         values[..., :3] = srgb_decode(values[..., :3])
@@ -173,6 +174,7 @@ def _to_linear(q: np.ndarray, fmt: str, srgb: bool) -> np.ndarray:
 
 
 def _from_linear(values: np.ndarray, fmt: str, srgb: bool) -> np.ndarray:
+    """`_to_linear`'s inverse, rounded to ``fmt``'s unorm integers."""
     values = values.copy()
     if srgb:
         values[..., :3] = srgb_encode(values[..., :3])
