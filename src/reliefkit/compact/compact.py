@@ -111,11 +111,10 @@ def gpu_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str, 
     for name, array in arrays.items():
         if array is None:
             continue
-        role = codec.arrays[name].role
-        mipmaps = role in ("color", "normal")
-        raw = texture_bytes(np.asarray(array), layered=role is not None
-                            and _layered(np.asarray(array), role), mipmaps=mipmaps)
-        encoded = encoding_of(array)
+        role, array = codec.arrays[name].role, np.asarray(array)
+        raw = int(array.nbytes) if role is None else texture_bytes(
+            array, layered=_layered(array, role), mipmaps=role in ("color", "normal"))
+        encoded = encoding_of(arrays[name])
         out[name] = (encoded.format, encoded.nbytes, raw) if encoded is not None \
             else ("raw", raw, raw)
     return out
