@@ -219,3 +219,24 @@ def test_without_the_format_the_decoded_arrays_are_uploaded(gl, monkeypatch):
     got, expected = render(compact, camera), render(raw_twin(compact), camera)
     for name in ("color", "mask", "depth", "normal"):
         np.testing.assert_array_equal(getattr(got, name), getattr(expected, name))
+
+
+def test_a_textured_mesh_draws_and_stores_its_encoded_texture(gl, tmp_path):
+    from reliefkit.scene.camera import Camera
+    from reliefkit.scene.mesh import Material, RenderMesh
+
+    v, u = np.mgrid[:32, :32] / 31.0
+    texture = np.round(np.stack([u, v, 1 - u, np.ones_like(u)], -1) * 255).astype(np.uint8)
+    positions = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float32)
+    mesh = RenderMesh(positions, [[0, 1, 2], [0, 2, 3]], np.tile([0, 0, 1.0], (4, 1)),
+                      np.ones((4, 4)), uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]),
+                      materials=[Material(texture=texture)])
+    compact = compress(mesh)
+    assert encoding_of(compact.materials[0].texture).format == "bc7"
+    camera = Camera(eye=(0, 0, 3), target=(0, 0, 0), size=(96, 96), ortho_height=1.0)
+    got, expected = render(compact, camera), render(raw_twin(compact), camera)
+    np.testing.assert_array_equal(got.mask, expected.mask)
+    assert np.abs(got.color - expected.color).max() <= COLOR_TOLERANCE
+    path = save(tmp_path / "m.rk", compact)
+    assert member_data_bytes(path, "texture") == 32 * 32  # BC7: a byte a texel
+    np.testing.assert_array_equal(render(load(path), camera).color, got.color)

@@ -110,7 +110,7 @@ def _rows(dtype: str, cols: int, **options) -> ArraySpec:
     return ArraySpec((dtype,), ndim=2, trailing=(cols,), **options)
 
 
-_TEXTURE = ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False)
+_TEXTURE = ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False, role="color")
 
 #: The core's ``mesh`` kind; the composition root (`reliefkit.builtins`) registers it.
 MESH_CODEC = Codec(
