@@ -9,13 +9,18 @@ from ..core.technique import baker
 from ..errors import UsageError
 
 
-def bake(source, kind: str, *, progress=None, **params):
+def bake(source, kind: str, *, progress=None, compress=None, **params):
     """Bake a RenderMesh (or a 2D height array) into the representation ``kind``.
 
     ``params`` are the baker's typed parameters (``reliefkit bake --help`` lists them per
-    kind); an unknown or invalid one is a UsageError.
+    kind); an unknown or invalid one is a UsageError. ``compress``: a
+    `reliefkit.compact.compact.CompressOptions` (or its fields as a dict); with
+    ``compress="bc"`` the result is `compress`-ed, whatever the kind.
     """
     import numpy as np
+
+    from ..compact.compact import bake_compression
+    from ..compact.compact import compress as compressed
 
     tech, chosen = baker(kind)
     source_kind = "heightmap" if isinstance(source, np.ndarray) else "mesh"
@@ -23,7 +28,9 @@ def bake(source, kind: str, *, progress=None, **params):
         raise UsageError(f"--as {kind} bakes a {' or '.join(chosen.sources)}, not a "
                          f"{source_kind}")
     values = options.make(chosen.params, params, f"bake --as {kind}")
-    return chosen.bake(source, values, progress)
+    how = bake_compression(compress)
+    rep = chosen.bake(source, values, progress)
+    return compressed(rep, how) if how.compress == "bc" else rep
 
 
 __all__ = ["bake"]

@@ -1,5 +1,6 @@
 """Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique, or one of the
-core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering).
+core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering;
+`compact`: compressed textures' bytes and error).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
@@ -13,7 +14,7 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import loading, platform
+from . import compact, loading, platform
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -46,7 +47,9 @@ def suites() -> dict:
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
                                   loading.run_suite, takes_mesh=True),
             "platform": BenchSuite("platform", "a turntable in one render call against one "
-                                   "call per view, per demo tile", platform.run_suite)}
+                                   "call per view, per demo tile", platform.run_suite),
+            "compact": BenchSuite("compact", "bytes and image error of compressed textures, "
+                                  "per demo asset and kind", compact.run_suite)}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 

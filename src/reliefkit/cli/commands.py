@@ -17,8 +17,9 @@ from ..animation import (
 )
 from ..bake import bake
 from ..bench import run_suite
+from ..compact.compact import CompressOptions, gpu_bytes
 from ..compare import compare, metrics_markdown, write_comparison
-from ..core.params import ANIMATION_TIME
+from ..core.params import ANIMATION_TIME, options_of
 from ..core.technique import baker, technique_of
 from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
@@ -97,10 +98,13 @@ def _print_load_warnings(obj) -> None:
 
 def _bake_input(args, source=None):
     _, chosen = baker(args.kind)
-    params = applicable(given_options(args), chosen.options, f"--as {args.kind}")
+    given = given_options(args)
+    compression = {opt.name: given.pop(opt.name) for opt in options_of(CompressOptions)
+                   if opt.name in given}
+    params = applicable(given, chosen.options, f"--as {args.kind}")
     source = _bake_source(args.input) if source is None else source
     with progress_bar(f"baking {args.kind}", 1) as advance:
-        return bake(source, args.kind, progress=advance, **params)
+        return bake(source, args.kind, progress=advance, compress=compression, **params)
 
 
 def cmd_bake(args) -> int:
@@ -111,10 +115,19 @@ def cmd_bake(args) -> int:
     source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
     save(args.output, rep, source_hash=source_hash)
     print(f"wrote {args.output}: {_arrays_summary(array_bytes(rep), args.output)}, "
-          f"{format_bytes(Path(args.output).stat().st_size)} on disk")
+          f"{format_bytes(Path(args.output).stat().st_size)} on disk{_gpu_summary(rep)}")
     for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
         print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
+
+
+def _gpu_summary(rep) -> str:
+    """``; on the GPU RAW -> COMPACT`` for a compressed representation, else nothing."""
+    sizes = gpu_bytes(rep).values()
+    if all(fmt == "raw" for fmt, _, _ in sizes):
+        return ""
+    return (f"; on the GPU {format_bytes(sum(raw for _, _, raw in sizes))} raw -> "
+            f"{format_bytes(sum(gpu for _, gpu, _ in sizes))} compact")
 
 
 def _arrays_summary(sizes: dict[str, int], path: str, shown: int = 3) -> str:
@@ -370,14 +383,19 @@ def cmd_info(args) -> int:
 
 
 def _print_section(section: dict) -> None:
-    """``key: value`` lines; an .rk's arrays one per line (dtype and shape; ``--json`` also
-    has their checksums), so a six-part cube reads as a list rather than a wall of JSON."""
+    """``key: value`` lines; an .rk's arrays one per line (dtype and shape, the format and
+    bytes it has on the GPU against its raw bytes; ``--json`` also has their checksums and
+    encodings), so a six-part cube reads as a list rather than a wall of JSON."""
     for key, value in section.items():
         if key == "arrays" and isinstance(value, dict):
             print(f"{key:>24}: {len(value)}")
             for name, record in value.items():
+                record = record | record.get("encoding", {})  # an encoded one: as decoded
                 shape = "x".join(map(str, record.get("shape", []))) or "scalar"
-                print(f"{name:>26}  {record.get('dtype')} {shape}")
+                gpu = record.get("gpu", {})
+                on_gpu = f"  on the GPU {gpu['format']} {format_bytes(gpu['bytes'])} (raw " \
+                         f"{format_bytes(gpu['raw_bytes'])})" if gpu else ""
+                print(f"{name:>26}  {record.get('dtype')} {shape}{on_gpu}")
             continue
         shown = json.dumps(value) if isinstance(value, dict | list) else value
         print(f"{key:>24}: {shown}")
@@ -388,8 +406,12 @@ def _describe_file(spec: str) -> dict:
     checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
     _check_not_empty(spec)
     if Path(spec).suffix.lower() == ".rk":
-        load(spec)  # every check render makes: checksums, then the representation's own
-        return {**read_manifest(spec), "checksums": "ok", "valid": "ok"}
+        rep = load(spec)  # every check render makes: checksums, then the representation's own
+        manifest = read_manifest(spec)
+        for name, (fmt, gpu, raw) in gpu_bytes(rep).items():
+            if name in manifest["arrays"]:
+                manifest["arrays"][name]["gpu"] = {"format": fmt, "bytes": gpu, "raw_bytes": raw}
+        return {**manifest, "checksums": "ok", "valid": "ok"}
 
     return describe(_load(spec))
 

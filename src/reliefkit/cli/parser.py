@@ -8,6 +8,8 @@ import sys
 from .. import __version__
 from ..bench import suite_names, suites
 from ..builtins import registry
+from ..compact.compact import CompressOptions
+from ..core.params import options_of
 from ..core.technique import bakers, techniques
 from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
@@ -221,5 +223,6 @@ def _add_bake_args(p: argparse.ArgumentParser, table: dict,
     p.add_argument("--as", dest="kind", default=kinds[0] if kinds else None, choices=kinds,
                    help="representation to bake (default: %(default)s)")
     add_options(p, [(name, b.options) for name, (_, b) in table.items()], "bake options")
+    add_options(p, [("compress", options_of(CompressOptions))], "compression (any kind)")
 
 

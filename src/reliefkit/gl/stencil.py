@@ -1,8 +1,7 @@
 """Stencil-buffer passes, which moderngl does not expose: an offscreen framebuffer with a
 depth + stencil renderbuffer, and the stencil state, through raw GL entry points.
 
-The entry points come from the context's own loader (glcontext's ``load``, the same one
-moderngl resolves its functions with), so they act on the context moderngl made current.
+The entry points come from `gl.raw` (the context's own loader).
 A drawable that needs a stencil (the slicing technique's multi-pass test, §4.1 of the
 Kautz-Seidel paper) renders into a `StencilTarget` inside its ``draw`` and then writes the
 result into the frame's own target.
@@ -14,6 +13,9 @@ import ctypes
 
 from ..errors import GPUError
 from .context import check_gl_error
+from .raw import raw_gl
+
+_u = ctypes.c_uint
 
 GL_FRAMEBUFFER = 0x8D40
 GL_RENDERBUFFER = 0x8D41
@@ -31,53 +33,6 @@ NEVER, LESS, EQUAL, LEQUAL, GREATER, NOTEQUAL, GEQUAL, ALWAYS = range(0x0200, 0x
 #: Stencil operations.
 KEEP, ZERO, REPLACE, INCR = 0x1E00, 0x0000, 0x1E01, 0x1E02
 
-_u, _i, _f = ctypes.c_uint, ctypes.c_int, ctypes.c_float
-_SIGNATURES = {
-    "glGenFramebuffers": (None, _i, ctypes.POINTER(_u)),
-    "glDeleteFramebuffers": (None, _i, ctypes.POINTER(_u)),
-    "glBindFramebuffer": (None, _u, _u),
-    "glFramebufferTexture2D": (None, _u, _u, _u, _u, _i),
-    "glFramebufferRenderbuffer": (None, _u, _u, _u, _u),
-    "glCheckFramebufferStatus": (_u, _u),
-    "glGenRenderbuffers": (None, _i, ctypes.POINTER(_u)),
-    "glDeleteRenderbuffers": (None, _i, ctypes.POINTER(_u)),
-    "glBindRenderbuffer": (None, _u, _u),
-    "glRenderbufferStorage": (None, _u, _u, _i, _i),
-    "glDrawBuffers": (None, _i, ctypes.POINTER(_u)),
-    "glViewport": (None, _i, _i, _i, _i),
-    "glClearColor": (None, _f, _f, _f, _f),
-    "glClearStencil": (None, _i),
-    "glClear": (None, _u),
-    "glEnable": (None, _u),
-    "glDisable": (None, _u),
-    "glStencilFunc": (None, _u, _i, _u),
-    "glStencilOp": (None, _u, _u, _u),
-    "glStencilMask": (None, _u),
-    "glColorMask": (None, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte),
-}
-
-
-class _GL:
-    """The raw entry points above, resolved once per context."""
-
-    def __init__(self, ctx):
-        loader = getattr(getattr(ctx, "mglo", None), "_context", None)
-        if loader is None or not hasattr(loader, "load"):
-            raise GPUError("stencil passes need the GL loader of moderngl's context, which "
-                           "this moderngl build does not expose; use the single-pass test")
-        for name, (restype, *argtypes) in _SIGNATURES.items():
-            address = loader.load(name)
-            if not address:
-                raise GPUError(f"the GL driver has no {name}; stencil passes are unavailable")
-            setattr(self, name[2:], ctypes.CFUNCTYPE(restype, *argtypes)(address))
-
-
-def raw_gl(ctx) -> _GL:
-    extra = ctx.extra if isinstance(ctx.extra, dict) else {}
-    if "raw_gl" not in extra:
-        extra["raw_gl"] = _GL(ctx)
-        ctx.extra = extra
-    return extra["raw_gl"]
 
 
 class StencilTarget:

@@ -277,3 +277,106 @@ def _srgb_to_linear_half(rgba8: np.ndarray) -> np.ndarray:
     out[..., :3] = colour_table[rgba8[..., :3]]
     out[..., 3] = levels.astype(np.float16)[rgba8[..., 3]]
     return out
+
+
+# -- encoded textures (reliefkit.compact) ---------------------------------------------------
+
+GL_TEXTURE_2D, GL_TEXTURE_3D, GL_TEXTURE_2D_ARRAY = 0x0DE1, 0x806F, 0x8C1A
+GL_TEXTURE_BASE_LEVEL, GL_TEXTURE_MAX_LEVEL = 0x813C, 0x813D
+_GL_TARGETS = {"2d": GL_TEXTURE_2D, "3d": GL_TEXTURE_3D, "2d_array": GL_TEXTURE_2D_ARRAY}
+#: Block format -> (GL internal format, its sRGB variant or None, the extension naming it,
+#: the targets GL allows it on: S3TC and RGTC are 2D-only, BPTC also takes 3D textures).
+BLOCK_FORMATS = {
+    "bc1": (0x83F1, 0x8C4D, "GL_EXT_texture_compression_s3tc", ("2d", "2d_array")),
+    "bc4": (0x8DBB, None, "GL_ARB_texture_compression_rgtc", ("2d", "2d_array")),
+    "bc5": (0x8DBD, None, "GL_ARB_texture_compression_rgtc", ("2d", "2d_array")),
+    "bc7": (0x8E8C, 0x8E8D, "GL_ARB_texture_compression_bptc", ("2d", "2d_array", "3d")),
+}
+_QUANTIZED_DTYPES = {"u8": "nu1", "u16": "nu2"}
+
+
+def encoded_supported(ctx, encoded, target: str, srgb: bool = False) -> bool:
+    """Whether this GL samples ``encoded`` on ``target`` as it is (else: upload the decoded
+    array). Quantized images are plain normalized textures, 2D or 2D arrays."""
+    if encoded.format in _QUANTIZED_DTYPES:
+        return target in ("2d", "2d_array") and not srgb
+    linear, srgb_format, extension, targets = BLOCK_FORMATS[encoded.format]
+    return (target in targets and extension in ctx.extensions
+            and (srgb_format is not None or not srgb))
+
+
+def check_encoded_size(ctx, encoded, target: str, what: str) -> None:
+    """Refuse an encoded texture over the GL limits (its bytes as uploaded), before any
+    allocation."""
+    height, width = encoded.size
+    if target == "2d":
+        _check_2d(ctx, width, height, what)
+    elif target == "3d":
+        check_3d_size(ctx, width, height, encoded.layers, what, nbytes=encoded.nbytes)
+    else:
+        check_array_size(ctx, width, height, encoded.layers, what, nbytes=encoded.nbytes)
+
+
+def encoded_texture(ctx, encoded, *, target: str = "2d", what: str = "texture",
+                    filter: str = "linear", srgb: bool = False, mipmaps: bool = False,
+                    repeat: bool = False):
+    """Upload a `reliefkit.compact.encodings.EncodedImage` as it is: block formats through
+    glCompressedTexImage (moderngl has no compressed upload: it makes the texture object,
+    whose levels are then redefined compressed), one call per mip level; ``u8``/``u16`` as
+    normalized textures (level 0 only). ``mipmaps``: every level of a block encoding (they
+    are encoded per level: the GL cannot build them). Sizes are checked before anything is
+    allocated."""
+    import moderngl
+
+    if not encoded_supported(ctx, encoded, target, srgb):
+        raise GPUError(f"{what}: this GL cannot sample {encoded.format} on a {target} texture")
+    check_encoded_size(ctx, encoded, target, what)
+    height, width = encoded.size
+    layers, comps = encoded.layers, encoded.channels
+    size = (width, height) if target == "2d" else (width, height, layers)
+    make = {"2d": ctx.texture, "3d": ctx.texture3d, "2d_array": ctx.texture_array}[target]
+    quantized = _QUANTIZED_DTYPES.get(encoded.format)
+    levels = encoded.levels if mipmaps and not quantized else encoded.levels[:1]
+    if quantized:
+        tex = make(size, comps, np.ascontiguousarray(levels[0]), dtype=quantized)
+    else:
+        tex = make(size, 4 if comps == 3 else comps, None, dtype="f1")
+    try:
+        if not quantized:
+            _compressed_levels(ctx, tex.glo, encoded, target, srgb, levels)
+        nearest = filter == "nearest"
+        minify = moderngl.NEAREST if nearest else (
+            moderngl.LINEAR_MIPMAP_LINEAR if len(levels) > 1 else moderngl.LINEAR)
+        tex.filter = (minify, moderngl.NEAREST if nearest else moderngl.LINEAR)
+        tex.repeat_x = tex.repeat_y = repeat
+        check_gl_error(ctx, f"creating {what} ({layers} x {width}x{height}, "
+                            f"{encoded.format}, {len(levels)} levels)")
+    except BaseException:
+        tex.release()
+        raise
+    return tex
+
+
+def _compressed_levels(ctx, glo: int, encoded, target: str, srgb: bool, levels) -> None:
+    """Redefine texture ``glo``'s levels as ``levels`` (compressed bytes, level 0 first)."""
+    from .raw import raw_gl
+
+    gl = raw_gl(ctx)
+    linear, srgb_format, _, _ = BLOCK_FORMATS[encoded.format]
+    internal = srgb_format if srgb else linear
+    gl_target = _GL_TARGETS[target]
+    height, width = encoded.size
+    gl.BindTexture(gl_target, glo)
+    try:
+        for k, data in enumerate(levels):
+            h, w = max(height >> k, 1), max(width >> k, 1)
+            buffer = np.ascontiguousarray(data).ctypes.data
+            if target == "2d":
+                gl.CompressedTexImage2D(gl_target, k, internal, w, h, 0, data.size, buffer)
+            else:
+                gl.CompressedTexImage3D(gl_target, k, internal, w, h, encoded.layers, 0,
+                                        data.size, buffer)
+        gl.TexParameteri(gl_target, GL_TEXTURE_BASE_LEVEL, 0)
+        gl.TexParameteri(gl_target, GL_TEXTURE_MAX_LEVEL, len(levels) - 1)
+    finally:
+        gl.BindTexture(gl_target, 0)

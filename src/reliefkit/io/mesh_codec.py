@@ -110,7 +110,7 @@ def _rows(dtype: str, cols: int, **options) -> ArraySpec:
     return ArraySpec((dtype,), ndim=2, trailing=(cols,), **options)
 
 
-_TEXTURE = ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False)
+_TEXTURE = ArraySpec(("uint8",), ndim=3, trailing=(4,), required=False, role="color")
 
 #: The core's ``mesh`` kind; the composition root (`reliefkit.builtins`) registers it.
 MESH_CODEC = Codec(
@@ -168,7 +168,7 @@ def check_base_arrays(arrays: dict, kind: str, per_vertex=("normals", "uvs")) ->
 #: [u0, v0, u1, v1]. Files without them load as before (no tint).
 SURFACE_ARRAYS = {
     "surface": ArraySpec(("uint8",), ndim=4, trailing=(4,), required=False,
-                         max_size=4 * MAX_MATERIALS * ATLAS_SIZE ** 2),
+                         max_size=4 * MAX_MATERIALS * ATLAS_SIZE ** 2, role="color"),
     "material": ArraySpec(("uint16",), ndim=1, required=False, max_size=MAX_BASE_TRIANGLES),
 }
 

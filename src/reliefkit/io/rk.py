@@ -39,12 +39,14 @@ import numpy as np
 from numpy.lib import format as npy
 
 from .. import __version__
+from ..compact.encodings import EncodedImage, check, decoded, encoding_of, stored_bytes
 from ..errors import FormatError, ReliefkitError
 from .atomic import atomic_path
 
 __all__ = [
     "ArraySpec", "Codec", "CodecTable", "RkFile", "use_codecs",
-    "save", "load", "read_manifest", "write_rk", "read_rk", "file_sha256", "array_bytes",
+    "save", "load", "read_manifest", "codec_of", "write_rk", "read_rk", "file_sha256",
+    "array_bytes",
     "FORMAT_NAME", "FORMAT_VERSION", "DEFAULT_MAX_BYTES",
 ]
 
@@ -91,6 +93,11 @@ class ArraySpec:
     trailing : fixed trailing dimensions, ``None`` for a free one, e.g. ``(4, 4)``.
     max_size : the most elements the kind accepts (its own limits, such as a texture's
         texels), or None; checked on the declared shape, before any data is inflated.
+    role : what `reliefkit.compact.compress` may do to it: ``"color"`` (uint8 sRGB colour
+        with alpha, or float32 linear colour: block-compressed sRGB), ``"normal"`` (unit
+        vectors, float32 in [-1, 1] or uint8 as (n + 1) / 2: block-compressed),
+        ``"height"`` (float32 in [0, 1], 0 empty: quantized), or None: stored exactly
+        (positions, occupancy, derived data).
     """
 
     dtypes: tuple[str, ...]
@@ -99,6 +106,11 @@ class ArraySpec:
     finite: bool = False
     trailing: tuple[int | None, ...] | None = None
     max_size: int | None = None
+    role: str | None = None
+
+
+#: The roles an `ArraySpec` may declare (what `reliefkit.compact` may encode it as).
+ROLES = ("color", "normal", "height")
 
 
 #: The optional array of a baked representation that keeps its source mesh's bounds, so
@@ -121,6 +133,9 @@ class Codec:
     check_shapes : ``{name: shape} -> None``, raising `FormatError` where the arrays' shapes
         disagree (a colour image not the size of its height field), or None; run on the
         declared shapes before anything is inflated, and before writing.
+    rederive : ``(arrays, params) -> arrays``: the arrays derived from others (safety radii
+        from heights) computed again, for `reliefkit.compact.compress` once it changed the
+        values they derive from; None when nothing derived is stored.
     """
 
     kind: str
@@ -130,6 +145,7 @@ class Codec:
     from_arrays: Callable[[dict[str, np.ndarray], dict], object]
     version: int = 1
     check_shapes: Callable[[dict[str, tuple[int, ...]]], None] | None = None
+    rederive: Callable[[dict[str, np.ndarray], dict], dict[str, np.ndarray]] | None = None
 
 
 @dataclass(frozen=True)
@@ -228,6 +244,8 @@ def _check_spec(kind: str, name: str, spec: ArraySpec) -> None:
             raise FormatError(f"{where}: {text!r} is not a numpy dtype") from None
         if dtype.hasobject or dtype.fields is not None or dtype.subdtype is not None:
             raise FormatError(f"{where}: dtype {text!r} is not a plain numeric dtype")
+    if spec.role is not None and spec.role not in ROLES:
+        raise FormatError(f"{where}: role {spec.role!r} is none of {', '.join(ROLES)}")
     tail = len(spec.trailing or ())
     if any(type(n) is not int or n < tail for n in _ndims(spec)):
         raise FormatError(f"{where}: ndim must be ints >= the number of trailing dims")
@@ -321,9 +339,12 @@ def _check_source_hash(value) -> None:
 
 
 def array_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str, int]:
-    """Bytes of each array a representation stores (its memory, uncompressed), by name."""
+    """Bytes of each array a representation stores (its memory, uncompressed; an encoded
+    array: its encoded level 0, as the file stores it), by name."""
     arrays, _ = _table(codecs).for_object(representation).to_arrays(representation)
-    return {name: int(np.asarray(a).nbytes) for name, a in arrays.items() if a is not None}
+    return {name: int(np.asarray(a).nbytes if encoding_of(a) is None
+                      else encoding_of(a).data.size)
+            for name, a in arrays.items() if a is not None}
 
 
 def save(path, representation, *, source_hash: str | None = None,
@@ -347,12 +368,19 @@ def save(path, representation, *, source_hash: str | None = None,
     return write_rk(path, codec.kind, arrays, params, source_hash=source_hash, codecs=codecs)
 
 
+def codec_of(representation, *, codecs: CodecTable | None = None) -> Codec:
+    """The codec that saves ``representation`` (in ``codecs`` or the process's table)."""
+    return _table(codecs).for_object(representation)
+
+
 def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
              source_hash: str | None = None, codecs: CodecTable | None = None) -> Path:
     """Validate arrays and params against a registered kind, then write atomically.
 
-    Arrays are stored C-contiguous and little-endian; values are kept bit for bit. On any
-    failure nothing is left behind and an existing file at `path` is unchanged.
+    Arrays are stored C-contiguous and little-endian; values are kept bit for bit. An array
+    that carries an encoding (`reliefkit.compact.encodings.encoding_of`) is stored as its
+    encoded level 0 instead. On any failure nothing is left behind and an existing file at
+    `path` is unchanged.
     """
     path = Path(path)
     try:
@@ -422,12 +450,16 @@ def _write_zip(fh, head: dict, arrays: dict[str, np.ndarray]) -> None:
     entries = {}
     with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as zf:
         for name, arr in arrays.items():
-            big = arr.nbytes > _FORCE_ZIP64
+            encoded = encoding_of(arr)
+            stored = arr if encoded is None else encoded.data
+            big = stored.nbytes > _FORCE_ZIP64
             with zf.open(_zipinfo(f"{name}.npy"), "w", force_zip64=big) as raw:
                 out = _HashingWriter(raw)
-                npy.write_array(out, arr, allow_pickle=False)
-            entries[name] = {"dtype": arr.dtype.str, "shape": list(arr.shape),
+                npy.write_array(out, stored, allow_pickle=False)
+            entries[name] = {"dtype": stored.dtype.str, "shape": list(stored.shape),
                              "sha256": out.sha.hexdigest()}
+            if encoded is not None:
+                entries[name]["encoding"] = _encoding_entry(encoded)
         manifest = {**head, "arrays": entries}
         zf.writestr(_zipinfo(MANIFEST_NAME), json.dumps(manifest, indent=2) + "\n")
 
@@ -458,7 +490,8 @@ class _Span:
 
 @dataclass(frozen=True)
 class _Member:
-    """One .npy member whose header passed every check; nothing read yet."""
+    """One .npy member whose header passed every check; nothing read yet. ``encoding``:
+    the manifest's encoding of it (the member holds its blocks), checked."""
 
     span: _Span
     dtype: np.dtype
@@ -466,10 +499,18 @@ class _Member:
     fortran: bool
     header_len: int
     sha256: str
+    encoding: dict | None = None
+
+    @property
+    def array_shape(self) -> tuple[int, ...]:
+        """The shape of the array it stands for (an encoded one: decoded)."""
+        return self.shape if self.encoding is None else tuple(self.encoding["shape"])
 
     @property
     def nbytes(self) -> int:
-        return math.prod(self.shape) * self.dtype.itemsize
+        """Bytes of the array it stands for in memory (an encoded one: decoded)."""
+        dtype = self.dtype if self.encoding is None else np.dtype(self.encoding["dtype"])
+        return math.prod(self.array_shape) * dtype.itemsize
 
 
 def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None = None):
@@ -523,7 +564,8 @@ def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES,
     """
     with _open_rk(path) as archive:
         manifest, codec, members = _inspect(archive, max_bytes, _table(codecs))
-        arrays = {name: _read_member(archive, name, m) for name, m in members.items()}
+        arrays = {name: _decoded(_read_member(archive, name, m), m.encoding)
+                  for name, m in members.items()}
         for name, arr in arrays.items():
             if codec.arrays[name].finite:
                 _check_finite(name, arr)
@@ -571,7 +613,7 @@ def _inspect(archive: _Archive, max_bytes: int | None, codecs: CodecTable):
     members = {name: _inspect_member(archive, codec, name, entry, spans[f"{name}.npy"])
                for name, entry in entries.items()}
     if codec.check_shapes is not None:
-        codec.check_shapes({name: member.shape for name, member in members.items()})
+        codec.check_shapes({name: member.array_shape for name, member in members.items()})
     total = sum(m.nbytes for m in members.values())
     if max_bytes is not None and total > max_bytes:
         raise FormatError(f"arrays declare {total / 2**30:.2f} GiB, over the "
@@ -820,18 +862,66 @@ def _inspect_member(archive: _Archive, codec: Codec, name: str, entry: dict,
     info = span.info
     head = _peek(archive, span, f"array '{name}'", _HEADER_PEEK)
     dtype, shape, fortran, header_len = _parse_npy_header(name, head)
-    _check_array(codec.kind, name, codec.arrays[name], dtype, shape)
+    encoding = entry.get("encoding")
+    if encoding is None:
+        _check_array(codec.kind, name, codec.arrays[name], dtype, shape)
+    else:
+        _check_encoding(codec, name, encoding, dtype, shape)
     if dtype.str != entry["dtype"] or list(shape) != entry["shape"]:
         raise FormatError(f"array '{name}': the .npy header says {dtype.str} {shape} but the "
                           f"manifest says {entry['dtype']} {tuple(entry['shape'])}; the file is "
                           "corrupt")
-    member = _Member(span, dtype, shape, fortran, header_len, entry["sha256"])
-    if header_len + member.nbytes != info.file_size:
+    member = _Member(span, dtype, shape, fortran, header_len, entry["sha256"], encoding)
+    stored = math.prod(shape) * dtype.itemsize
+    if header_len + stored != info.file_size:
         raise FormatError(f"array '{name}' declares shape {shape} {dtype.str} "
-                          f"({member.nbytes} bytes) but its member holds "
+                          f"({stored} bytes) but its member holds "
                           f"{info.file_size - header_len} bytes of data; the file is truncated "
                           "or forged")
     return member
+
+
+_ENCODING_KEYS = {"format": str, "shape": list, "dtype": str, "layered": bool, "srgb": bool,
+                  "mipmaps": bool, "scale": float, "bias": float}
+
+
+def _encoding_entry(encoded: EncodedImage) -> dict:
+    """The manifest's record of an encoded array (everything but its bytes)."""
+    return {key: list(getattr(encoded, key)) if key == "shape" else getattr(encoded, key)
+            for key in _ENCODING_KEYS}
+
+
+def _check_encoding(codec: Codec, name: str, encoding, dtype: np.dtype, shape: tuple) -> None:
+    """An encoded member: its manifest record, the array it decodes to against the kind's
+    spec, and its bytes (uint8, one dimension) exactly what the encoding holds."""
+    where = f"array '{name}'"
+    ok = isinstance(encoding, dict) and set(encoding) == set(_ENCODING_KEYS) and all(
+        isinstance(encoding[k], t) and (t is not float or math.isfinite(encoding[k]))
+        for k, t in _ENCODING_KEYS.items())
+    if not ok:
+        raise FormatError(f"{where}: its encoding needs exactly {', '.join(_ENCODING_KEYS)}; "
+                          "the file is corrupt")
+    try:
+        check(encoding["format"], tuple(encoding["shape"]), encoding["dtype"],
+              encoding["layered"])
+    except ReliefkitError as exc:
+        raise FormatError(f"{where}: {exc}; the file is corrupt") from None
+    decoded_shape = tuple(encoding["shape"])
+    _check_array(codec.kind, name, codec.arrays[name], np.dtype(encoding["dtype"]),
+                 decoded_shape)
+    expected = stored_bytes(encoding["format"], decoded_shape, encoding["layered"])
+    if dtype != np.uint8 or shape != (expected,):
+        raise FormatError(f"{where}: a {encoding['format']} encoding of {decoded_shape} is "
+                          f"({expected},) uint8, its member holds {shape} {dtype.str}; the file "
+                          "is corrupt or forged")
+
+
+def _decoded(stored: np.ndarray, encoding: dict | None) -> np.ndarray:
+    """A member's array: itself, or the array its encoding stands for."""
+    if encoding is None:
+        return stored
+    values = dict(encoding, shape=tuple(encoding["shape"]))
+    return decoded(EncodedImage(data=stored, **values))
 
 
 def _parse_npy_header(name: str, head: bytes) -> tuple[np.dtype, tuple, bool, int]:

@@ -25,6 +25,9 @@ from ..gl.textures import (
     _check_2d,
     check_3d_size,
     check_array_size,
+    check_encoded_size,
+    encoded_supported,
+    encoded_texture,
     texture2d,
     texture3d,
     texture_array,
@@ -71,6 +74,7 @@ class Executor:
         self.ctx = ctx
         self._made: list = []                   # every GL object, in creation order
         self._textures: dict[int, object] = {}  # id(Texture) -> GL texture
+        self._decode: dict[int, tuple] = {}     # id(GL texture) -> its (scale, bias)
         self._geometry: dict[int, _Uploaded] = {}
         self._keep_alive: list = []             # plan objects whose ids key the tables
         self._viewed: dict[int, Geometry] = {}  # id(geometry) -> its latest view's
@@ -112,7 +116,9 @@ class Executor:
         key = id(tex)
         if key not in self._textures:
             self._keep_alive.append(tex)
-            self._textures[key] = self.keep(_upload_texture(self.ctx, tex))
+            gl_tex = self._textures[key] = self.keep(_upload_texture(self.ctx, tex))
+            self._decode[id(gl_tex)] = (tex.encoded.scale, tex.encoded.bias) \
+                if _as_encoded(self.ctx, tex) else (1.0, 0.0)
         return self._textures[key]
 
     def _buffers(self, geometry: Geometry) -> _Uploaded:
@@ -176,7 +182,8 @@ class Executor:
 
     def bind_textures(self, prog, textures: dict, first_unit: int = 0) -> dict:
         """Bind ``textures`` (sampler name -> Texture or GL texture) to units from
-        ``first_unit`` on, one unit per distinct texture; returns the sampler uniforms."""
+        ``first_unit`` on, one unit per distinct texture; returns the sampler uniforms and
+        each sampler's ``<sampler>_decode`` (`render.plan.Texture`)."""
         units: dict[int, int] = {}
         samplers = {}
         for name, tex in textures.items():
@@ -186,6 +193,7 @@ class Executor:
                 units[key] = first_unit + len(units)
                 gl_tex.use(units[key])
             samplers[name] = units[key]
+            samplers[f"{name}_decode"] = self._decode.get(key, (1.0, 0.0))
         return samplers
 
     def set_raster(self, raster) -> None:
@@ -269,6 +277,7 @@ class Executor:
         for obj in reversed(self._made):
             obj.release()
         self._made, self._textures, self._geometry, self._keep_alive = [], {}, {}, []
+        self._decode = {}
         self._viewed = {}
         self.groups, self.cache, self._full_screen = {}, {}, {}
 
@@ -307,6 +316,9 @@ def _write(buffer: _Buffer, array: np.ndarray, dtype=None) -> None:
 def _check_size(ctx, tex: Texture) -> None:
     """Refuse ``tex`` over the GL limits as `reliefkit.gl.textures` would when creating it
     (sRGB texture arrays are decoded to float16 there: two bytes a channel)."""
+    if _as_encoded(ctx, tex):
+        check_encoded_size(ctx, tex.encoded, tex.target, tex.what)
+        return
     array = tex.levels[0] if tex.levels is not None else tex.array
     shape = array.shape
     if tex.target == "2d" and len(shape) >= 2:
@@ -319,10 +331,27 @@ def _check_size(ctx, tex: Texture) -> None:
                          nbytes=array.size * itemsize)
 
 
+def _as_encoded(ctx, tex: Texture) -> bool:
+    """Whether ``tex`` is uploaded in its encoded form (else its array, the decoded values)."""
+    return tex.encoded is not None and encoded_supported(ctx, tex.encoded, tex.target,
+                                                         _encoded_srgb(tex))
+
+
+def _encoded_srgb(tex: Texture) -> bool:
+    """Whether the GL decodes ``tex``'s encoding from sRGB: as it decodes the array (uint8
+    sampled sRGB), or, for a float array, as the encoding stored it (linear colour kept
+    sRGB-encoded), so both sample the same values."""
+    return tex.srgb if tex.encoded.dtype == "uint8" else tex.encoded.srgb
+
+
 def _upload_texture(ctx, tex: Texture):
     """A GL texture of ``tex`` through `reliefkit.gl.textures` (sizes checked first)."""
     repeat = tex.wrap[0] == "repeat"
-    if tex.target == "2d" and tex.levels is not None:
+    if _as_encoded(ctx, tex):
+        gl_tex = encoded_texture(ctx, tex.encoded, target=tex.target, what=tex.what,
+                                 filter=tex.filter, srgb=_encoded_srgb(tex), mipmaps=tex.mipmaps,
+                                 repeat=repeat)
+    elif tex.target == "2d" and tex.levels is not None:
         gl_tex = texture_levels(ctx, list(tex.levels), what=tex.what)
     elif tex.target == "2d":
         gl_tex = texture2d(ctx, tex.array, what=tex.what, filter=tex.filter, srgb=tex.srgb,

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compact.encodings import encoding_of
 from ..core.params import param
 from ..core.technique import DrawableSpec, ProgramVariant
 from ..scene.mesh import Material, RenderMesh
@@ -77,7 +78,8 @@ def mesh_plans(mesh: RenderMesh, shadows: bool = False, instrument: bool = False
             if key not in textures:
                 textures[key] = Texture(material.texture, srgb=True, mipmaps=True,
                                         wrap=("repeat", "repeat", "repeat"),
-                                        what=f"{mesh.name} texture")
+                                        what=f"{mesh.name} texture",
+                                        encoded=encoding_of(material.texture))
             sampled = {"u_texture": textures[key]}
         multipass = None
         if shadows:

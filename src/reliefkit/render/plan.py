@@ -21,6 +21,8 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
+from ..compact.encodings import EncodedImage
+
 PRIMITIVES = ("triangles", "points", "lines", "triangle_strip")
 #: The passes every executor has; techniques name multi-pass kinds of their own in
 #: `DrawPlan.multipass`.
@@ -71,7 +73,12 @@ class Texture:
     "2d_array": (D, H, W[, C]), indexed [w, v, u] (a 2D array's layers along D); row 0 is
     v = 0. uint8 is normalised (sRGB-decoded with ``srgb``), float32 stays float, uint16 is
     an unsigned integer texture. ``mipmaps``: built from level 0 by the GL; ``levels``:
-    given level arrays (level 0 first) instead. ``wrap``: per axis (u, v[, w])."""
+    given level arrays (level 0 first) instead. ``wrap``: per axis (u, v[, w]).
+    ``encoded``: the array block-compressed or quantized (`reliefkit.compact`), uploaded as
+    it is where the GL samples its format (with its own mip levels); ``array`` then holds
+    its decoded values, the fallback. A program declaring ``vec2 <sampler>_decode`` gets
+    the encoding's (scale, bias) from unorm to the array's values, or (1, 0) for the
+    array itself."""
 
     array: np.ndarray
     target: str = "2d"
@@ -81,12 +88,16 @@ class Texture:
     levels: tuple[np.ndarray, ...] | None = None
     wrap: tuple[str, ...] = ("clamp", "clamp", "clamp")
     what: str = "texture"
+    encoded: EncodedImage | None = None
 
     def __post_init__(self):
         if self.target not in TARGETS or self.filter not in FILTERS or \
                 any(w not in WRAPS for w in self.wrap):
             raise ValueError(f"{self.what}: bad texture state {self.target}, {self.filter}, "
                              f"{self.wrap}")
+        if self.encoded is not None and tuple(self.encoded.shape) != self.array.shape:
+            raise ValueError(f"{self.what}: its encoding stands for a {self.encoded.shape} "
+                             f"array, not {self.array.shape}")
 
 
 @dataclass(frozen=True)
@@ -235,6 +246,9 @@ def _encode(value, arrays: _Arrays):
         return value
     if isinstance(value, np.generic):
         return {"scalar": value.dtype.str, "value": value.item()}
+    if isinstance(value, EncodedImage):
+        return {"encoded": {f.name: _encode(getattr(value, f.name), arrays)
+                            for f in fields(value)}}
     if isinstance(value, tuple):
         return {"tuple": [_encode(v, arrays) for v in value]}
     if isinstance(value, list):
@@ -255,6 +269,8 @@ def _decode(value, arrays: Mapping[str, np.ndarray]):
         return np.dtype(value["scalar"]).type(value["value"])
     if "tuple" in value:
         return tuple(_decode(v, arrays) for v in value["tuple"])
+    if "encoded" in value:
+        return EncodedImage(**{k: _decode(v, arrays) for k, v in value["encoded"].items()})
     return {k: _decode(v, arrays) for k, v in value["dict"].items()}
 
 

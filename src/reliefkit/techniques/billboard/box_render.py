@@ -54,6 +54,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...core.transforms import invert_box
@@ -175,12 +176,14 @@ def box_textures(box: BillboardBox, variant: str, k: int) -> dict:
                                  what=f"box {k} distance")}
     if variant == "volumetric":
         out["u_color"] = Texture(box.color, target="3d", filter="nearest",
-                                 what=f"box {k} colour")
+                                 what=f"box {k} colour", encoded=encoding_of(box.color))
         out["u_normal"] = Texture(box.normal, target="3d", filter="nearest",
-                                  what=f"box {k} normal")
+                                  what=f"box {k} normal", encoded=encoding_of(box.normal))
     else:
-        out["u_color"] = Texture(box.color, srgb=True, filter="nearest", what=f"box {k} colour")
-        out["u_normal"] = Texture(box.normal, filter="nearest", what=f"box {k} normal")
+        out["u_color"] = Texture(box.color, srgb=True, filter="nearest", what=f"box {k} colour",
+                                 encoded=encoding_of(box.color))
+        out["u_normal"] = Texture(box.normal, filter="nearest", what=f"box {k} normal",
+                                  encoded=encoding_of(box.normal))
         out["u_displacement"] = Texture(box.displacement, filter="nearest",
                                         what=f"box {k} displacement")
     return out

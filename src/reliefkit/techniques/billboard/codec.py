@@ -36,8 +36,8 @@ CLOUD_ARRAYS = {
     "u_axes": _rows("float64", 3),
     "v_axes": _rows("float64", 3),
     "rects": ArraySpec(("int32",), ndim=2, trailing=(5,), max_size=5 * MAX_RECTANGLES),
-    "color": ArraySpec(("uint8",), ndim=4, trailing=(None, None, 4)),
-    "normal": ArraySpec(("uint8",), ndim=4, trailing=(None, None, 3)),
+    "color": ArraySpec(("uint8",), ndim=4, trailing=(None, None, 4), role="color"),
+    "normal": ArraySpec(("uint8",), ndim=4, trailing=(None, None, 3), role="normal"),
     "source_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False,
                                finite=True),
 }
@@ -70,8 +70,8 @@ def _optional(spec: ArraySpec) -> ArraySpec:
 
 BOX_ARRAYS = {
     "box_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
-    "color": ArraySpec(("uint8",), ndim=(3, 4), trailing=(None, 4)),
-    "normal": ArraySpec(("uint8",), ndim=(3, 4), trailing=(None, 3)),
+    "color": ArraySpec(("uint8",), ndim=(3, 4), trailing=(None, 4), role="color"),
+    "normal": ArraySpec(("uint8",), ndim=(3, 4), trailing=(None, 3), role="normal"),
     "distance": ArraySpec(("uint8",), ndim=3),
     "displacement": ArraySpec(("uint16",), ndim=3, required=False),
 }

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...compact.encodings import encoding_of
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...render.plan import Attribute, DrawPlan, Geometry, Program, Texture
 from .representation import BillboardCloud
@@ -69,9 +70,11 @@ def cloud_plan(cloud: BillboardCloud, instrument: bool = False) -> DrawPlan:
         geometry=Geometry({name: Attribute(a) for name, a in attributes.items()},
                           indices=quad_indices(cloud.count)),
         textures={"u_color_atlas": Texture(cloud.color, target="2d_array", srgb=True,
-                                           mipmaps=True, what="billboard colour atlas"),
+                                           mipmaps=True, what="billboard colour atlas",
+                                           encoded=encoding_of(cloud.color)),
                   "u_normal_atlas": Texture(cloud.normal, target="2d_array", mipmaps=True,
-                                            what="billboard normal atlas")},
+                                            what="billboard normal atlas",
+                                            encoded=encoding_of(cloud.normal))},
         origin=tuple(float(x) for x in cloud.center))
 
 

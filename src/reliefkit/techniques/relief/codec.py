@@ -15,9 +15,9 @@ from .representation import ReliefObject, ReliefTexture
 MAX_PARTS = 6
 
 RELIEF_ARRAYS = {
-    "height": ArraySpec(("float32",), ndim=2, finite=True),
-    "color": ArraySpec(("uint8",), ndim=3, trailing=(None, 4)),
-    "normal": ArraySpec(("float32",), ndim=3, trailing=(None, 3), finite=True),
+    "height": ArraySpec(("float32",), ndim=2, finite=True, role="height"),
+    "color": ArraySpec(("uint8",), ndim=3, trailing=(None, 4), role="color"),
+    "normal": ArraySpec(("float32",), ndim=3, trailing=(None, 3), finite=True, role="normal"),
     "safety": ArraySpec(("uint8", "uint16"), ndim=(2, 3), required=False),
     "box_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
     "clip_bounds": ArraySpec(("float64",), ndim=2, trailing=(2, 3), required=False, finite=True),
@@ -92,14 +92,34 @@ def _object_from(arrays: dict, params: dict) -> ReliefObject:
         raise FormatError(f"invalid relief object: {exc}") from None
 
 
+def _rederive_safety(arrays: dict, params: dict, prefix: str = "") -> dict:
+    """Safety radii computed again from (quantized) heights, with the bake's tolerance: a
+    radius of the exact heights may skip a crossing of the quantized ones."""
+    safety = arrays.get(prefix + "safety")
+    if safety is None:
+        return arrays
+    from .safety import safety_radii  # numba: slow to import
+
+    radii = safety_radii(arrays[prefix + "height"],
+                         tolerance=float(params.get("safety_tolerance", 0.0)),
+                         octants=safety.ndim == 3)
+    return arrays | {prefix + "safety": radii}
+
+
+def _rederive_parts(arrays: dict, params: dict) -> dict:
+    for k, part_params in enumerate(params.get("part_params", [])):
+        arrays = _rederive_safety(arrays, part_params, f"p{k}_")
+    return arrays
+
+
 RELIEF = Codec(kind="relief", cls=ReliefTexture, arrays=RELIEF_ARRAYS,
                to_arrays=lambda r: (_relief_arrays(r), dict(r.params)),
-               from_arrays=_relief_from)
+               from_arrays=_relief_from, rederive=_rederive_safety)
 RELIEF_OBJECT = Codec(
     kind="relief-object", cls=ReliefObject,
     arrays={"source_bounds": RELIEF_ARRAYS["source_bounds"]} | {
         f"p{k}_{name}": ArraySpec(spec.dtypes, spec.ndim, required=False, finite=spec.finite,
-                                  trailing=spec.trailing)
+                                  trailing=spec.trailing, role=spec.role)
         for k in range(MAX_PARTS) for name, spec in PART_ARRAYS.items()},
-    to_arrays=_object_arrays, from_arrays=_object_from)
+    to_arrays=_object_arrays, from_arrays=_object_from, rederive=_rederive_parts)
 CODECS = (RELIEF, RELIEF_OBJECT)

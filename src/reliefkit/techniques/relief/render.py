@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...errors import UsageError
 from ...gl.uniforms import box_uniforms
@@ -114,9 +115,12 @@ def relief_plan(relief: ReliefTexture, options: ReliefRenderOptions,
                          "draws the exact walk): bake it with --safety, or render with "
                          "--method maxmip (exact, needs no radii)")
     octants = method == "robust" and relief.safety.ndim == 3
-    textures = {"u_height": Texture(relief.height, filter="nearest", what="height"),
-                "u_color": Texture(relief.color, srgb=True, mipmaps=True, what="color"),
-                "u_normal": Texture(relief.normal, what="normal")}
+    textures = {"u_height": Texture(relief.height, filter="nearest", what="height",
+                                    encoded=encoding_of(relief.height)),
+                "u_color": Texture(relief.color, srgb=True, mipmaps=True, what="color",
+                                   encoded=encoding_of(relief.color)),
+                "u_normal": Texture(relief.normal, what="normal",
+                                    encoded=encoding_of(relief.normal))}
     if octants:
         textures["u_safety_octants"] = Texture(relief.safety.astype(np.float32),
                                                target="2d_array", filter="nearest",

@@ -22,6 +22,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ...bake.uv_atlas import atlas_uniforms
+from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...render.plan import (
@@ -266,7 +267,8 @@ def shell_textures(rep: TexturedShell, shell, origin) -> tuple[dict, dict]:
     textures["u_tets"] = Texture(texels, filter="nearest", what="shell tetrahedra")
     if rep.surface is not None:
         textures["u_surface"] = Texture(rep.surface.rgba8, target="2d_array", srgb=True,
-                                        what="shell surface materials")
+                                        what="shell surface materials",
+                                        encoded=encoding_of(rep.surface.rgba8))
     sizes = [(a.shape[2], a.shape[1], a.shape[0]) for a, _ in levels]
     sizes += [sizes[-1]] * (MAX_LEVELS - len(sizes))
     uniforms = {"u_levels": len(levels), "u_level_size": sizes,

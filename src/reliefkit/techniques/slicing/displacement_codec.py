@@ -28,8 +28,8 @@ from .displacement import MAX_TEXELS, MAX_TILE, DisplacementMap
 
 ARRAYS = BASE_MESH_ARRAYS | {
     "color": ArraySpec(("float32",), ndim=3, trailing=(4,), finite=True,
-                       max_size=4 * MAX_TEXELS),
-    "height": ArraySpec(("float32",), ndim=2, finite=True, max_size=MAX_TEXELS),
+                       max_size=4 * MAX_TEXELS, role="color"),
+    "height": ArraySpec(("float32",), ndim=2, finite=True, max_size=MAX_TEXELS, role="height"),
     "source_bounds": SOURCE_BOUNDS,
 } | SURFACE_ARRAYS
 OWN = ("scale", "tile", "wrap")

@@ -24,6 +24,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ...bake.uv_atlas import atlas_uniforms
+from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...render.plan import Attribute, DrawPlan, Geometry, Program, Texture, ViewHook, ViewUpdate
@@ -108,12 +109,15 @@ class DisplacementDrawable:
         origin = 0.5 * (lo + hi)
         test = opts.alpha_test if opts.slicing == "surface" else "fill"
         textures = {"u_height": Texture(rep.height, filter="nearest",
-                                        what="displacement height"),
+                                        what="displacement height",
+                                        encoded=encoding_of(rep.height)),
                     "u_color": Texture(rep.color, wrap=("repeat",) * 3 if rep.wrap
-                                       else ("clamp",) * 3, what="displacement colour")}
+                                       else ("clamp",) * 3, what="displacement colour",
+                                       encoded=encoding_of(rep.color))}
         if rep.surface is not None:
             textures["u_surface"] = Texture(rep.surface.rgba8, "2d_array", srgb=True,
-                                            what="displacement surface materials")
+                                            what="displacement surface materials",
+                                            encoded=encoding_of(rep.surface.rgba8))
         h, w = rep.height.shape
         layers = rep.surface_layers()
         volume = None if opts.slicing == "surface" else rep.volume()

@@ -23,6 +23,7 @@ uniform mat4 u_world_to_box;
 uniform mat4 u_box_to_world;
 uniform sampler2D u_color;    // sRGB base colour (decoded to linear by the sampler)
 uniform sampler2D u_normal;   // world-space normals
+uniform vec2 u_normal_decode; // (scale, bias) from the sampled value to the normal
 
 vec3 to_box(vec3 world) {
     vec4 b = u_world_to_box * vec4(world, 1.0);
@@ -75,8 +76,13 @@ const float WALL_COS = 0.2588, SLOPE_COS = 0.5;
 // (bright dots and stripes on walls). On a wall the heightfield's own normal is the surface's;
 // elsewhere the baked one keeps the mesh's smooth shading and detail, and where a real surface
 // is that steep the two agree.
+vec3 baked_normal(vec2 uv) {
+    return normalize(textureLod(u_normal, uv, 0.0).xyz * u_normal_decode.x
+                     + u_normal_decode.y);  // not mipmapped
+}
+
 vec3 heightfield_normal(vec3 hit, vec4 plane) {
-    vec3 baked = normalize(textureLod(u_normal, hit.xy, 0.0).xyz);  // not mipmapped
+    vec3 baked = baked_normal(hit.xy);
     vec3 geometric = normalize(plane.xyz);
     vec3 level = normalize(world_plane(hit, vec3(0.0, 0.0, 1.0)).xyz);  // along the h lines
     if (dot(geometric, baked) < 0.0) geometric = -geometric;  // the same side, up the h lines
@@ -135,7 +141,7 @@ void main() {
     vec4 plane = tangent_plane(hit_box, on_face);
     vec3 n;
     if (at_entry && entered_side) n = box_face_normal(hit_box);  // a side wall of the box
-    else if (on_face) n = normalize(textureLod(u_normal, hit_box.xy, 0.0).xyz);  // underside
+    else if (on_face) n = baked_normal(hit_box.xy);  // underside
     else n = heightfield_normal(hit_box, plane);
     vec2 uv_dx, uv_dy;
     hit_gradients(ndc, hit_box, plane, uv_dx, uv_dy);

@@ -1,0 +1,35 @@
+"""``bake --compress bc`` on any kind, and ``info`` showing each array's GPU format and bytes."""
+
+from __future__ import annotations
+
+from helpers import assert_one_line_error, run_cli
+
+from reliefkit.compact.encodings import encoding_of
+from reliefkit.io.rk import load
+
+
+def test_bake_compress_bc_writes_the_encoded_arrays_and_info_lists_them(tmp_path):
+    raw, compact = tmp_path / "raw.rk", tmp_path / "c.rk"
+    common = ["bake", "demo:terrain", "--as", "relief", "--depth-res", "32", "--color-res", "32"]
+    assert run_cli(*common, "-o", raw).returncode == 0
+    out = run_cli(*common, "--compress", "bc", "--color-format", "bc1", "--height-bits", "8",
+                  "-o", compact)
+    assert out.returncode == 0, out.stderr
+    assert "raw -> " in out.stdout and "compact" in out.stdout
+    rep = load(compact)
+    assert (encoding_of(rep.height).format, encoding_of(rep.color).format,
+            encoding_of(rep.normal).format) == ("u8", "bc1", "bc7")
+    assert compact.stat().st_size < raw.stat().st_size
+    info = run_cli("info", compact)
+    assert info.returncode == 0, info.stderr
+    lines = {line.split()[0]: line for line in info.stdout.splitlines() if "on the GPU" in line}
+    # 32 x 32 texels: BC1 8 bytes per 4x4 block (with its mip chain: 128+32+8+8+8+8 blocks
+    # -> 1,528 B), u8 one byte a texel, BC7 16 bytes per block
+    assert "float32 32x32  on the GPU u8 1.0 KiB (raw 4.0 KiB)" in lines["height"]
+    assert "uint8 32x32x4  on the GPU bc1" in lines["color"]
+    assert "float32 32x32x3  on the GPU bc7" in lines["normal"]
+
+
+def test_encoding_flags_without_compress_are_refused(tmp_path):
+    assert_one_line_error(run_cli("bake", "demo:terrain", "--as", "relief", "--height-bits",
+                                  "8", "-o", tmp_path / "x.rk"), "--compress bc")
