@@ -27,6 +27,11 @@ LEVEL0_VIEWS = ((0.0, 89.0), (90.0, 80.0))
 #: both. (Minified views differ more: the encoded mip levels are encoded again, the raw
 #: upload's are the GL's own; docs/compact.md.)
 COLOR_TOLERANCE = 2 / 255
+#: Kinds that threshold a filtered value, and the share of covered pixels whose colour may
+#: therefore jump: the impostor keeps a frame where its filtered coverage is >= 0.5, and
+#: llvmpipe filters BC7 in float but RGBA8 with 8-bit weights, so at outlines a frame drops
+#: in or out (measured: 26-52 of ~3,200 pixels on its sample sphere).
+THRESHOLD_FLIPS = {"octahedral-impostor": 0.02}
 
 
 def encoded_samples():
@@ -71,7 +76,8 @@ def test_the_encoded_textures_draw_their_decoded_values(gl, tech_kind):
         got, expected = render(compact, camera), render(raw, camera)
         np.testing.assert_array_equal(got.mask, expected.mask)
         np.testing.assert_allclose(got.depth, expected.depth, atol=1e-6)
-        assert np.abs(got.color - expected.color).max() <= COLOR_TOLERANCE
+        off = np.abs(got.color - expected.color).max(axis=-1) > COLOR_TOLERANCE
+        assert off.sum() <= THRESHOLD_FLIPS.get(tech_kind[1], 0.0) * got.mask.sum()
 
 
 @pytest.mark.parametrize("tech_kind", encoded_samples(), ids="-".join)

@@ -3,8 +3,10 @@
 Arrays: ``color`` uint8 (S, S, 4) sRGB with coverage alpha, ``normal`` uint8 (S, S, 3)
 object-space normals, ``depth`` uint8 (S, S) heights along each frame's direction, ``center``
 float64 (3,), ``source_bounds``; params ``grid``, ``hemi``, ``radius``, ``padding`` (the
-typed fields that change rendering) and the bake's parameters. Plain uint8 arrays, so a
-generic encoder can block-compress them (colour BC1/BC7, normal BC5/BC7, depth BC4).
+typed fields that change rendering) and the bake's parameters. ``bake --compress bc``
+stores colour and normals as BC7 (or BC1) (`reliefkit.compact`). Depths stay R8: BC4's
+interpolated levels decode differently per GL (the format allows it), and the parallax
+search turns that 1/255 into another texel at outlines (1.7% of a sphere's pixels moved).
 """
 
 from __future__ import annotations
@@ -14,13 +16,14 @@ from ...io.rk import SOURCE_BOUNDS, ArraySpec, Codec
 from .representation import MAX_ATLAS, OctahedralImpostor
 
 
-def _atlas(channels: int | None) -> ArraySpec:
+def _atlas(channels: int | None, role: str | None) -> ArraySpec:
     ndim, trailing = (2, None) if channels is None else (3, (None, None, channels))
     return ArraySpec(("uint8",), ndim=ndim, trailing=trailing,
-                     max_size=MAX_ATLAS * MAX_ATLAS * (channels or 1))
+                     max_size=MAX_ATLAS * MAX_ATLAS * (channels or 1), role=role)
 
 
-ARRAYS = {"color": _atlas(4), "normal": _atlas(3), "depth": _atlas(None),
+ARRAYS = {"color": _atlas(4, "color"), "normal": _atlas(3, "normal"),
+          "depth": _atlas(None, None),
           "center": ArraySpec(("float64",), ndim=1, trailing=(3,), finite=True),
           "source_bounds": SOURCE_BOUNDS}
 OWN = ("grid", "hemi", "radius", "padding")  # the codec's params, written last

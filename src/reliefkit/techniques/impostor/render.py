@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...render.mesh import SHADOW_MAP_SIZE
@@ -51,9 +52,11 @@ def impostor_plan(rep: OctahedralImpostor, options: ImpostorRenderOptions,
                                   "SHADOWS": options.shadows}),
         geometry=Geometry({"in_corner": Attribute(_CORNERS)}, indices=_TRIANGLES),
         textures={"u_color_atlas": Texture(rep.color, srgb=True, mipmaps=True,
-                                           what="impostor colour atlas"),
+                                           what="impostor colour atlas",
+                                           encoded=encoding_of(rep.color)),
                   "u_normal_atlas": Texture(rep.normal, mipmaps=True,
-                                            what="impostor normal atlas"),
+                                            what="impostor normal atlas",
+                                            encoded=encoding_of(rep.normal)),
                   "u_depth_atlas": Texture(rep.depth, what="impostor depth atlas")},
         uniforms={"u_radius": rep.radius, "u_grid": rep.grid, "u_hemi": rep.hemi,
                   "u_frame_radius": rep.frame_radius, "u_frame_texels": float(rep.frame),
