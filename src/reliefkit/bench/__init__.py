@@ -13,7 +13,7 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import loading, platform
+from . import loading, platform, scene
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -46,7 +46,10 @@ def suites() -> dict:
     core = {"loading": BenchSuite("loading", "memory of loading meshes, x the file's size",
                                   loading.run_suite, takes_mesh=True),
             "platform": BenchSuite("platform", "a turntable in one render call against one "
-                                   "call per view, per demo tile", platform.run_suite)}
+                                   "call per view, per demo tile", platform.run_suite),
+            "scene": BenchSuite("scene", "1,000 and 10,000 instances of one asset, each "
+                                "representation against the mesh decimated to equal error",
+                                scene.run_suite, takes_mesh=True)}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 

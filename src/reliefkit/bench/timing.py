@@ -19,6 +19,16 @@ def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
                  light=None) -> list[dict]:
     """`time_render` of ``obj`` with each option set of ``variants``, the draws interleaved
     (`gl.timing.gpu_times_ms`): use it for figures reported as ratios of each other."""
+    return time_scenes([(obj, options) for options in variants], camera, repeats=repeats,
+                       light=light)
+
+
+def time_scenes(entries, camera, *, repeats: int = 3, light=None,
+                counts: bool = False) -> list[dict]:
+    """`time_render` of each (object, options) of ``entries``, the draws interleaved. With
+    ``counts`` each also has what does not depend on the device, from one more draw:
+    ``draw_calls`` (the executor's), ``samples_passed`` (fragments that passed the depth
+    test, in the order drawn) and ``primitives`` (GL queries)."""
     import moderngl
 
     ctx = get_context()
@@ -26,7 +36,7 @@ def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
     light = light or DirectionalLight()
     fbo = None
     try:
-        for options in variants:
+        for obj, options in entries:
             scenes.append(Scene([obj], ctx=ctx, **options))
         fbo = render_target(ctx, *camera.size, FRAME_ATTACHMENTS)
 
@@ -38,7 +48,17 @@ def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
                 scene.draw_opaque(camera, light)
             return draw
 
-        return gpu_times_ms(ctx, [drawing(s) for s in scenes], repeats=repeats)
+        draws = [drawing(s) for s in scenes]
+        times = gpu_times_ms(ctx, draws, repeats=repeats)
+        if counts:
+            for row, scene, draw in zip(times, scenes, draws, strict=True):
+                before = scene.executor.draw_calls
+                query = ctx.query(samples=True, primitives=True)
+                with query:
+                    draw()
+                row.update(draw_calls=scene.executor.draw_calls - before,
+                           samples_passed=query.samples, primitives=query.primitives)
+        return times
     finally:
         bind_home_framebuffer(ctx)
         if fbo is not None:

@@ -120,12 +120,12 @@ def refuse_unless_instanceable(plan: DrawPlan) -> None:
         refuse(f"its multi-pass kind {plan.multipass.kind!r} draws each object by itself")
     if plan.geometry.instances is not None:
         refuse("its geometry is instanced already (one instance per primitive)")
-    if DEFINE not in allowed_defines(plan.program.name):
-        refuse(f"its program {plan.program.name} has no {DEFINE} variant")
     if plan.per_view is not None and not getattr(resolve(plan.per_view.function), _SAFE,
                                                  False):
         doc = (resolve(plan.per_view.function).__doc__ or "").strip().split("\n\n")[0]
         refuse("its view hook works per object (" + " ".join(doc.split()).rstrip(".") + ")")
+    if DEFINE not in allowed_defines(plan.program.name):
+        refuse(f"its program {plan.program.name} has no {DEFINE} variant")
 
 
 def instanced_view(plan: DrawPlan, camera, light, *, hook: str, data: dict) -> ViewUpdate:
