@@ -24,7 +24,8 @@ from reliefkit.scene.light import DirectionalLight
 
 #: The kinds drawn instanced, and the mesh (the ground truth and the decimated mesh).
 INSTANCEABLE = {("relief", "relief"), ("relief", "relief-object"),
-                ("billboard", "billboard-cloud")}
+                ("billboard", "billboard-cloud"), ("slicing", "depth-object"),
+                ("slicing", "visual-hull")}  # the depth objects ray cast by default
 SIZE = (128, 128)
 #: Three placements about the origin that overlap on screen (the depth test decides).
 PLACED = placements([[-1.3, 0.0, 0.2], [1.1, 0.3, -0.6], [0.1, -0.5, 1.0]],
@@ -184,3 +185,10 @@ def test_bad_placements_are_one_line_errors(gl, bad, words):
     with pytest.raises(Exception) as info:
         render(make_asset("tree"), camera, instances=bad)
     assert words in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_depth_object_drawn_by_slices_is_refused(gl):
+    camera = Camera.orbit((0.0, 0.0, 0.0), 30, 25, 7.0, size=(32, 32))
+    with pytest.raises(NotInstanceable, match="view hook works per object .*slice stack"):
+        render(sample("slicing", "depth-object"), camera, instances=PLACED,
+               slicing="orthogonal")
