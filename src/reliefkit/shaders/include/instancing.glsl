@@ -7,7 +7,9 @@
 // vertex stored relative to the plan's origin, and hands the instance to the fragment stage
 // through flat varyings. Fragment stage (ray casting kinds): `to_object` takes a point of
 // the pixel's ray into the object as it is, where the baked textures and box matrices hold,
-// `to_instance` and `rotate_to_instance` bring a hit and its normal back out.
+// `to_instance` and `rotate_to_instance` bring a hit and its normal back out. A camera-facing
+// quad (an impostor) places its centre with `placed`, sizes itself by `instance_scale()`
+// and looks its view direction up in the object's frame (`rotate_to_object`).
 #if defined INSTANCED
 #if defined VERTEX_SHADER
 in vec4 in_instance;       // translation from the object's origin to the instance's, scale
@@ -17,6 +19,13 @@ flat out vec2 v_instance_yaw;
 #else
 flat in vec4 v_instance;
 flat in vec2 v_instance_yaw;
+#endif
+
+// The instance's uniform scale (a camera-facing quad's size).
+#if defined VERTEX_SHADER
+float instance_scale() { return in_instance.w; }
+#else
+float instance_scale() { return v_instance.w; }
 #endif
 
 vec3 rotate_to_instance(vec3 v) {
@@ -51,6 +60,7 @@ vec3 placed(vec3 local, vec3 model_offset) {
 #endif
 
 #else
+float instance_scale() { return 1.0; }
 vec3 rotate_to_instance(vec3 v) { return v; }
 vec3 rotate_to_object(vec3 v) { return v; }
 vec3 to_instance(vec3 object_point) { return object_point; }
