@@ -9,6 +9,7 @@ frames are then composited by depth and their positions and normals placed by P.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -192,3 +193,21 @@ def test_a_depth_object_drawn_by_slices_is_refused(gl):
     with pytest.raises(NotInstanceable, match="view hook works per object .*slice stack"):
         render(sample("slicing", "depth-object"), camera, instances=PLACED,
                slicing="orthogonal")
+
+
+def test_instanced_plans_round_trip_through_json(gl):
+    from reliefkit.render.instancing import instanced
+    from reliefkit.render.plan import from_json, to_json
+    from reliefkit.render.registry import make_drawables
+
+    plans = instanced(make_drawables([sample("relief", "relief-object")], {})[0].plans, PLACED)
+    doc, arrays = to_json(plans)
+    again = from_json(json.loads(json.dumps(doc)), arrays)
+    assert [p.per_view.function for p in again] == [p.per_view.function for p in plans]
+    for got, want in zip(again, plans, strict=True):
+        assert got.geometry.instances == want.geometry.instances == len(PLACED)
+        assert dict(got.program.defines) == dict(want.program.defines)
+        for name in ("in_instance", "in_instance_yaw"):
+            np.testing.assert_array_equal(got.geometry.attributes[name].array,
+                                          want.geometry.attributes[name].array)
+            assert got.geometry.attributes[name].per_instance
