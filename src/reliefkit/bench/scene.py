@@ -120,17 +120,20 @@ def equal_error(name: str, rep, asset, views, truth) -> tuple[dict, object]:
     its row and that mesh."""
     target = mean_ssim(rep, views, truth)
     full = mesh_bytes(asset)
+
+    def scored(budget: float):
+        mesh = decimated(asset, int(budget))  # None: nothing left at that budget
+        return mesh, (-1.0 if mesh is None else mean_ssim(mesh, views, truth))
+
     lo, hi = FLOOR * full, float(full)
     best, best_ssim = asset, 1.0
-    floor_mesh = decimated(asset, int(lo))
-    floor_ssim = mean_ssim(floor_mesh, views, truth)
+    floor_mesh, floor_ssim = scored(lo)
     if floor_ssim >= target:
         best, best_ssim, hi = floor_mesh, floor_ssim, lo
     else:
         for _ in range(BISECT_STEPS):
             mid = math.sqrt(lo * hi)
-            candidate = decimated(asset, int(mid))
-            score = mean_ssim(candidate, views, truth)
+            candidate, score = scored(mid)
             if score >= target:
                 best, best_ssim, hi = candidate, score, mid
             else:
