@@ -72,6 +72,8 @@ def run_suite(quick: bool, out: Path, log, mesh: str | None = None) -> tuple[str
         log(f"{n} instances: {layout['camera'].size[0]}x{layout['camera'].size[1]}")
         fields.append(time_field(asset, reps, decimations, layout,
                                  QUICK_REPEATS if quick else REPEATS))
+        log(", ".join(f"{name} {t['wall_ms']:.0f} ms"
+                      for name, t in fields[-1]["times"].items()))
     data = {"asset": asset.name, "instance_px": px, "elevation": ELEVATION,
             "mesh_bytes": mesh_bytes(asset), "mesh_triangles": asset.triangle_count,
             "rows": rows, "refused": refused, "fields": fields, "target": TARGET,
