@@ -28,7 +28,8 @@ def time_scenes(entries, camera, *, repeats: int = 3, light=None,
     """`time_render` of each (object, options) of ``entries``, the draws interleaved. With
     ``counts`` each also has what does not depend on the device, from one more draw:
     ``draw_calls`` (the executor's), ``samples_passed`` (fragments that passed the depth
-    test, in the order drawn) and ``primitives`` (GL queries)."""
+    test, in the order drawn) and ``primitives`` (GL queries); that draw is the warm-up of
+    the timed ones."""
     import moderngl
 
     ctx = get_context()
@@ -49,16 +50,11 @@ def time_scenes(entries, camera, *, repeats: int = 3, light=None,
             return draw
 
         draws = [drawing(s) for s in scenes]
-        times = gpu_times_ms(ctx, draws, repeats=repeats)
-        if counts:
-            for row, scene, draw in zip(times, scenes, draws, strict=True):
-                before = scene.executor.draw_calls
-                query = ctx.query(samples=True, primitives=True)
-                with query:
-                    draw()
-                row.update(draw_calls=scene.executor.draw_calls - before,
-                           samples_passed=query.samples, primitives=query.primitives)
-        return times
+        counted = [_counts(ctx, scene, draw) for scene, draw in zip(scenes, draws,
+                                                                    strict=True)] \
+            if counts else [{} for _ in draws]
+        times = gpu_times_ms(ctx, draws, repeats=repeats, warmup=0 if counts else 1)
+        return [t | c for t, c in zip(times, counted, strict=True)]
     finally:
         bind_home_framebuffer(ctx)
         if fbo is not None:
@@ -67,3 +63,13 @@ def time_scenes(entries, camera, *, repeats: int = 3, light=None,
             fbo.release()
         for scene in scenes:
             scene.release()
+
+
+def _counts(ctx, scene, draw) -> dict:
+    """One draw of ``scene`` under GL queries: its draw calls, samples passed, primitives."""
+    before = scene.executor.draw_calls
+    query = ctx.query(samples=True, primitives=True)
+    with query:
+        draw()
+    return {"draw_calls": scene.executor.draw_calls - before, "samples_passed": query.samples,
+            "primitives": query.primitives}
