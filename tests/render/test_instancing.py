@@ -130,7 +130,7 @@ def test_instances_draw_the_placed_objects_composited_by_depth(gl, obj):
     smooth = same_surface & ~_edges(want["mask"], want["normal"])
     assert smooth.sum() >= 0.5 * both.sum()  # small instances: many edge pixels
     for aov in ("color", "normal"):
-        close = np.abs(got.__dict__[aov] - want[aov]).max(-1) <= 2e-3
+        close = np.abs(getattr(got, aov) - want[aov]).max(-1) <= 2e-3
         assert (smooth & ~close).sum() <= 0.02 * smooth.sum(), aov
 
 
