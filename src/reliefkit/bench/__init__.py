@@ -14,7 +14,7 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import compact, loading, platform
+from . import compact, loading, platform, scene
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -49,7 +49,10 @@ def suites() -> dict:
             "platform": BenchSuite("platform", "a turntable in one render call against one "
                                    "call per view, per demo tile", platform.run_suite),
             "compact": BenchSuite("compact", "bytes and image error of compressed textures, "
-                                  "per demo asset and kind", compact.run_suite)}
+                                  "per demo asset and kind", compact.run_suite),
+            "scene": BenchSuite("scene", "1,000 and 10,000 instances of one asset, each "
+                                "representation against the mesh decimated to equal error",
+                                scene.run_suite, takes_mesh=True)}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 

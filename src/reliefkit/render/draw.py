@@ -21,14 +21,18 @@ from ..gl.targets import check_msaa, draw_passes
 from ..scene.light import DirectionalLight
 from .executor import Executor
 from .frame import frame_from_passes
+from .instancing import InstancedDrawable
 from .registry import make_drawables
 
 
 class Scene:
     """``objects`` as drawables with ``options`` routed by name, uploaded once into ``ctx``;
-    `frame(camera)` draws them. Use it as a context manager (or call `release`)."""
+    `frame(camera)` draws them. With ``instances`` ((N, 5) placements, `render.instancing`)
+    each object is drawn at every placement, one draw call per plan. Use it as a context
+    manager (or call `release`)."""
 
-    def __init__(self, objects, *, ctx=None, count_iterations: bool = False, **options):
+    def __init__(self, objects, *, ctx=None, count_iterations: bool = False, instances=None,
+                 **options):
         self.objects = list(objects) if isinstance(objects, list | tuple) else [objects]
         if not self.objects:
             raise UsageError("nothing to render")
@@ -36,6 +40,8 @@ class Scene:
         self.count_iterations = count_iterations
         self.executor = Executor(self.ctx)
         self.drawables = make_drawables(self.objects, options, instrument=count_iterations)
+        if instances is not None:
+            self.drawables = [InstancedDrawable(d, instances) for d in self.drawables]
         try:
             for drawable in self.drawables:
                 self.executor.upload(drawable.plans)
@@ -105,7 +111,7 @@ class Scene:
 
 
 def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
-           msaa: int = 1, **options):
+           msaa: int = 1, instances=None, **options):
     """Render a representation, a RenderMesh (ground truth), or a list of them, into a Frame;
     with a list (or any iterable) of cameras, into a list of Frames, uploading once
     (bit-identical to one `render` per camera).
@@ -114,7 +120,9 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
     fragments and loop iterations per pixel (``frame.extra["iterations"]``). ``msaa`` (1, 2,
     4 or 8 samples) draws the opaque objects once more, multisampled, for the colour only:
     edge pixels get the covered fraction as alpha, every AOV stays single-sample, and
-    transparent objects are composited single-sample over it.
+    transparent objects are composited single-sample over it. ``instances`` ((N, 5)
+    placements) draws each object at every placement in one draw call per plan
+    (`render.instancing`; `NotInstanceable` says why an object cannot be).
     """
     several = not hasattr(camera, "size")  # a list, tuple or any iterable of cameras
     try:
@@ -126,7 +134,8 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
         raise UsageError("render needs a camera or a non-empty list of cameras")
     ctx = ctx or get_context()
     check_msaa(ctx, msaa)
-    with Scene(obj, ctx=ctx, count_iterations=count_iterations, **options) as scene:
+    with Scene(obj, ctx=ctx, count_iterations=count_iterations, instances=instances,
+               **options) as scene:
         frames = [scene.frame(cam, light, msaa=msaa) for cam in cameras]
     return frames if several else frames[0]
 

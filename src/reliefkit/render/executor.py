@@ -81,6 +81,7 @@ class Executor:
         self.groups: dict[int, list] = {}        # id(geometry) -> its multi-pass plans
         self.cache: dict = {}                    # a multi-pass kind's per-light products
         self._full_screen: dict = {}             # vertex arrays of `draw_full_screen`
+        self.draw_calls = 0                      # of draw_viewed and draw_full_screen
 
     # -- upload ---------------------------------------------------------------------------
     def upload(self, plans) -> None:
@@ -243,6 +244,7 @@ class Executor:
         self.set_raster(raster or viewed.raster)
         try:
             vao.render(_MODES[viewed.geometry.primitive], **_counts(viewed))
+            self.draw_calls += 1
         finally:
             self.reset_raster()
 
@@ -257,6 +259,7 @@ class Executor:
         self.set_raster(raster)
         try:
             self._full_screen[key].render(moderngl.TRIANGLES, vertices=3)
+            self.draw_calls += 1
         finally:
             self.reset_raster()
 

@@ -24,6 +24,9 @@ MESH_PROGRAMS = tuple(  # the draw-path variants (compiled as GLSL ES by the tes
     ProgramVariant(PROGRAM, {"HAS_TEXTURE": textured, "COUNT_ITERATIONS": counted,
                              "SHADOWS": shadows})
     for textured in (False, True) for counted in (False, True) for shadows in (False, True)
+) + tuple(ProgramVariant(PROGRAM, {"HAS_TEXTURE": textured, "COUNT_ITERATIONS": counted,
+                                   "INSTANCED": True})
+          for textured in (False, True) for counted in (False, True)
 ) + tuple(ProgramVariant(PROGRAM, {"HAS_TEXTURE": textured, "SHADOW_MAP": True})
           for textured in (False, True))
 SHADOW_MAP_SIZE = 2048  # texels on a side over the mesh's bounding sphere

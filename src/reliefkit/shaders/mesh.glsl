@@ -3,11 +3,13 @@
 // as 1; 1 MASK, fragments with alpha < u_alpha_cutoff discarded, the rest drawn as 1; 2 BLEND,
 // alpha kept), and with HAS_TEXTURE its texture and UV transform. SHADOWS: lit only where the
 // shadow map (render/shadows.py) sees the light; SHADOW_MAP: the depth pass from the light
-// that draws it (the alpha test only, no outputs).
-//! defines: HAS_TEXTURE SHADOWS SHADOW_MAP
+// that draws it (the alpha test only, no outputs). INSTANCED: at every placement of
+// render/instancing.py (include/instancing.glsl).
+//! defines: HAS_TEXTURE SHADOWS SHADOW_MAP INSTANCED
 
 #if defined VERTEX_SHADER
 #include "include/camera.glsl"
+#include "include/instancing.glsl"
 uniform vec3 u_model_offset;  // from the mesh's origin to the camera's (gl/uniforms.py)
 in vec3 in_position;
 in vec3 in_normal;
@@ -23,9 +25,9 @@ out vec2 v_uv;
 #endif
 
 void main() {
-    v_world = in_position + u_model_offset;
+    v_world = placed(in_position, u_model_offset);
     v_local = in_position;
-    v_normal = in_normal;
+    v_normal = rotate_to_instance(in_normal);
     v_color = in_color;
 #if defined HAS_TEXTURE
     v_uv = (u_uv_transform * vec3(in_uv, 1.0)).xy;

@@ -21,8 +21,9 @@ from ...render.plan import Attribute, DrawPlan, Geometry, Program, Texture
 from .representation import BillboardCloud
 
 PROGRAM = "billboard:billboard.glsl"
-PROGRAMS = tuple(ProgramVariant(PROGRAM, {"COUNT_ITERATIONS": counted})
-                 for counted in (False, True))  # the draw-path variants (GLSL ES test)
+PROGRAMS = tuple(ProgramVariant(PROGRAM, {"COUNT_ITERATIONS": counted, "INSTANCED": placed})
+                 for counted in (False, True)
+                 for placed in (False, True))  # the draw-path variants (GLSL ES test)
 
 #: (s, t) of a quad's four corners, counter-clockwise seen from the side u x v faces, so
 #: gl_FrontFacing is true there; and its two triangles.

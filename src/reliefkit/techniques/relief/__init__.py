@@ -89,7 +89,7 @@ def _samples() -> dict:
 def _programs() -> tuple[ProgramVariant, ...]:
     flags = {"WRITE_DEPTH": True, "SHADOWS": True, "COUNT_ITERATIONS": True}
     return tuple(ProgramVariant(PROGRAM, {f"METHOD_{m.upper()}": True} | extra)
-                 for m in METHODS for extra in ({}, flags)) + (
+                 for m in METHODS for extra in ({}, flags, flags | {"INSTANCED": True})) + (
         ProgramVariant(PROGRAM, {"METHOD_ROBUST": True, "SAFETY_OCTANTS": True} | flags),)
 
 

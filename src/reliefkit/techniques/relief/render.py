@@ -17,6 +17,7 @@ from ...core.params import param
 from ...errors import UsageError
 from ...gl.uniforms import box_uniforms
 from ...render.frame import window_depth
+from ...render.instancing import instance_safe
 from ...render.plan import (
     Attribute,
     DrawPlan,
@@ -166,6 +167,7 @@ def relief_plan(relief: ReliefTexture, options: ReliefRenderOptions,
                            "planes": proxy.planes}))
 
 
+@instance_safe
 def proxy_view(plan: DrawPlan, camera, light, *, box_to_world: np.ndarray,
                planes: np.ndarray) -> ViewUpdate:
     """A proxy's view hook: the faces to cull from ``camera`` (`render.proxy.cull_face`)

@@ -42,6 +42,7 @@ from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...errors import UsageError
 from ...gl.uniforms import box_uniforms
+from ...render.instancing import instance_safe
 from ...render.plan import (
     Attribute,
     DrawPlan,
@@ -70,7 +71,9 @@ VISIBLE_TEXELS = 1.5       # a point this many texels (plus one slice) behind im
                            # surface still counts as seen by image k
 PROGRAMS = tuple(ProgramVariant(PROGRAM, d) for d in (
     {}, {"HULL": True}, {"TEXTURING_NEAREST": True}, {"UNLIT": True}, {"TEST_ONE": True},
-    {"COLOR_ONLY": True}, {"SLAB": True}, {"RAYCAST": True}, {"RAYCAST": True, "HULL": True})) + (
+    {"COLOR_ONLY": True}, {"SLAB": True}, {"RAYCAST": True}, {"RAYCAST": True, "HULL": True},
+    {"RAYCAST": True, "INSTANCED": True},
+    {"RAYCAST": True, "HULL": True, "INSTANCED": True, "COUNT_ITERATIONS": True})) + (
     ProgramVariant(COPY_PROGRAM, {}),)
 
 
@@ -258,6 +261,7 @@ def slice_stack(cube_to_world, resolution: int, slicing: str, slices: int | None
     return make(cube_to_world, camera, count)
 
 
+@instance_safe
 def ray_cast_view(plan, camera, light, *, cube_to_world, planes, texturing) -> ViewUpdate:
     """View hook of ray casting: the box's uniforms and the proxy's faces to cull."""
     geometry = plan.geometry

@@ -4,11 +4,12 @@
 // 0.5 on the base level, so minification never erodes thin parts (a mip level averages them
 // with the empty texels around them); colour and normal are sampled with mipmaps.
 // Two-sided as the ground truth (shaders/mesh.glsl): a rectangle seen from its back shades
-// with its stored normal negated.
-//! defines:
+// with its stored normal negated. INSTANCED: at every placement of render/instancing.py.
+//! defines: INSTANCED
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
+#include "core:include/instancing.glsl"
 uniform vec3 u_model_offset;  // from the cloud's origin to the camera's (gl/uniforms.py)
 in vec3 in_position;          // quad corner relative to the cloud's origin
 in vec3 in_atlas;             // (u, v) in the page, page index
@@ -19,7 +20,7 @@ flat out float v_page;
 flat out vec3 v_plane_normal;
 
 void main() {
-    v_world = in_position + u_model_offset;
+    v_world = placed(in_position, u_model_offset);
     v_uv = in_atlas.xy;
     v_page = in_atlas.z;
     v_plane_normal = in_plane_normal;
@@ -35,6 +36,7 @@ precision highp sampler2DArray;
 #include "core:include/shading.glsl"
 #include "core:include/frame_outputs.glsl"
 #include "core:include/iterations.glsl"
+#include "core:include/instancing.glsl"
 uniform sampler2DArray u_color_atlas;   // linear colour, alpha = coverage
 uniform sampler2DArray u_normal_atlas;  // world normal as (n + 1) / 2
 in vec3 v_world;
@@ -56,7 +58,7 @@ void main() {
     vec3 base = texture(u_color_atlas, at).rgb;
     vec3 encoded = texture(u_normal_atlas, at).rgb;
     if (textureLod(u_color_atlas, at, 0.0).a < 0.5) discard;
-    vec3 n = stored_normal(encoded);
+    vec3 n = rotate_to_instance(stored_normal(encoded));  // the atlas holds the object's
     if (!gl_FrontFacing) n = -n;  // two-sided, the rule of shaders/mesh.glsl
     write_frame(vec4(shade_phong(base, n, towards_eye(v_world), 1.0), 1.0), v_world, n);
     write_iterations(0, 0, true);

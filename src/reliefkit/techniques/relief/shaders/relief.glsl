@@ -1,14 +1,18 @@
 // Relief texture (Baboud & Decoret 2006): rasterize the box (or reverse frustum) and
 // intersect each pixel's ray with the heightfield in normalized box coordinates.
-//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST METHOD_MAXMIP METHOD_CONE SAFETY_OCTANTS WRITE_DEPTH SHADOWS
+// INSTANCED: at every placement of render/instancing.py; the ray is followed in the object as
+// it is (core:include/instancing.glsl), the hit, its normal and the lighting are the
+// instance's.
+//! defines: METHOD_BINARY METHOD_EXACT METHOD_ROBUST METHOD_MAXMIP METHOD_CONE SAFETY_OCTANTS WRITE_DEPTH SHADOWS INSTANCED
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
+#include "core:include/instancing.glsl"
 in vec3 in_position;   // proxy vertex relative to its origin (render.py relief_proxy)
 uniform vec3 u_model_offset;  // from the proxy's origin to the camera's (gl/uniforms.py)
 
 void main() {
-    gl_Position = u_proj * u_view * vec4(in_position + u_model_offset, 1.0);
+    gl_Position = u_proj * u_view * vec4(placed(in_position, u_model_offset), 1.0);
 }
 #endif
 
@@ -19,6 +23,7 @@ void main() {
 #include "core:include/shading.glsl"
 #include "core:include/frame_outputs.glsl"
 #include "core:include/iterations.glsl"
+#include "core:include/instancing.glsl"
 uniform mat4 u_world_to_box;
 uniform mat4 u_box_to_world;
 uniform sampler2D u_color;    // sRGB base colour (decoded to linear by the sampler)
@@ -33,6 +38,12 @@ vec3 to_box(vec3 world) {
 vec3 to_world(vec3 box) {
     vec4 w = u_box_to_world * vec4(box, 1.0);
     return w.xyz / w.w;
+}
+
+// The point of the ray through NDC (x, y) at NDC z, in the object as it is: the world of
+// the box matrices and the baked normals (an instance's is placed, include/instancing.glsl).
+vec3 object_ray_point(vec2 ndc_xy, float ndc_z) {
+    return to_object(unproject(ndc_xy, ndc_z));
 }
 
 // The axis (0, 1, 2) of the box face nearest to box point p.
@@ -102,7 +113,7 @@ void hit_gradients(vec2 ndc, vec3 hit, vec4 plane, out vec2 dx, out vec2 dy) {
     vec2 uv[2];
     for (int i = 0; i < 2; ++i) {
         vec2 next = ndc + (i == 0 ? vec2(pixel.x, 0.0) : vec2(0.0, pixel.y));
-        vec3 o = unproject(next, -1.0), e = unproject(next, 1.0);
+        vec3 o = object_ray_point(next, -1.0), e = object_ray_point(next, 1.0);
         float fo = dot(plane, vec4(o, 1.0)), fe = dot(plane, vec4(e, 1.0));
         float t = fo != fe ? clamp(fo / (fo - fe), -1e6, 1e6) : 1e6;  // parallel: far away
         uv[i] = clamp(to_box(mix(o, e, t)).xy - hit.xy, -1.0, 1.0);
@@ -117,7 +128,8 @@ void main() {
     // (or at the near plane), s = 1 where it leaves; a projective box_to_world maps lines to
     // lines, so it stays a line there, and no proxy depth is involved
     vec3 a, b;
-    if (!box_segment(u_world_to_box, unproject(ndc, -1.0), unproject(ndc, 1.0), a, b)) discard;
+    if (!box_segment(u_world_to_box, object_ray_point(ndc, -1.0), object_ray_point(ndc, 1.0),
+                     a, b)) discard;
     vec3 d = b - a;
     if (dot(d, d) == 0.0) discard;
     float s0 = 0.0, s1 = 1.0;
@@ -146,7 +158,7 @@ void main() {
     vec2 uv_dx, uv_dy;
     hit_gradients(ndc, hit_box, plane, uv_dx, uv_dy);
     vec4 base = textureGrad(u_color, hit_box.xy, uv_dx, uv_dy);
-    vec3 to_eye = towards_eye(hit);
+    vec3 to_eye = rotate_to_object(towards_eye(to_instance(hit)));
     if (dot(n, to_eye) < 0.0) n = -n;  // seen from behind (side walls): shade the visible side
 
     float lit = 1.0;
@@ -154,7 +166,8 @@ void main() {
 #if defined SHADOWS
     // Cast from where the light enters the box towards the hit: that ray is unblocked until
     // its first hit, as the safety radii assume; the point is lit if that first hit is it.
-    vec3 towards_light = to_box(hit + u_light_dir * 1e-3 * length(u_box_to_world[0].xyz)) - hit_box;
+    vec3 light_dir = rotate_to_object(u_light_dir);
+    vec3 towards_light = to_box(hit + light_dir * 1e-3 * length(u_box_to_world[0].xyz)) - hit_box;
     vec3 ld = -towards_light;
     vec2 lspan = unit_cube_interval(hit_box, ld);   // s = 0 at the hit; entry at lspan.x < 0
     vec3 l_origin = hit_box + lspan.x * ld;
@@ -162,17 +175,19 @@ void main() {
     float texel_len = length(ld * vec3(scale.xy, float(max(u_hf_size.x, u_hf_size.y))));
     float l_end = -lspan.x - 1.5 / max(texel_len, 1e-20);
     float l_hit;
-    if (dot(n, u_light_dir) <= 0.0) {
+    if (dot(n, light_dir) <= 0.0) {
         lit = 0.0;  // facing away from the light
     } else if (l_end > 0.0 &&
                relief_intersect(l_origin * scale, ld * scale, 0.0, l_end, l_hit, shadow_iters)) {
         lit = 0.0;
     }
 #endif
-    write_frame(vec4(shade_phong(base.rgb, n, to_eye, lit), 1.0), hit, n);  // a hit is opaque
+    vec3 placed_hit = to_instance(hit), placed_n = rotate_to_instance(n);
+    write_frame(vec4(shade_phong(base.rgb, placed_n, rotate_to_instance(to_eye), lit), 1.0),
+                placed_hit, placed_n);  // a hit is opaque
     write_iterations(iters, shadow_iters, true);
 #if defined WRITE_DEPTH
-    gl_FragDepth = window_depth(hit);
+    gl_FragDepth = window_depth(placed_hit);
 #elif defined COUNT_ITERATIONS
     gl_FragDepth = gl_FragCoord.z;  // the counted-miss path writes depth, so every path does
 #endif

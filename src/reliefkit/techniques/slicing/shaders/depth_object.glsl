@@ -15,10 +15,13 @@
 //   HULL        a visual hull: three silhouettes (one per axis) are tested
 //   TEXTURING_NEAREST  the single closest image instead of the three-image blend
 //   UNLIT       the blended colour without lighting
-//! defines: TEST_ONE COLOR_ONLY RAYCAST SLAB HULL TEXTURING_NEAREST UNLIT
+//   INSTANCED   with RAYCAST: at every placement of render/instancing.py, the ray walked in
+//               the object as it is (core:include/instancing.glsl)
+//! defines: TEST_ONE COLOR_ONLY RAYCAST SLAB HULL TEXTURING_NEAREST UNLIT INSTANCED
 
 #if defined VERTEX_SHADER
 #include "core:include/camera.glsl"
+#include "core:include/instancing.glsl"
 uniform vec3 u_model_offset;
 in vec3 in_position;   // world, relative to the cube's centre
 in vec3 in_cube;       // cube coordinates of the vertex
@@ -26,7 +29,7 @@ out vec3 v_world;
 out vec3 v_cube;
 
 void main() {
-    v_world = in_position + u_model_offset;
+    v_world = placed(in_position, u_model_offset);
     v_cube = in_cube;
     gl_Position = u_proj * u_view * vec4(v_world, 1.0);
 }
@@ -40,6 +43,7 @@ void main() {
 #include "core:include/raybox.glsl"
 #include "include/cube_images.glsl"
 #include "include/texturing.glsl"
+#include "core:include/instancing.glsl"
 uniform int u_face;                 // TEST_ONE: the image tested in this pass
 uniform mat4 u_world_to_box;        // camera-relative world -> cube coordinates
 uniform mat4 u_box_to_world;        // cube coordinates -> camera-relative world
@@ -141,7 +145,7 @@ bool slab_segment(vec3 world, out vec3 q0, out vec3 dq) {
 #if defined RAYCAST
 bool pixel_segment(out vec3 q0, out vec3 dq) {
     vec2 ndc = fragment_ndc();
-    vec3 a = unproject(ndc, -1.0), b = unproject(ndc, 1.0);
+    vec3 a = to_object(unproject(ndc, -1.0)), b = to_object(unproject(ndc, 1.0));
     vec3 qa = (u_world_to_box * vec4(a, 1.0)).xyz, qb = (u_world_to_box * vec4(b, 1.0)).xyz;
     vec2 span = unit_cube_interval(qa, qb - qa);
     span.x = max(span.x, 0.0);
@@ -159,8 +163,8 @@ void main() {
 #if defined RAYCAST
     vec3 q0, dq;
     if (!pixel_segment(q0, dq) || !raycast(q0, dq, q, steps)) discard;
-    world = (u_box_to_world * vec4(q, 1.0)).xyz;
-    gl_FragDepth = window_depth(world);
+    world = (u_box_to_world * vec4(q, 1.0)).xyz;  // in the object as it is
+    gl_FragDepth = window_depth(to_instance(world));
     q += normalize(dq) * (INSIDE_TEXELS / float(u_res));
 #elif defined SLAB
     vec3 q0, dq;
@@ -176,14 +180,15 @@ void main() {
 #if defined TEST_ONE
     write_frame(vec4(0.0), world, vec3(0.0));
 #else
-    vec3 towards = towards_eye(world);
+    vec3 towards = rotate_to_object(towards_eye(to_instance(world)));
     vec4 color;
     vec3 n;
     textured(q, towards, color, n);
+    n = rotate_to_instance(n);
 #if !defined UNLIT
-    color.rgb = shade_phong(color.rgb, n, towards, 1.0);
+    color.rgb = shade_phong(color.rgb, n, rotate_to_instance(towards), 1.0);
 #endif
-    write_frame(color, world, n);
+    write_frame(color, to_instance(world), n);
 #endif
     write_iterations(steps, 0, true);
 }
