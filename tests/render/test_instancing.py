@@ -26,7 +26,8 @@ from reliefkit.scene.light import DirectionalLight
 #: The kinds drawn instanced, and the mesh (the ground truth and the decimated mesh).
 INSTANCEABLE = {("relief", "relief"), ("relief", "relief-object"),
                 ("billboard", "billboard-cloud"), ("slicing", "depth-object"),
-                ("slicing", "visual-hull")}  # the depth objects ray cast by default
+                ("slicing", "visual-hull"),  # the depth objects ray cast by default
+                ("impostor", "octahedral-impostor")}
 SIZE = (128, 128)
 #: Three placements about the origin that overlap on screen (the depth test decides).
 PLACED = placements([[-1.3, 0.0, 0.2], [1.1, 0.3, -0.6], [0.1, -0.5, 1.0]],

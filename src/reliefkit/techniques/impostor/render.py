@@ -19,7 +19,8 @@ from .representation import OctahedralImpostor
 PROGRAM = "impostor:impostor.glsl"
 PROGRAMS = tuple(ProgramVariant(PROGRAM, {"COUNT_ITERATIONS": counted, "SHADOWS": shadows})
                  for counted in (False, True) for shadows in (False, True)) \
-    + (ProgramVariant(PROGRAM, {"SHADOW_MAP": True}),)  # the draw-path variants
+    + (ProgramVariant(PROGRAM, {"SHADOW_MAP": True}),
+       ProgramVariant(PROGRAM, {"INSTANCED": True}))  # the draw-path variants
 
 _CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], np.float32)
 _TRIANGLES = np.array([0, 1, 2, 0, 2, 3], np.uint32)

@@ -9,15 +9,19 @@
 // blended object-space normals light it.
 // SHADOWS: lit only where the light's shadow map (drawn with SHADOW_MAP: coverage and depth
 // only, the quad facing the light) sees it.
-//! defines: SHADOWS SHADOW_MAP
+// INSTANCED (render/instancing.py): each instance's quad faces the camera from its own centre;
+// the frames are chosen and looked up in the object as it is (the view direction and the
+// pixel's ray turned back by the instance's yaw and scale), the hit and its normal brought out.
+//! defines: SHADOWS SHADOW_MAP INSTANCED
 
 #include "core:include/camera.glsl"
+#include "core:include/instancing.glsl"
 uniform vec3 u_model_offset;  // the bounding sphere's centre, relative to the camera's origin
 uniform float u_radius;       // the bounding sphere's radius
 
-// From the sphere's centre towards the viewer: the direction the frames are chosen by.
-vec3 towards_viewer() {
-    return u_orthographic ? u_view_dir : normalize(u_eye - u_model_offset);
+// From a sphere's centre (camera-relative) towards the viewer.
+vec3 towards_viewer_from(vec3 center) {
+    return u_orthographic ? u_view_dir : normalize(u_eye - center);
 }
 
 // The reference up of a view along -d: +y, -z at the poles (octahedral.frame_basis).
@@ -28,20 +32,23 @@ vec3 reference_up(vec3 d) {
 #if defined VERTEX_SHADER
 in vec2 in_corner;  // (+-1, +-1)
 out vec3 v_world;
+flat out vec3 v_center;  // this instance's centre, camera-relative
 
 void main() {
-    vec3 d = towards_viewer();
+    v_center = placed(vec3(0.0), u_model_offset);
+    float radius = instance_scale() * u_radius;
+    vec3 d = towards_viewer_from(v_center);
     vec3 right = normalize(cross(reference_up(d), d));
     vec3 up = cross(d, right);
     // The quad through the centre that holds the sphere's outline: its radius seen from
     // the eye (orthographic), or where the sphere's tangent cone meets the quad's plane.
-    float half_side = u_radius;
+    float half_side = radius;
     if (!u_orthographic) {
-        float dist = length(u_eye - u_model_offset);
-        half_side = u_radius * dist / sqrt(max(dist * dist - u_radius * u_radius,
-                                                1e-4 * dist * dist));
+        float dist = length(u_eye - v_center);
+        half_side = radius * dist / sqrt(max(dist * dist - radius * radius,
+                                              1e-4 * dist * dist));
     }
-    v_world = u_model_offset + (in_corner.x * right + in_corner.y * up) * half_side;
+    v_world = v_center + (in_corner.x * right + in_corner.y * up) * half_side;
     gl_Position = u_proj * u_view * vec4(v_world, 1.0);
 }
 #endif
@@ -64,6 +71,7 @@ uniform float u_frame_radius;      // half the side of the square a frame covers
 uniform float u_frame_texels;      // texels on a frame's side
 uniform int u_parallax_steps;
 in vec3 v_world;
+flat in vec3 v_center;
 
 vec2 sign_not_zero(vec2 v) {
     return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
@@ -159,12 +167,15 @@ void look_up(ivec2 cell, vec3 origin, vec3 dir, out float coverage, out vec3 col
 }
 
 void main() {
-    vec3 d = towards_viewer();
+    // In the object as it is (the identity without INSTANCED): the view direction, the
+    // pixel's ray from the quad, relative to the sphere's centre.
+    vec3 d = rotate_to_object(towards_viewer_from(v_center));
     ivec2 f0, f1, f2;
     vec3 w;
     blend_frames(d, f0, f1, f2, w);
-    vec3 origin = v_world - u_model_offset;
-    vec3 dir = u_orthographic ? -u_view_dir : normalize(v_world - u_eye);
+    vec3 quad_point = to_object(v_world);
+    vec3 origin = quad_point - u_model_offset;
+    vec3 dir = rotate_to_object(u_orthographic ? -u_view_dir : normalize(v_world - u_eye));
     vec3 a, c0, c1, c2, n0, n1, n2, t;
     int samples = 0;
     look_up(f0, origin, dir, a.x, c0, n0, t.x, samples);
@@ -186,12 +197,12 @@ void main() {
     // see different surfaces, would float a surface between them).
     float heaviest = wa.x >= max(wa.y, wa.z) ? t.x : (wa.y >= wa.z ? t.y : t.z);
     vec3 agree = wa * step(abs(t - heaviest), vec3(4.0 * 2.0 * u_frame_radius / u_frame_texels));
-    vec3 world = v_world + dot(agree, t) / (agree.x + agree.y + agree.z) * dir;
+    vec3 world = to_instance(quad_point + dot(agree, t) / (agree.x + agree.y + agree.z) * dir);
     gl_FragDepth = window_depth(world);
 #if !defined SHADOW_MAP
     vec3 base = wa.x * c0 + wa.y * c1 + wa.z * c2;
     vec3 n = wa.x * n0 + wa.y * n1 + wa.z * n2;
-    n = length(n) > 1e-3 ? normalize(n) : d;  // opposite normals averaged to nothing
+    n = rotate_to_instance(length(n) > 1e-3 ? normalize(n) : d);  // 0: opposite normals averaged
     float lit = 1.0;
 #if defined SHADOWS
     lit = light_visibility(world - u_model_offset, dot(n, u_light_dir) >= 0.0 ? n : -n);
