@@ -36,10 +36,10 @@ from ...bench.report import save_figure, write_report
 from ...bench.timing import time_render
 from ...gl.context import gl_info
 from ...io.meshes import load_mesh
-from ...io.rk import array_bytes
 from ...metrics import compare
 from ...render import render
 from ...scene.assets import make_asset
+from ...scene.decimate import decimated, mesh_bytes
 from ...scene.mesh import RenderMesh, vertex_normals
 from ...scene.views import bounds_radius, orbit_bounds
 from ...units import format_bytes
@@ -122,42 +122,9 @@ def subdivided(mesh, times: int):
                       name=f"{mesh.name} subdivided {times}x")
 
 
-def mesh_bytes(mesh) -> int:
-    return sum(array_bytes(mesh).values())
-
-
 def boxes_bytes(rep) -> int:
     """A DMBBC's own maps (colour, normal, displacement, distance), without its flat cloud."""
     return sum(v for k, v in rep.memory_bytes().items() if k != "billboard_cloud")
-
-
-def decimated(mesh, target_bytes: int):
-    """``mesh`` simplified by fast_simplification to about ``target_bytes`` (None when the
-    package is missing; the mesh itself when it is already that small). Colours, UVs and
-    materials come from the nearest original vertex / face."""
-    full = mesh_bytes(mesh)
-    if target_bytes >= full:
-        return mesh
-    try:
-        import fast_simplification
-    except ImportError:
-        return None
-    from scipy.spatial import cKDTree
-
-    points = mesh.world_positions
-    reduction = min(1.0 - target_bytes / full, 0.999)
-    new_points, faces = fast_simplification.simplify(points, mesh.indices.astype(np.int64),
-                                                     target_reduction=reduction)
-    if len(faces) == 0:
-        return None
-    near = cKDTree(points).query(new_points)[1]
-    centroids = points[mesh.indices].mean(axis=1)
-    face_near = cKDTree(centroids).query(new_points[faces].mean(axis=1))[1]
-    faces = faces.astype(np.uint32)
-    return RenderMesh(new_points, faces, vertex_normals(new_points.astype(np.float32), faces),
-                      mesh.colors[near], None if mesh.uvs is None else mesh.uvs[near],
-                      name=f"{mesh.name} decimated", materials=mesh.materials,
-                      material=mesh.material[face_near])
 
 
 # -- per asset: bake, tables 1 and 2 ----------------------------------------------------
