@@ -19,6 +19,15 @@ def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
                  light=None) -> list[dict]:
     """`time_render` of ``obj`` with each option set of ``variants``, the draws interleaved
     (`gl.timing.gpu_times_ms`): use it for figures reported as ratios of each other."""
+    return time_side_by_side([(obj, options) for options in variants], camera,
+                             repeats=repeats, light=light)
+
+
+def time_side_by_side(drawn: list[tuple[object, dict]], camera, *, repeats: int = 3,
+                      light=None) -> list[dict]:
+    """`time_render` of each (object, render options) of ``drawn``, the draws interleaved:
+    several objects (a representation and its mesh) timed as ratios of each other. Only the
+    opaque pass is drawn, as in `time_render`."""
     import moderngl
 
     ctx = get_context()
@@ -26,7 +35,7 @@ def time_renders(obj, camera, variants: list[dict], *, repeats: int = 3,
     light = light or DirectionalLight()
     fbo = None
     try:
-        for options in variants:
+        for obj, options in drawn:
             scenes.append(Scene([obj], ctx=ctx, **options))
         fbo = render_target(ctx, *camera.size, FRAME_ATTACHMENTS)
 
