@@ -35,7 +35,8 @@ class Sizing:
     ``params(n, mesh)`` are the bake parameters at resolution ``n``, an integer in [``lo``,
     ``hi``] whose files grow with it; ``knob`` says in words what ``n`` is (for the report);
     ``label`` names the row (the baker's name when empty: a baker with several variants
-    declares one `Sizing` each); ``needs_uvs``: only for meshes with texture coordinates.
+    declares one `Sizing` each); ``needs_uvs``: only for meshes with texture coordinates;
+    ``render``: the render options it is drawn with (none: its defaults).
     """
 
     knob: str
@@ -44,6 +45,7 @@ class Sizing:
     params: Callable
     label: str = ""
     needs_uvs: bool = False
+    render: dict | None = None
 
 
 @dataclass(frozen=True)

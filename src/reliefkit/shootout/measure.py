@@ -39,23 +39,26 @@ def draws_opaque(obj) -> bool:
                for plan in drawable.plans)
 
 
-def frame_time(obj, mesh, camera) -> dict:
+def frame_time(obj, mesh, camera, options: dict) -> dict:
     """Milliseconds of ``obj`` and of the full ``mesh`` drawn interleaved in one run, and
     their ratio (None for an object with transparent drawables: only the opaque pass is
     timed)."""
     if not draws_opaque(obj):
         return {"frame_ms": None, "mesh_ms": None, "frame_ratio": None}
-    mesh_t, obj_t = time_side_by_side([(mesh, {}), (obj, {})], camera, repeats=TIMING_REPEATS)
+    mesh_t, obj_t = time_side_by_side([(mesh, {}), (obj, options)], camera,
+                                      repeats=TIMING_REPEATS)
     return {"frame_ms": obj_t["wall_ms"], "mesh_ms": mesh_t["wall_ms"],
             "frame_ratio": obj_t["wall_ms"] / max(mesh_t["wall_ms"], 1e-9)}
 
 
-def measure(obj, mesh, cameras_by_size: dict, truths_by_size: dict) -> tuple[dict, dict]:
-    """Figures by screen size, and the first view's picture by size (for the sheets)."""
+def measure(obj, mesh, cameras_by_size: dict, truths_by_size: dict,
+            options: dict) -> tuple[dict, dict]:
+    """Figures by screen size of ``obj`` drawn with render ``options``, and the first view's
+    picture by size (for the sheets)."""
     figures, pictures = {}, {}
     for size, cameras in cameras_by_size.items():
-        frames = render(obj, cameras)
+        frames = render(obj, cameras, **options)
         figures[size] = scores(frames, truths_by_size[size], mesh.radius) \
-            | frame_time(obj, mesh, cameras[0])
+            | frame_time(obj, mesh, cameras[0], options)
         pictures[size] = frames[0].rgba8(TILE_BACKGROUND)
     return figures, pictures

@@ -39,12 +39,13 @@ def recommend(result: dict, sizes, budgets) -> list[dict]:
 
 
 def recommendation_line(row: dict | None, size: int, budget: int) -> str:
+    """The verdict in words, with its figures (no times: the line is the same every run)."""
     where = f"{size} px, {format_bytes(budget)}"
     if row is None:
         return f"{where}: nothing fits"
     f = row["sizes"][size]
     figures = (f"SSIM {f['ssim']:.3f}, IoU {f['iou']:.3f}, PSNR {_db(f['psnr'])}, "
-               f"{format_bytes(row['bytes'])}{_ratio(f['frame_ratio'])}")
+               f"{format_bytes(row['bytes'])}")
     if row["label"] == DECIMATED:
         return (f"{where}: the decimated mesh ({row['n']:,} triangles; {figures}): no "
                 "image-based representation beats it here")
@@ -70,10 +71,6 @@ def finish(results: dict) -> dict:
 
 def _db(value) -> str:
     return "inf dB" if value is None or math.isinf(value) else f"{value:.1f} dB"
-
-
-def _ratio(value) -> str:
-    return "" if value is None else f", frame {value:.2f}x the mesh"
 
 
 def _cell(value, digits: int = 3) -> str:

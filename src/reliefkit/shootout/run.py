@@ -45,7 +45,7 @@ def size_rows(mesh, chosen, budgets, probes_dir: Path, out: Path, rk_dir: str,
         search = Search(candidate, mesh, probes_dir) if reason is None else None
         for budget in budgets:
             row = {"label": candidate.label, "kind": candidate.kind, "budget": budget,
-                   "knob": candidate.sizing.knob}
+                   "knob": candidate.sizing.knob, "render": candidate.sizing.render or {}}
             found = search.largest_fitting(budget) if search else None
             if found is None:
                 row |= {"fits": False, "reason": reason or search.failure()}
@@ -55,6 +55,8 @@ def size_rows(mesh, chosen, budgets, probes_dir: Path, out: Path, rk_dir: str,
                     shutil.copyfile(found.path, tmp)
                 row |= {"fits": True, "n": found.n, "bytes": (out / name).stat().st_size,
                         "file": name, "bake_s": found.bake_s}
+            if search:
+                row["probes"] = search.measured()
             rows.append(row)
             done += 1
             advance(done)
@@ -68,14 +70,15 @@ def size_rows(mesh, chosen, budgets, probes_dir: Path, out: Path, rk_dir: str,
 def decimated_row(mesh, budget: int) -> dict:
     start = time.perf_counter()
     small = decimate_to_bytes(mesh, budget, compact=True)
-    row = {"label": DECIMATED, "kind": "mesh", "budget": budget,
+    row = {"label": DECIMATED, "kind": "mesh", "budget": budget, "render": {},
            "knob": "triangles (quadric decimation; compact GPU bytes)"}
     if small is None:
         textures = gpu_bytes(mesh, compact=True)["textures"]
         return row | {"fits": False, "reason": "not one triangle fits" + (
             f" (its textures alone take {textures:,} bytes compact)" if textures else "")}
     compact, raw = gpu_bytes(small, compact=True), gpu_bytes(small)
-    return row | {"fits": True, "n": small.triangle_count, "bytes": compact["total"],
+    return row | {"fits": True, "n": small.triangle_count, "vertices": len(small.positions),
+                  "bytes": compact["total"],
                   "raw_bytes": raw["total"], "gpu_bytes": compact,
                   "bake_s": time.perf_counter() - start, "drawn": small}
 
@@ -98,7 +101,7 @@ def shoot_mesh(mesh, chosen, budgets, sizes, out: Path, name: str, pictures: dic
     with progress_bar(f"measuring {name}", len(measured)) as advance:
         for k, row in enumerate(measured):
             drawn = row.pop("drawn", None) or load(out / row["file"])
-            row["sizes"], shots = measure(drawn, mesh, cams, truths)
+            row["sizes"], shots = measure(drawn, mesh, cams, truths, row["render"])
             for size, image in shots.items():
                 pictures[size].setdefault((name, row["budget"]), []).append(
                     (row["label"], image))

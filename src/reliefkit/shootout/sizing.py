@@ -177,6 +177,10 @@ class Search:
                 factor = min(MAX_GROWTH, (budget / b.bytes) ** (1.0 / growth))
         return min(hi, max(n + 1, math.floor(n * factor)))
 
+    def measured(self) -> list[list[int]]:
+        """[n, file bytes] of every probe so far that baked, by n."""
+        return [[n, p.bytes] for n, p in sorted(self.probes.items()) if p.bytes is not None]
+
     def failure(self) -> str:
         """Why no knob value fits (for the report's row)."""
         lo = self.probe(self.candidate.sizing.lo)
