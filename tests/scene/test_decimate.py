@@ -17,12 +17,12 @@ from reliefkit.scene.decimate import (
 from reliefkit.scene.mesh import Material, RenderMesh, vertex_normals
 
 
-def textured_cube(alpha: int = 255) -> RenderMesh:
+def textured_cube(alpha: int = 255, texels=(4, 8)) -> RenderMesh:
     """8 vertices, 12 triangles, uvs, one colour, an 8 x 4 RGBA texture."""
     box = trimesh.creation.box()
     points = np.asarray(box.vertices, np.float32)
     faces = np.asarray(box.faces, np.uint32)
-    image = np.full((4, 8, 4), 200, np.uint8)
+    image = np.full((*texels, 4), 200, np.uint8)
     image[..., 3] = alpha
     return RenderMesh(points, faces, vertex_normals(points, faces),
                       np.broadcast_to(np.float32([0.5, 0.5, 0.5, 1]), (8, 4)),
@@ -107,3 +107,16 @@ def test_decimate_to_bytes_keeps_a_mesh_that_fits_and_refuses_an_impossible_budg
     kept = decimate_to_bytes(mesh, 10**6)
     assert kept.triangle_count == mesh.triangle_count
     assert decimate_to_bytes(textured_cube(), 30) is None  # the texture alone takes 40
+
+
+def test_textures_that_do_not_fit_are_halved_to_half_the_budget():
+    mesh = textured_cube(texels=(64, 64))
+    # compact: geometry 200 bytes; the 64 x 64 BC1 texture with its mips 2048 + 512 + 128
+    # + 32 + 3 x 8 = 2744 bytes: the whole mesh fits 3000, not 2000, where the texture may
+    # take 1000: at 32 x 32 it takes 512 + 128 + 32 + 3 x 8 = 696
+    assert decimate_to_bytes(mesh, 3000).texture.shape == (64, 64, 4)
+    small = decimate_to_bytes(mesh, 2000)
+    assert small.texture.shape == (32, 32, 4) and small.triangle_count == 12
+    assert gpu_bytes(small, compact=True) == {"vertices": 128, "indices": 72,
+                                              "textures": 696, "total": 896}
+    np.testing.assert_array_equal(small.texture, 200)  # a flat image stays flat

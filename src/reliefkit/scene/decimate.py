@@ -20,6 +20,8 @@ the most triangles whose bytes fit a budget.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..io.rk import array_bytes
@@ -35,6 +37,9 @@ RAW_VERTEX_BYTES = {"positions": 12, "normals": 12, "uvs": 8, "colors": 16}
 UINT16_VERTICES = 1 << 16
 BLOCK_BYTES = {"bc1": 8, "bc7": 16}  # per 4x4 block
 RGBA8_BYTES = 4
+#: A decimated mesh whose textures do not fit gives them at most this share of the budget,
+#: halving them until they do (what an artist trading texels for triangles would do).
+TEXTURE_SHARE = 0.5
 #: Bisection steps on the triangle count: 2^-18 of it is below one triangle for any mesh
 #: the loaders take, so the search ends on the exact largest count that fits.
 SEARCH_STEPS = 18
@@ -180,11 +185,45 @@ def decimated(mesh, target_bytes: int) -> RenderMesh | None:
     return simplified(mesh, round(mesh.triangle_count * (1.0 - reduction)))
 
 
+def halved(image: np.ndarray) -> np.ndarray:
+    """An (h, w, 4) uint8 image at half its size in each direction longer than one texel
+    (means of 2 x 2 texels; an odd last row or column dropped)."""
+    h, w = image.shape[:2]
+    fy, fx = (2 if h > 1 else 1), (2 if w > 1 else 1)
+    blocks = image[:h // fy * fy, :w // fx * fx].reshape(h // fy, fy, w // fx, fx, -1)
+    return np.rint(blocks.astype(np.float32).mean(axis=(1, 3))).astype(np.uint8)
+
+
+def textures_within(mesh, budget: int, *, compact: bool = True) -> RenderMesh:
+    """``mesh`` with its textures halved until they take at most ``budget`` bytes (or are
+    1 x 1); the mesh itself when they already do."""
+    def texture_total(m) -> int:
+        return gpu_bytes(m, compact=compact)["textures"]
+
+    while texture_total(mesh) > budget and any(
+            m.texture is not None and m.texture.size > 4 for m in mesh.materials):
+        smaller = {}
+        for m in mesh.materials:
+            if m.texture is not None and id(m.texture) not in smaller:
+                smaller[id(m.texture)] = halved(m.texture)
+        materials = [m if m.texture is None else dataclasses.replace(
+            m, texture=smaller[id(m.texture)]) for m in mesh.materials]
+        mesh = RenderMesh(mesh.world_positions, mesh.indices, mesh.normals, mesh.colors,
+                          mesh.uvs, name=mesh.name, extra=dict(mesh.extra),
+                          materials=materials, material=mesh.material)
+    return mesh
+
+
 def decimate_to_bytes(mesh, budget: int, *, compact: bool = True) -> RenderMesh | None:
     """The mesh with the most triangles whose `gpu_bytes` (compact or raw) fit ``budget``, found
     by bisection on the target triangle count (deterministic); compact, it is returned
-    quantized (`compact_mesh`). None when not even one triangle fits (the textures alone may
-    exceed the budget) or fast_simplification is missing."""
+    quantized (`compact_mesh`). When the whole mesh does not fit, its textures are first
+    halved until they take at most `TEXTURE_SHARE` of the budget. None when not even one
+    triangle fits or fast_simplification is missing."""
+    whole = gpu_bytes(mesh, compact=compact)["total"] <= budget
+    if not whole:
+        mesh = textures_within(mesh, int(budget * TEXTURE_SHARE), compact=compact)
+
     def fitted(triangles: int):
         candidate = simplified(mesh, triangles)
         if candidate is None:
