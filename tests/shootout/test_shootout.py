@@ -63,6 +63,10 @@ def test_every_row_is_there_and_every_file_fits_its_budget(runs):
     assert not tiny["relief-cube"]["fits"] and "at its smallest" in tiny["relief-cube"]["reason"]
     files = {p.relative_to(folder).as_posix() for p in (folder / "rk").rglob("*.rk")}
     assert files == {r["file"] for r in rows if r.get("file")}
+    # the mesh bakers without a sizing are named, not silently left out
+    assert "relief-frustum" in data["unsized"]
+    assert set(data["unsized"]).isdisjoint(c.kind for c in candidates())
+    assert ", ".join(data["unsized"]) in (folder / "shootout.md").read_text()
     for name in ("pareto-32.png", "sheet-32.png", "pareto-48.png", "sheet-48.png"):
         assert (folder / name).stat().st_size > 0
 

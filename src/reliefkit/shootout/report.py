@@ -12,6 +12,7 @@ from ..bench.report import machine, machine_line
 from ..io.atomic import atomic_path
 from ..units import format_bytes
 from .run import DECIMATED
+from .sizing import unsized
 
 #: Fields that hold seconds or milliseconds: the only ones two runs may disagree on.
 TIME_FIELDS = ("bake_s", "frame_ms", "mesh_ms", "frame_ratio", "machine")
@@ -65,6 +66,7 @@ def finish(results: dict) -> dict:
     for mesh in results["meshes"]:
         mesh["recommendations"] = recommend(mesh, results["sizes"], results["budgets"])
     results["summary"] = summarize(results)
+    results["unsized"] = unsized()
     results["machine"] = machine()
     return results
 
@@ -125,6 +127,9 @@ def markdown(results: dict) -> str:
              "the size in pixels. Surface err: world position error where both cover, per "
              "bounding radius; frame x: frame time over the full mesh's, timed side by "
              "side.", "", machine_line(results["machine"]), ""]
+    if results["unsized"]:
+        lines += [f"Not in the shootout (their bakers declare no sizing: they do not stand in "
+                  f"for a whole mesh): {', '.join(results['unsized'])}.", ""]
     if len(results["meshes"]) > 1:
         wins = results["summary"]["wins"]
         lines += ["## Summary", "", f"Of {results['summary']['verdicts']} verdicts (mesh x "

@@ -87,6 +87,12 @@ def candidates(kinds: list[str] | None = None) -> list[Candidate]:
     return [c for c in every if c.label in kinds or c.kind in kinds]
 
 
+def unsized() -> list[str]:
+    """The bakers of meshes that declare no sizing: not in the shootout (the report names
+    them, so a new kind without one is seen missing)."""
+    return [name for name, (_, b) in bakers().items() if "mesh" in b.sources and not b.sizings]
+
+
 def parse_kinds(text: str | None) -> list[Candidate]:
     """``--kinds a,b`` (None: every candidate)."""
     if text is None:
@@ -164,8 +170,9 @@ class Search:
         return self.probe(below)
 
     def _next_up(self, n: int, budget: int) -> int:
-        """The next knob value to try above ``n`` (which fits): where the growth measured
-        between the last two probes below predicts ``budget``, at most doubled, at least n+1."""
+        """The next knob value to try above ``n`` (which fits): a tolerance beyond where the
+        growth measured between the last two probes predicts ``budget`` (so the next probe
+        most likely brackets it), at least a tolerance above ``n``, at most doubled."""
         hi = self.candidate.sizing.hi
         known = sorted(k for k, p in self.probes.items() if p.bytes is not None and k <= n)
         factor = MAX_GROWTH
@@ -174,7 +181,8 @@ class Search:
             growth = math.log(b.bytes / a.bytes) / math.log(b.n / a.n) if b.bytes > a.bytes \
                 else 0.0
             if growth > 0:
-                factor = min(MAX_GROWTH, (budget / b.bytes) ** (1.0 / growth))
+                predicted = (budget / b.bytes) ** (1.0 / growth) * (1 + KNOB_TOLERANCE)
+                factor = min(MAX_GROWTH, max(1 + KNOB_TOLERANCE, predicted))
         return min(hi, max(n + 1, math.floor(n * factor)))
 
     def measured(self) -> list[list[int]]:
