@@ -55,13 +55,15 @@ def pareto(results: dict, size: int, path: Path) -> Path:
 
 
 def thumbnail(image: np.ndarray) -> np.ndarray:
-    """An RGBA tile no larger than `SHEET_TILE` on its longest side (box filtered)."""
+    """An RGBA tile about `SHEET_TILE` on its longest side: larger pictures box filtered,
+    smaller ones enlarged by a whole factor, each pixel a square (what S pixels show)."""
     from PIL import Image
 
     h, w = image.shape[:2]
+    if max(h, w) <= SHEET_TILE:
+        factor = SHEET_TILE // max(h, w)
+        return np.repeat(np.repeat(image, factor, axis=0), factor, axis=1)
     scale = SHEET_TILE / max(h, w)
-    if scale >= 1:
-        return image
     small = Image.fromarray(image, "RGBA").resize(
         (max(1, round(w * scale)), max(1, round(h * scale))), Image.Resampling.BOX)
     return np.asarray(small)
@@ -74,7 +76,7 @@ def sheet(results: dict, pictures: dict, size: int, path: Path) -> Path:
         for budget in results["budgets"]:
             shots = pictures[size].get((mesh["name"], budget), [])
             (_, reference), = pictures[size][(mesh["name"], None)]
-            row = [(f"{mesh['name']}: full mesh", reference)]
+            row = [(f"{mesh['name']}, full mesh; budget {format_bytes(budget)}", reference)]
             for label, image in shots:
                 got = next(r for r in mesh["rows"] if r["label"] == label
                            and r["budget"] == budget)
