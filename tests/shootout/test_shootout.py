@@ -136,6 +136,24 @@ def test_metrics_are_those_of_the_full_mesh_drawn_from_the_same_views(runs):
         assert len(figures["views"]) == len(data["views"]) == 6
 
 
+def test_a_row_is_measured_and_timed_with_its_declared_render_options():
+    """A relief cube over 128 texels has no safety radii: drawn (and timed) with its
+    declared method, never the robust default, which refuses it."""
+    from reliefkit.bake import bake
+    from reliefkit.render import render
+    from reliefkit.shootout.measure import measure
+    from reliefkit.shootout.views import cameras
+
+    mesh = lamp()
+    cube, = (c for c in candidates() if c.label == "relief-cube")
+    rep = bake(mesh, cube.kind, **cube.sizing.params(140, mesh))
+    views = {32: cameras(mesh.bounds, 32)[:2]}
+    figures, pictures = measure(rep, mesh, views, {32: render(mesh, views[32])},
+                                cube.sizing.render)
+    assert figures[32]["iou"] > 0.9 and figures[32]["frame_ratio"] > 0
+    assert pictures[32].shape == (32, 32, 4)
+
+
 @pytest.mark.parametrize(("args", "words"), [
     (["demo:tree", "--budgets", "1MB,lots"], ["--budgets", "lots"]),
     (["demo:tree", "--budgets", "0KB"], ["--budgets", "outside"]),

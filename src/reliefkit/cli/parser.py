@@ -39,7 +39,7 @@ CORE_EXAMPLES = {
                "reliefkit render demo:tree --turntable 36 --size 640x480 -o spin.mp4",
                "reliefkit render demo:tree --turntable 36 -o frames/%04d.png"],
     "shootout": ["reliefkit shootout demo:tree --out out/shootout    what to ship at 64 and "
-                 "256 px, 256 KB, 1 and 4 MB",
+                 "256 px, 256 KB and 1 MB",
                  "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "
                  "--out out/shootout"],
     "info": ["reliefkit info --gl                               the OpenGL renderer and its "
@@ -206,7 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
                  "Pareto plot and a contact sheet per size, and one recommendation per size "
                  "and budget.")
     p.add_argument("meshes", nargs="+", metavar="MESH", help="mesh files or demo:NAME")
-    p.add_argument("--budgets", default="256KB,1MB,4MB",
+    p.add_argument("--budgets", default="256KB,1MB",
                    help="byte budgets, KB/MB binary (default: %(default)s)")
     p.add_argument("--sizes", default="64,256",
                    help="screen sizes in pixels: the bounding sphere's diameter "

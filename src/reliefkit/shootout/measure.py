@@ -32,10 +32,11 @@ def scores(frames, truths, radius: float) -> dict:
     return means | {"views": views}
 
 
-def draws_opaque(obj) -> bool:
-    """Whether every drawable of ``obj`` is drawn in the opaque pass (what is timed)."""
+def draws_opaque(obj, options: dict) -> bool:
+    """Whether every drawable of ``obj`` (with render ``options``) is drawn in the opaque
+    pass (what is timed)."""
     return all(plan.render_pass != "transparent"
-               for drawable in make_drawables([obj], {}, instrument=False)
+               for drawable in make_drawables([obj], options, instrument=False)
                for plan in drawable.plans)
 
 
@@ -43,7 +44,7 @@ def frame_time(obj, mesh, camera, options: dict) -> dict:
     """Milliseconds of ``obj`` and of the full ``mesh`` drawn interleaved in one run, and
     their ratio (None for an object with transparent drawables: only the opaque pass is
     timed)."""
-    if not draws_opaque(obj):
+    if not draws_opaque(obj, options):
         return {"frame_ms": None, "mesh_ms": None, "frame_ratio": None}
     mesh_t, obj_t = time_side_by_side([(mesh, {}), (obj, options)], camera,
                                       repeats=TIMING_REPEATS)
