@@ -99,6 +99,30 @@ def test_the_decimated_mesh_fits_every_budget_counted_by_hand(runs):
     assert big["n"] == full.triangle_count  # 64 KB holds the whole mesh
 
 
+def sheets(parts: int = 4, n: int = 12) -> RenderMesh:
+    """``parts`` wavy open sheets of n x n quads: quadric decimation keeps their borders, so
+    it stops short of one triangle (as on a CAD model of many open parts)."""
+    u, v = (a.ravel() for a in np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1)))
+    corner = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
+    quad = np.concatenate([np.column_stack([corner, corner + 1, corner + n + 2]),
+                           np.column_stack([corner, corner + n + 2, corner + n + 1])])
+    points = np.concatenate([np.column_stack([u + 1.2 * k, v, 0.1 * np.sin(7 * u)])
+                             for k in range(parts)]).astype(np.float32)
+    faces = np.concatenate([quad + k * len(u) for k in range(parts)]).astype(np.uint32)
+    return RenderMesh(points, faces, vertex_normals(points, faces), np.ones((len(points), 4)))
+
+
+def test_a_budget_below_the_decimation_floor_says_where_decimation_stops():
+    from reliefkit.scene.decimate import gpu_bytes, simplified
+    from reliefkit.shootout.run import decimated_row
+
+    mesh = sheets()
+    floor = simplified(mesh, 1)
+    row = decimated_row(mesh, gpu_bytes(floor, compact=True)["total"] - 1)
+    assert not row["fits"]
+    assert f"stops at {floor.triangle_count:,} triangles" in row["reason"]
+
+
 def without_times(value):
     if isinstance(value, dict):
         return {k: without_times(v) for k, v in value.items() if k not in TIME_FIELDS}
