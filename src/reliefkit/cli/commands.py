@@ -25,7 +25,7 @@ from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
 from ..gl.context import gl_info
 from ..io.atomic import atomic_path, check_writable, written_together
-from ..io.inputs import describe, load_input
+from ..io.inputs import DEMO_PREFIX, describe, load_input
 from ..io.rk import array_bytes, file_sha256, load, read_manifest, save
 from ..progress import progress_bar, waiting
 from ..render import Scene, render, render_options
@@ -40,6 +40,7 @@ from ..scene.views import (
     parse_view,
     turntable,
 )
+from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, shootout
 from ..units import format_bytes
 from .options import applicable, given_options
 
@@ -363,6 +364,22 @@ def cmd_bench(args) -> int:
     report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out), mesh=args.mesh)
     print(report)
     print("wrote " + ", ".join(map(str, paths)))
+    return 0
+
+
+def cmd_shootout(args) -> int:
+    """Every argument checked and every mesh loaded before any work."""
+    budgets, sizes = parse_budgets(args.budgets), parse_sizes(args.sizes)
+    chosen = parse_kinds(args.kinds)
+    check_writable(args.out, "--out", folder=True)
+    for spec in args.meshes:
+        if not spec.startswith(DEMO_PREFIX):
+            _check_mesh_file(spec, "shootout")
+    results, paths = shootout(load_meshes(args.meshes), chosen, budgets, sizes, Path(args.out))
+    for mesh in results["meshes"]:
+        for rec in mesh["recommendations"]:
+            print(f"{mesh['name']}: {rec['line']}")
+    print("wrote " + ", ".join(str(p) for p in paths))
     return 0
 
 

@@ -14,7 +14,16 @@ from ..core.technique import bakers, techniques
 from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
 from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW
-from .commands import cmd_bake, cmd_bench, cmd_compare, cmd_demo, cmd_info, cmd_render
+from ..shootout.sizing import candidates as shootout_candidates
+from .commands import (
+    cmd_bake,
+    cmd_bench,
+    cmd_compare,
+    cmd_demo,
+    cmd_info,
+    cmd_render,
+    cmd_shootout,
+)
 from .exits import EXIT_USAGE
 from .options import add_flag, add_options
 
@@ -31,12 +40,16 @@ CORE_EXAMPLES = {
                "APNG)",
                "reliefkit render demo:tree --turntable 36 --size 640x480 -o spin.mp4",
                "reliefkit render demo:tree --turntable 36 -o frames/%04d.png"],
+    "shootout": ["reliefkit shootout demo:tree --out out/shootout    what to ship at 64 and "
+                 "256 px, 256 KB and 1 MB",
+                 "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "
+                 "--out out/shootout"],
     "info": ["reliefkit info --gl                               the OpenGL renderer and its "
              "limits",
              "reliefkit info model.obj                          counts and bounds of a mesh "
              "(or an .rk)"],
 }
-ORDER = ("demo", "render", "bake", "compare", "bench", "info")
+ORDER = ("demo", "render", "bake", "compare", "shootout", "bench", "info")
 
 
 def _examples(command: str | None = None) -> list[str]:
@@ -186,6 +199,26 @@ def build_parser() -> argparse.ArgumentParser:
     _add_view_args(p)
     p.add_argument("--out", default="out/compare", help="output folder (default: %(default)s)")
     p.set_defaults(run=cmd_compare)
+
+    p = _command(sub, "shootout", "which representation to ship for a mesh, per size and budget",
+                 "Bake every representation the registry can size so that its .rk file fits "
+                 "each budget, decimate the mesh to the same compact GPU bytes, render both "
+                 "from six views with the bounding sphere spanning each size in pixels, and "
+                 "measure them against the full mesh; write shootout.md, shootout.json, a "
+                 "Pareto plot and a contact sheet per size, and one recommendation per size "
+                 "and budget.")
+    p.add_argument("meshes", nargs="+", metavar="MESH", help="mesh files or demo:NAME")
+    p.add_argument("--budgets", default="256KB,1MB",
+                   help="byte budgets, KB/MB binary (default: %(default)s)")
+    p.add_argument("--sizes", default="64,256",
+                   help="screen sizes in pixels: the bounding sphere's diameter "
+                        "(default: %(default)s)")
+    p.add_argument("--kinds", metavar="K,K",
+                   help="only these representations, by baker or row (default: every one "
+                        "the registry can size: "
+                        + ", ".join(c.label for c in shootout_candidates()) + ")")
+    p.add_argument("--out", required=True, help="output folder")
+    p.set_defaults(run=cmd_shootout)
 
     names = suite_names()
     p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",

@@ -20,12 +20,32 @@ from .params import Option, options_of
 
 __all__ = [
     "Baker", "BenchSuite", "CompareMetric", "CompareVariant", "DemoTile", "DrawableSpec",
-    "ProgramVariant", "REGISTRY", "Registry", "Technique", "register", "unregister",
+    "ProgramVariant", "REGISTRY", "Registry", "Sizing", "Technique", "register", "unregister",
     "techniques", "technique", "technique_of", "baker", "bakers", "drawable_spec",
 ]
 
 #: The core's shader namespace and the package whose ``shaders/`` folder it is.
 CORE_NAMESPACE, CORE_PACKAGE = "core", "reliefkit"
+
+
+@dataclass(frozen=True)
+class Sizing:
+    """How `reliefkit shootout` sizes a baker's representation of a whole mesh to a byte budget.
+
+    ``params(n, mesh)`` are the bake parameters at resolution ``n``, an integer in [``lo``,
+    ``hi``] whose files grow with it; ``knob`` says in words what ``n`` is (for the report);
+    ``label`` names the row (the baker's name when empty: a baker with several variants
+    declares one `Sizing` each); ``needs_uvs``: only for meshes with texture coordinates;
+    ``render``: the render options it is drawn with (none: its defaults).
+    """
+
+    knob: str
+    lo: int
+    hi: int
+    params: Callable
+    label: str = ""
+    needs_uvs: bool = False
+    render: dict | None = None
 
 
 @dataclass(frozen=True)
@@ -35,7 +55,8 @@ class Baker:
     ``params`` is a dataclass whose fields (made with `reliefkit.core.params.param`) are the
     baker's typed options; the CLI derives flags, defaults and help from it. ``bake(source,
     params, progress)`` gets a validated instance. ``sources`` names what it accepts:
-    ``"mesh"`` (a RenderMesh) and/or ``"heightmap"`` (a 2D height array).
+    ``"mesh"`` (a RenderMesh) and/or ``"heightmap"`` (a 2D height array). ``sizings``: how
+    the shootout sizes it to a budget (none: it does not stand in for a whole mesh).
     """
 
     name: str
@@ -43,6 +64,7 @@ class Baker:
     params: type
     bake: Callable
     sources: tuple[str, ...] = ("mesh",)
+    sizings: tuple[Sizing, ...] = ()
 
     @property
     def options(self) -> tuple[Option, ...]:

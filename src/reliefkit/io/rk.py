@@ -731,21 +731,23 @@ def _inflate(raw: _RawReader, size: int, what: str, chunk: int) -> Iterator[byte
     pieces = iter(raw)
     pending = b""
     left = size
+    read_all = False  # zlib may still hold output (and the end) after the last input byte
     try:
         while left or not inflater.eof:
             if inflater.eof:
                 raise FormatError(f"{what} inflates to {size - left} bytes, fewer than its "
                                   f"declared {size}; the file is truncated, corrupt or forged")
-            if not pending:
+            if not pending and not read_all:
                 pending = next(pieces, b"")
-                if not pending:
-                    raise FormatError(f"{what}: its deflate stream ends early; the file is "
-                                      "truncated or corrupt")
+                read_all = not pending
             out = inflater.decompress(pending, min(chunk, left) if left else 1)
             if out and not left:
                 raise FormatError(f"{what} inflates to more than its declared {size} bytes; "
                                   "the file is corrupt or forged")
             if not out and not inflater.eof and len(inflater.unconsumed_tail) == len(pending):
+                if read_all:
+                    raise FormatError(f"{what}: its deflate stream ends early; the file is "
+                                      "truncated or corrupt")
                 raise FormatError(f"{what}: its deflate stream does not progress; the file is "
                                   "corrupt")
             pending = inflater.unconsumed_tail

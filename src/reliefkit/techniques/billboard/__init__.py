@@ -11,7 +11,14 @@ from __future__ import annotations
 from ...core.technique import Baker, BenchSuite, CompareMetric, CompareVariant, Technique
 from . import box_render, render
 from .bake import bake_billboard_cloud
-from .bakers import BillboardBoxesParams, BillboardCloudParams, bake_cloud, bake_dmbbc
+from .bakers import (
+    CLOUD_SIZING,
+    DMBBC_SIZINGS,
+    BillboardBoxesParams,
+    BillboardCloudParams,
+    bake_cloud,
+    bake_dmbbc,
+)
 from .box_bake import bake_boxes
 from .boxes import VARIANTS, BillboardBoxes
 from .cloud import BillboardCloudPlan, build_billboard_cloud
@@ -141,10 +148,11 @@ TECHNIQUE = Technique(
     representations=(BillboardCloud, BillboardBoxes),
     bakers=(
         Baker("billboard-cloud", "Décoret's greedy planes, each face within epsilon of one, "
-              "as textured rectangles in atlases", BillboardCloudParams, bake_cloud),
+              "as textured rectangles in atlases", BillboardCloudParams, bake_cloud,
+              sizings=(CLOUD_SIZING,)),
         Baker("dmbbc", "displacement-mapped billboard clouds: boxes of +-epsilon around the "
               "same rectangles, ray-cast (volumetric, shell or thick shell)",
-              BillboardBoxesParams, bake_dmbbc),
+              BillboardBoxesParams, bake_dmbbc, sizings=DMBBC_SIZINGS),
     ),
     drawables=(render.drawable_spec(), box_render.drawable_spec()),
     compare_variants=_compare_variants(),

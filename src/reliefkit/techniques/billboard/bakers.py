@@ -5,7 +5,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ...core.params import param
+from ...core.technique import Sizing
 from .bake import bake_billboard_cloud
 from .box_bake import SURFACES, bake_boxes
 from .boxes import VARIANTS
@@ -59,3 +62,18 @@ def bake_dmbbc(source, p: BillboardBoxesParams, progress=None):
     return bake_boxes(source, p.variant, epsilon=p.epsilon, max_planes=p.max_planes,
                       texel_size=p.texel_size, thickness=p.thickness, surfaces=p.surfaces,
                       progress=progress)
+
+
+def texel_across(n: int, mesh) -> float:
+    """The texel size that puts ``n`` texels across the mesh's bounding-box diagonal."""
+    return float(np.linalg.norm(np.subtract(*mesh.bounds[::-1]))) / n
+
+
+#: The shootout sizes a billboard cloud, and each DMBBC variant, by its texel size.
+TEXELS_ACROSS = "texels across the bounding-box diagonal (texel_size = diagonal / n)"
+CLOUD_SIZING = Sizing(TEXELS_ACROSS, 16, 4096,
+                      lambda n, mesh: {"texel_size": texel_across(n, mesh)})
+DMBBC_SIZINGS = tuple(
+    Sizing(TEXELS_ACROSS, 16, 1024, lambda n, mesh, v=variant: {
+        "variant": v, "texel_size": texel_across(n, mesh)}, label=f"dmbbc-{variant}")
+    for variant in VARIANTS)

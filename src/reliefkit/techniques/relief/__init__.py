@@ -17,6 +17,7 @@ from ...core.technique import (
 )
 from .bake import bake_relief, relief_from_heights
 from .bakers import (
+    CUBE_SIZING,
     ReliefCubeParams,
     ReliefFrustumParams,
     ReliefParams,
@@ -105,7 +106,7 @@ TECHNIQUE = Technique(
         Baker("relief-frustum", "one reverse-perspective frustum that sees the sides (§4.1)",
               ReliefFrustumParams, bake_frustum),
         Baker("relief-cube", "six reverse frusta splitting the bounding cube (§4.2)",
-              ReliefCubeParams, bake_cube),
+              ReliefCubeParams, bake_cube, sizings=(CUBE_SIZING,)),
     ),
     drawables=(DrawableSpec(ReliefTexture, ReliefDrawable, ReliefRenderOptions),
                DrawableSpec(ReliefObject, ReliefObjectDrawable, ReliefRenderOptions)),

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.params import param
+from ...core.technique import Sizing
 from ...errors import UsageError
 from .bake import DEFAULT_TOLERANCE, HEIGHTMAP_BOX, bake_relief, relief_from_heights
 from .frustum import bake_relief_cube, bake_relief_frustum
@@ -160,3 +161,11 @@ def bake_cube(source, p: ReliefCubeParams, progress=None):
     return bake_relief_cube(source, depth_res=p.depth_res, color_res=p.color_res,
                             safety=safety, tolerance=p.safety_tolerance, progress=progress,
                             octants=p.safety_octants)
+
+
+#: The shootout sizes a relief cube by its heightfields' resolution (colour follows it),
+#: without safety radii (a bake of minutes from 150 texels on two cores), drawn with the
+#: exact maximum mipmap, which needs nothing baked (docs/relief.md: "Which method").
+CUBE_SIZING = Sizing("depth_res: texels per side of each of the six heightfields", 8, 2048,
+                     lambda n, mesh: {"depth_res": n, "safety": False},
+                     render={"method": "maxmip"})

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from ...core.technique import Baker, BenchSuite, CompareMetric, CompareVariant, Technique
 from . import render
-from .bakers import ShellVolumeParams, bake_shell
+from .bakers import SHELL_SIZING, ShellVolumeParams, bake_shell
 from .codec import CODECS
 from .representation import TexturedShell
 from .shell import ShellVolume, build_shell
@@ -101,7 +101,7 @@ TECHNIQUE = Technique(
     representations=(TexturedShell,),
     bakers=(Baker("shell-volume", "a 3D texture (fur, clouds, ellipsoids, absorption, chain, "
                   "rocks, a .npy, a voxelized mesh) tiled in a shell extruded from the mesh",
-                  ShellVolumeParams, bake_shell),),
+                  ShellVolumeParams, bake_shell, sizings=(SHELL_SIZING,)),),
     drawables=(render.drawable_spec(),),
     compare_variants=_compare_variants(),
     compare_metrics=(CompareMetric("CPU reference", _against_reference,

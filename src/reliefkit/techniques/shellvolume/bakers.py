@@ -9,6 +9,7 @@ import numpy as np
 from ...bake.detail import LAYER_PER_EDGE, TILE_PER_LAYER, layer_thickness, uv_tiling
 from ...bake.uv_atlas import kept_atlas
 from ...core.params import param
+from ...core.technique import Sizing
 from ...errors import FormatError, UsageError
 from ...io.inputs import DEMO_PREFIX, load_input
 from ...scene.mesh import RenderMesh
@@ -116,3 +117,9 @@ def usable_part(mesh):
     return RenderMesh(mesh.world_positions, kept, mesh.normals, mesh.colors, mesh.uvs,
                       name=mesh.name, materials=mesh.materials,
                       material=np.asarray(mesh.material)[~bad]), int(bad.sum())
+
+
+#: The shootout sizes a shell volume (meshes with uvs only) by its 3D texture's voxels.
+SHELL_SIZING = Sizing("texture_size n,n,n/2: voxels of the 3D texture", 4, 128,
+                      lambda n, mesh: {"texture_size": (n, n, max(n // 2, 2))},
+                      needs_uvs=True)

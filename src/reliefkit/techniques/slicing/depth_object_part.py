@@ -4,7 +4,12 @@ from __future__ import annotations
 
 from ...core.technique import Baker, CompareMetric, CompareVariant, DemoTile
 from . import render
-from .bakers import DepthObjectParams, bake_depth_object, bake_visual_hull
+from .bakers import (
+    DEPTH_IMAGES_SIZING,
+    DepthObjectParams,
+    bake_depth_object,
+    bake_visual_hull,
+)
 from .codec import CODECS
 from .parts import Part
 from .representation import DepthObject, VisualHull
@@ -80,9 +85,9 @@ PART = Part(
     representations=(DepthObject, VisualHull),
     bakers=(Baker("depth-object", "six orthographic depth images on the bounding cube, "
                   "drawn as the intersection of their displaced volumes (§4)",
-                  DepthObjectParams, bake_depth_object),
+                  DepthObjectParams, bake_depth_object, sizings=(DEPTH_IMAGES_SIZING,)),
             Baker("visual-hull", "the six images' silhouettes only: the visual hull (§5)",
-                  DepthObjectParams, bake_visual_hull)),
+                  DepthObjectParams, bake_visual_hull, sizings=(DEPTH_IMAGES_SIZING,))),
     drawables=(render.drawable_spec(),),
     compare_variants=_compare_variants(),
     compare_metrics=(CompareMetric("exact reference", _against_reference,
