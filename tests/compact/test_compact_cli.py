@@ -33,3 +33,13 @@ def test_bake_compress_bc_writes_the_encoded_arrays_and_info_lists_them(tmp_path
 def test_encoding_flags_without_compress_are_refused(tmp_path):
     assert_one_line_error(run_cli("bake", "demo:terrain", "--as", "relief", "--height-bits",
                                   "8", "-o", tmp_path / "x.rk"), "--compress bc")
+
+
+def test_bake_takes_compress_by_its_name_as_documented():
+    """``rk.bake(mesh, kind, compress="bc")``: the string its docstring shows."""
+    from reliefkit import bake
+    from reliefkit.compact.encodings import encoding_of
+    from reliefkit.scene.assets import make_asset
+
+    rep = bake(make_asset("blob"), "relief-cube", compress="bc", depth_res=16)
+    assert encoding_of(rep.parts[0].color) is not None

@@ -91,9 +91,11 @@ def compress(representation, options: CompressOptions | None = None, *,
 
 
 def bake_compression(options) -> CompressOptions:
-    """`reliefkit.bake`'s ``compress`` argument checked before anything is baked: its
-    fields (a dict or `CompressOptions`); encoding choices without ``compress="bc"`` are
-    refused."""
+    """`reliefkit.bake`'s ``compress`` argument checked before anything is baked: "none" or
+    "bc", or its fields (a dict or `CompressOptions`); encoding choices without
+    ``compress="bc"`` are refused."""
+    if isinstance(options, str):
+        options = {"compress": options}
     if not isinstance(options, CompressOptions):
         options = make(CompressOptions, dict(options or {}), "bake --compress")
     if options.compress == "none" and options != CompressOptions():

@@ -105,7 +105,8 @@ def mesh_tables(mesh: dict, sizes, budgets) -> list[str]:
                 lines.append(f"| {r['label']} | - | - | - | cannot meet the budget: "
                              f"{r['reason']} |" + " |" * (5 * len(sizes) - 1))
                 continue
-            raw = f" ({format_bytes(r['raw_bytes'])} raw)" if "raw_bytes" in r else ""
+            raw = f" ({format_bytes(r['raw_bytes'])} raw)" if "raw_bytes" in r else \
+                f" (file {format_bytes(r['file_bytes'])})" if "file_bytes" in r else ""
             cells = []
             for s in sizes:
                 f = r["sizes"][s]
@@ -121,8 +122,10 @@ def markdown(results: dict) -> str:
     views = ", ".join(f"{v['name']} ({v['azimuth']:g}°, {v['elevation']:g}°)"
                       for v in results["views"])
     lines = ["# reliefkit shootout", "",
-             "Every representation sized so that its .rk file fits each budget, and the mesh "
-             "decimated to the same compact GPU bytes, against the full mesh. Figures are "
+             "Every representation sized so that its bytes on a GPU (textures block-"
+             "compressed, read back from its .rk file; the file's size beside) fit each "
+             "budget, and the mesh decimated to the same compact GPU bytes, against the full "
+             "mesh. Figures are "
              f"means over {len(results['views'])} views: {views}; the bounding sphere spans "
              "the size in pixels. Surface err: world position error where both cover, per "
              "bounding radius; frame x: frame time over the full mesh's, timed side by "

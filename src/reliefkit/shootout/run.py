@@ -36,7 +36,7 @@ def load_meshes(specs: list[str]) -> list:
 
 def size_rows(mesh, chosen, budgets, probes_dir: Path, out: Path, rk_dir: str,
               advance) -> list[dict]:
-    """One row per candidate and budget: the largest knob value whose file fits (the file
+    """One row per candidate and budget: the largest knob value whose GPU bytes fit (the file
     copied into ``out``/``rk_dir``, named in the row relative to ``out``), or why none does;
     then the decimated mesh at every budget."""
     rows, done = [], 0
@@ -53,8 +53,9 @@ def size_rows(mesh, chosen, budgets, probes_dir: Path, out: Path, rk_dir: str,
                 name = f"{rk_dir}/{candidate.label}-{budget}.rk"
                 with atomic_path(out / name) as tmp:
                     shutil.copyfile(found.path, tmp)
-                row |= {"fits": True, "n": found.n, "bytes": (out / name).stat().st_size,
-                        "file": name, "bake_s": found.bake_s}
+                row |= {"fits": True, "n": found.n, "bytes": found.bytes,
+                        "file_bytes": (out / name).stat().st_size, "file": name,
+                        "bake_s": found.bake_s}
             if search:
                 row["probes"] = search.measured()
             rows.append(row)

@@ -1,11 +1,14 @@
 """Each representation sized to a byte budget: the arguments, the candidates and the search.
 
 Every baker that declares a `core.technique.Sizing` stands in for a whole mesh; its one
-resolution knob ``n`` is searched so that the written .rk **file** fits the budget (bytes
-measured with ``stat``, never predicted). The search is deterministic: from the knob's lowest
-value it steps up by the growth the last two probes measured (at most doubling ``n``, so a
-probe overshoots a budget by a bounded factor) until a probe no longer fits, then bisects
-between the largest ``n`` that fits and the smallest that does not, until they are within
+resolution knob ``n`` is searched so that what the written .rk file puts on the GPU fits the
+budget: its arrays read back from the file as a GPU holds them (block-compressed textures
+with their mip chains, `compact.compact.gpu_bytes`), never predicted, so that it is the
+measure the decimated mesh is held to (`scene.decimate.gpu_bytes`, compact). The file's own
+size (deflated: the download) is reported beside it. The search is deterministic: from the
+knob's lowest value it steps up by the growth the last two probes measured (at most
+doubling ``n``, so a probe overshoots a budget by a bounded factor) until a probe no longer
+fits, then bisects between the largest ``n`` that fits and the smallest that does not, until they are within
 `KNOB_TOLERANCE` of each other. Every probe is kept, so the budgets of one run share them.
 """
 
@@ -18,12 +21,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..bake import bake
+from ..compact.compact import gpu_bytes
 from ..core.technique import bakers
 from ..errors import ReliefkitError, UsageError
-from ..io.rk import save
+from ..io.rk import load, save
 
-#: The options every shootout bake gets besides its knob (the one place to change them all).
-BAKE_OPTIONS: dict = {}
+#: The options every shootout bake gets besides its knob (the one place to change them all):
+#: block-compressed textures and 16-bit heights, as an engine ships them.
+BAKE_OPTIONS: dict = {"compress": "bc"}
 
 UNITS = {"": 1, "B": 1, "KB": 2**10, "KIB": 2**10, "MB": 2**20, "MIB": 2**20,
          "GB": 2**30, "GIB": 2**30}
@@ -107,13 +112,19 @@ def unfit_reason(candidate: Candidate, mesh) -> str | None:
     return None
 
 
+def file_gpu_bytes(path) -> int:
+    """Bytes a GPU holds for the representation in the .rk file at ``path``, read back."""
+    return sum(on_gpu for _, on_gpu, _ in gpu_bytes(load(path)).values())
+
+
 @dataclass
 class Probe:
     n: int
-    bytes: int | None = None       # the file's size; None: the bake was refused
+    bytes: int | None = None       # on the GPU, read from the file; None: the bake was refused
     bake_s: float = 0.0
     path: Path | None = None
     error: str | None = None
+    file_bytes: int | None = None  # the file's size on disk
 
 
 @dataclass
@@ -141,7 +152,7 @@ class Search:
             return Probe(n, error=str(error))
         seconds = time.perf_counter() - start
         save(path, rep)
-        return Probe(n, path.stat().st_size, seconds, path)
+        return Probe(n, file_gpu_bytes(path), seconds, path, file_bytes=path.stat().st_size)
 
     def fits(self, n: int, budget: int) -> bool:
         found = self.probe(n)
@@ -186,7 +197,7 @@ class Search:
         return min(hi, max(n + 1, math.floor(n * factor)))
 
     def measured(self) -> list[list[int]]:
-        """[n, file bytes] of every probe so far that baked, by n."""
+        """[n, bytes on the GPU] of every probe so far that baked, by n."""
         return [[n, p.bytes] for n, p in sorted(self.probes.items()) if p.bytes is not None]
 
     def failure(self) -> str:
@@ -194,5 +205,5 @@ class Search:
         lo = self.probe(self.candidate.sizing.lo)
         if lo.error:
             return f"the bake at its smallest ({lo.n}) was refused: {lo.error}"
-        return f"at its smallest ({self.candidate.sizing.knob}: {lo.n}) the file takes " \
-               f"{lo.bytes:,} bytes"
+        return f"at its smallest ({self.candidate.sizing.knob}: {lo.n}) it takes " \
+               f"{lo.bytes:,} bytes on the GPU"

@@ -10,7 +10,7 @@ from __future__ import annotations
 from ...core.technique import Baker, BenchSuite, CompareMetric, CompareVariant, Technique
 from . import render
 from .bake import bake_impostor
-from .bakers import ImpostorParams, bake_octahedral
+from .bakers import ATLAS_SIZING, ImpostorParams, bake_octahedral
 from .codec import CODECS
 from .representation import OctahedralImpostor
 
@@ -73,7 +73,7 @@ TECHNIQUE = Technique(
     representations=(OctahedralImpostor,),
     bakers=(Baker("octahedral-impostor", "N x N orthographic views (colour, normal, depth) "
                   "on a full or hemi octahedral map, in one atlas per channel",
-                  ImpostorParams, bake_octahedral),),
+                  ImpostorParams, bake_octahedral, sizings=(ATLAS_SIZING,)),),
     drawables=(render.drawable_spec(),),
     compare_variants=(CompareVariant("parallax"),
                       CompareVariant("no parallax", {"parallax_steps": 0}),

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...core.params import param
+from ...core.technique import Sizing
 from .bake import bake_impostor
 from .representation import MAX_ATLAS, MAX_GRID
 
@@ -21,6 +22,12 @@ class ImpostorParams:
     padding: int = param(2, "texels around each frame the bounding sphere stays out of "
                          "(dilated colour, no coverage), so filtering and the first mip "
                          "levels never mix frames", kind="int", lo=0, hi=64)
+
+
+#: The shootout sizes an impostor by its atlases' side at the default grid: from 12 texels a
+#: frame (8 of view inside the padding) up.
+ATLAS_SIZING = Sizing("atlas_res: texels on each atlas's side (grid 12)", 12 * 12,
+                      min(4096, MAX_ATLAS), lambda n, mesh: {"atlas_res": n})
 
 
 def bake_octahedral(source, p: ImpostorParams, progress=None):
