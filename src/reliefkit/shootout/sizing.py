@@ -8,8 +8,9 @@ measure the decimated mesh is held to (`scene.decimate.gpu_bytes`, compact). The
 size (deflated: the download) is reported beside it. The search is deterministic: from the
 knob's lowest value it steps up by the growth the last two probes measured (at most
 doubling ``n``, so a probe overshoots a budget by a bounded factor) until a probe no longer
-fits, then bisects between the largest ``n`` that fits and the smallest that does not, until they are within
-`KNOB_TOLERANCE` of each other. Every probe is kept, so the budgets of one run share them.
+fits, then bisects between the largest ``n`` that fits and the smallest that does not,
+until they are within `KNOB_TOLERANCE` of each other. Every probe is kept, so the budgets
+of one run share them.
 """
 
 from __future__ import annotations
