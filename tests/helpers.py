@@ -139,3 +139,15 @@ def assert_same_frames(got, expected) -> None:
             assert x == y, field.name
         else:
             np.testing.assert_array_equal(x, y, err_msg=field.name, strict=True)
+
+
+def frame_of_plans(gl, rep, drawable, plans, camera, light):
+    """The frame ``drawable`` draws of ``rep`` when its plans are ``plans`` (read back from
+    JSON, say), through a Scene on the test context."""
+    from reliefkit.render.draw import Scene
+
+    drawable.plans = plans
+    with Scene(rep, ctx=gl) as scene:
+        scene.drawables = [drawable]
+        scene.executor.upload(plans)
+        return scene.frame(camera, light)

@@ -10,7 +10,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from helpers import sample, technique_samples
+from helpers import frame_of_plans, sample, technique_samples
 
 from reliefkit import render
 from reliefkit.compact.compact import CompressOptions, compress
@@ -177,7 +177,6 @@ def test_a_broken_encoded_member_is_refused_before_allocating(tmp_path, monkeypa
 
 @pytest.mark.parametrize("tech_kind", encoded_samples(), ids="-".join)
 def test_encoded_plans_round_trip_through_json_and_draw_the_same_frame(gl, tech_kind):
-    from reliefkit.render.draw import Scene
     from reliefkit.render.plan import from_json, to_json
     from reliefkit.render.registry import make_drawables
     from reliefkit.scene.light import DirectionalLight
@@ -197,11 +196,7 @@ def test_encoded_plans_round_trip_through_json_and_draw_the_same_frame(gl, tech_
         assert (read.format, read.shape, read.srgb, read.mipmaps, read.scale, read.bias) == \
             (mine.format, mine.shape, mine.srgb, mine.mipmaps, mine.scale, mine.bias)
         np.testing.assert_array_equal(read.data, mine.data)
-    drawable.plans = back
-    with Scene(compact, ctx=gl) as scene:
-        scene.drawables = [drawable]
-        scene.executor.upload(drawable.plans)
-        frame = scene.frame(camera, light)
+    frame = frame_of_plans(gl, compact, drawable, back, camera, light)
     np.testing.assert_array_equal(frame.color, expected.color)
     np.testing.assert_array_equal(frame.depth, expected.depth)
 

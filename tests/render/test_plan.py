@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 import pytest
-from helpers import sample, technique_samples, toy_technique
+from helpers import frame_of_plans, sample, technique_samples, toy_technique
 
 from reliefkit.render import render
 from reliefkit.render.executor import Executor
@@ -85,13 +85,7 @@ def test_plans_read_back_draw_the_same_frame(gl, tech_kind):
     light = DirectionalLight()
     (drawable,) = make_drawables([rep], {})
     expected = render(rep, camera, light=light)
-    drawable.plans = _round_trip(drawable.plans)
-    from reliefkit.render.draw import Scene
-
-    with Scene(rep, ctx=gl) as scene:
-        scene.drawables = [drawable]
-        scene.executor.upload(drawable.plans)
-        frame = scene.frame(camera, light)
+    frame = frame_of_plans(gl, rep, drawable, _round_trip(drawable.plans), camera, light)
     np.testing.assert_array_equal(frame.color, expected.color)
     np.testing.assert_array_equal(frame.depth, expected.depth)
 
