@@ -214,6 +214,7 @@ def test_a_row_is_measured_and_timed_with_its_declared_render_options():
     (["demo:tree", "--budgets", "0KB"], ["--budgets", "outside"]),
     (["demo:tree", "--sizes", "64,huge"], ["--sizes", "huge"]),
     (["demo:tree", "--kinds", "relief-cube,teapot"], ["--kinds", "unknown teapot"]),
+    (["demo:tree", "--kinds", "relief"], ["--kinds", "relief", "cannot be sized"]),
     (["no_such_mesh.obj"], ["no_such_mesh.obj", "no such file"]),
     (["demo:nothing"], ["nothing"]),
     (["thing.rk"], ["mesh file"]),

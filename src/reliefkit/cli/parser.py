@@ -201,8 +201,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=cmd_compare)
 
     p = _command(sub, "shootout", "which representation to ship for a mesh, per size and budget",
-                 "Bake every representation the registry can size so that its .rk file fits "
-                 "each budget, decimate the mesh to the same compact GPU bytes, render both "
+                 "Bake every representation the registry can size so that its bytes on a GPU "
+                 "(textures block-compressed, read back from its .rk file) fit each budget, "
+                 "decimate the mesh to the same compact GPU bytes, render both "
                  "from six views with the bounding sphere spanning each size in pixels, and "
                  "measure them against the full mesh; write shootout.md, shootout.json, a "
                  "Pareto plot and a contact sheet per size, and one recommendation per size "

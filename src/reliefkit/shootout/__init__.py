@@ -1,10 +1,10 @@
 """`reliefkit shootout`: for a mesh, at these screen sizes and byte budgets, what to ship.
 
 Every representation the registry can size (`core.technique.Sizing`) is baked so that its
-.rk file fits each budget (`sizing`), the mesh is decimated to the same compact GPU bytes
-(`scene.decimate`), and both are drawn from fixed views (`views`) and measured against the
-full mesh (`measure`); `report` names the best per size and budget, `plots` draws the Pareto
-plots and contact sheets.
+bytes on a GPU, read back from its .rk file, fit each budget (`sizing`), the mesh is
+decimated to the same compact GPU bytes (`scene.decimate`), and both are drawn from fixed
+views (`views`) and measured against the full mesh (`measure`); `report` names the best per
+size and budget, `plots` draws the Pareto plots and contact sheets.
 """
 
 from __future__ import annotations

@@ -45,7 +45,7 @@ def pareto(results: dict, size: int, path: Path) -> Path:
                     marker="o", label="decimated mesh (compact)", zorder=4)
         for budget in results["budgets"]:
             ax.axvline(budget, color="0.75", lw=0.8, ls=":", zorder=1)
-        ax.set(xscale="log", xlabel="bytes (.rk file; the mesh: compact GPU bytes)",
+        ax.set(xscale="log", xlabel="bytes on a GPU (compact)",
                ylabel="1 - SSIM (mean over the views)",
                title=f"{mesh['name']}: {size} px")
         ax.grid(alpha=0.3)

@@ -48,8 +48,10 @@ def recommendation_line(row: dict | None, size: int, budget: int) -> str:
     figures = (f"SSIM {f['ssim']:.3f}, IoU {f['iou']:.3f}, PSNR {_db(f['psnr'])}, "
                f"{format_bytes(row['bytes'])}")
     if row["label"] == DECIMATED:
-        return (f"{where}: the decimated mesh ({row['n']:,} triangles; {figures}): no "
-                "image-based representation beats it here")
+        what = "the whole mesh" if row.get("whole") else "the decimated mesh"
+        textures = ", textures reduced to fit" if row.get("textures_reduced") else ""
+        return (f"{where}: {what} ({row['n']:,} triangles{textures}, compact; {figures}): "
+                "no image-based representation beats it here")
     return f"{where}: {row['label']} ({row['knob'].split(':')[0]} {row['n']}; {figures})"
 
 

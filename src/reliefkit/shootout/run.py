@@ -76,7 +76,10 @@ def decimated_row(mesh, budget: int) -> dict:
     if small is None:
         return row | {"fits": False, "reason": decimation_floor(mesh)}
     compact, raw = gpu_bytes(small, compact=True), gpu_bytes(small)
+    textures = gpu_bytes(mesh, compact=True)["textures"]
     return row | {"fits": True, "n": small.triangle_count, "vertices": len(small.positions),
+                  "whole": small.triangle_count == mesh.triangle_count,
+                  "textures_reduced": compact["textures"] < textures,
                   "bytes": compact["total"],
                   "raw_bytes": raw["total"], "gpu_bytes": compact,
                   "bake_s": time.perf_counter() - start, "drawn": small}

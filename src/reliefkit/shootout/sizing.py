@@ -87,6 +87,11 @@ def candidates(kinds: list[str] | None = None) -> list[Candidate]:
         return every
     known = {c.label for c in every} | {c.kind for c in every}
     unknown = [k for k in kinds if k not in known]
+    not_sized = [k for k in unknown if k in unsized()]
+    if not_sized:
+        raise UsageError(f"--kinds: {', '.join(not_sized)} cannot be sized to a budget (it "
+                         f"does not stand in for a whole mesh); the shootout's kinds: "
+                         f"{', '.join(sorted(known))}")
     if unknown:
         raise UsageError(f"--kinds: unknown {', '.join(unknown)} (known: "
                          f"{', '.join(sorted(known))})")
