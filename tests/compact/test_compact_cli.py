@@ -43,3 +43,11 @@ def test_bake_takes_compress_by_its_name_as_documented():
 
     rep = bake(make_asset("blob"), "relief-cube", compress="bc", depth_res=16)
     assert encoding_of(rep.parts[0].color) is not None
+
+
+def test_compress_that_changes_nothing_says_so(tmp_path):
+    """A depth object compresses nothing yet: the bake warns instead of a silent no-op."""
+    result = run_cli("bake", "demo:cup", "--as", "depth-object", "--res", "16",
+                     "--compress", "bc", "-o", tmp_path / "c.rk")
+    assert result.returncode == 0
+    assert "--compress bc changed nothing" in result.stderr

@@ -115,8 +115,12 @@ def cmd_bake(args) -> int:
     rep = _bake_input(args)
     source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
     save(args.output, rep, source_hash=source_hash)
+    gpu = _gpu_summary(rep)
     print(f"wrote {args.output}: {_arrays_summary(array_bytes(rep), args.output)}, "
-          f"{format_bytes(Path(args.output).stat().st_size)} on disk{_gpu_summary(rep)}")
+          f"{format_bytes(Path(args.output).stat().st_size)} on disk{gpu}")
+    if given_options(args).get("compress") == "bc" and not gpu:
+        print(f"warning: --compress bc changed nothing: a {args.kind} has no colour, normal "
+              "or height array that is compressed yet (docs/compact.md)", file=sys.stderr)
     for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
         print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
