@@ -235,7 +235,7 @@ def markdown(data: dict) -> str:
     for n, name, ratio in best:
         met = "meets" if ratio <= data["target"] else "misses"
         lines.append(f"{n:,} instances: the fastest against its decimated mesh is {name} at "
-                     f"{ratio:.2f}x, which {met} the target of {data['target']}x.")
+                     f"{ratio:.3g}x, which {met} the target of {data['target']}x.")
     return "\n".join(lines) + "\n"
 
 
