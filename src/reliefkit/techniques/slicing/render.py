@@ -42,7 +42,7 @@ from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...errors import UsageError
 from ...gl.uniforms import box_uniforms
-from ...render.instancing import instance_safe
+from ...render.instancing import instance_safe, per_object
 from ...render.plan import (
     Attribute,
     DrawPlan,
@@ -273,6 +273,8 @@ def ray_cast_view(plan, camera, light, *, cube_to_world, planes, texturing) -> V
                              "texturing": texturing})
 
 
+@per_object("it cuts a new slice stack through the object's own cube for each "
+            "camera")
 def slices_view(plan, camera, light, *, cube_to_world, resolution, slicing, slices, passes,
                 alpha_test, texturing) -> ViewUpdate:
     """View hook of slicing: this frame's slice stack as the vertex and index arrays,
