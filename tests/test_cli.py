@@ -82,7 +82,8 @@ def test_bake_render_info_relief(gl, tmp_path):
     assert stats["fragments"] >= stats["covered"]
     assert stats["iterations_max"] >= stats["iterations_mean"] > 0
     assert_one_line_error(run_cli("render", "demo:tree", "--method", "exact", "-o",
-                                  tmp_path / "m.png"), "--method does not apply", "RenderMesh")
+                                  tmp_path / "m.png"),
+                          "--method does not apply to demo:tree, a mesh")
     assert_one_line_error(run_cli("render", rk, "--method", "magic", "-o", tmp_path / "m.png"),
                           "method must be one of binary, exact, robust")
     assert_one_line_error(run_cli("bake", "demo:tree", "--as", "relief-cube", "--spread", "9",
@@ -190,7 +191,7 @@ def test_values_starting_with_a_dash_parse(gl, tmp_path):
     (["render", "demo:tree", "--background", "2", "-o", "x.png"], ["--background", "[0, 1]"]),
     (["render", "demo:tree", "--background", "grey", "-o", "x.png"], ["--background"]),
     (["render", "demo:tree", "--method", "exact", "-o", "x.png"],
-     ["--method does not apply", "RenderMesh"]),
+     ["--method does not apply to demo:tree, a mesh"]),
     (["render", "demo:tree", "--light", "1", "-o", "x.png"], ["--light", "AZ,EL"]),
     (["render", "demo:tree", "--light", "10,95", "-o", "x.png"], ["--light", "[-90, 90]"]),
     (["render", "demo:tree", "--fov", "0", "-o", "x.png"], ["--fov"]),
@@ -209,6 +210,16 @@ def test_render_options_name_the_typed_flag(gl, small_rk, tmp_path):
     result = run_cli("render", small_rk, "--linear-steps", "0", "-o", tmp_path / "x.png")
     assert_one_line_error(result, "--linear-steps must be within", code=2)
     assert "linear_steps" not in result.stderr
+
+
+def test_a_flag_that_does_not_apply_names_the_kind_not_its_class(gl, tmp_path):
+    rk = tmp_path / "imp.rk"
+    assert run_cli("bake", "demo:blob", "--as", "octahedral-impostor", "--grid", "4",
+                   "--atlas-res", "48", "-o", rk).returncode == 0
+    assert_one_line_error(run_cli("render", rk, "--method", "robust", "-o", tmp_path / "x.png"),
+                          f"--method does not apply to {rk}, an octahedral-impostor .rk", code=2)
+    assert_one_line_error(run_cli("render", rk, "--animate", "2", "-o", tmp_path / "x.png"),
+                          "an octahedral-impostor .rk, has no animation", code=2)
 
 
 def test_bake_refuses_an_rk_input(gl, small_rk, tmp_path):

@@ -16,6 +16,7 @@ from . import metrics, strict_json
 from .builtins import registry
 from .errors import UsageError
 from .io.atomic import atomic_path, written_together
+from .io.inputs import kind_of
 from .io.rk import array_bytes
 from .pictures import TILE_BACKGROUND, contact_sheet, save_image
 from .render import render, render_options
@@ -39,7 +40,7 @@ def compare(mesh, representation, camera, *, light=None, progress=None) -> dict:
     """
     tech = registry().technique_of(representation)
     if tech is None or not tech.compare_variants:
-        raise UsageError(f"nothing to compare: {type(representation).__name__} declares no "
+        raise UsageError(f"nothing to compare: kind {kind_of(representation)!r} declares no "
                          "compare variants")
     variants = [v for v in tech.compare_variants if v.available(representation)]
     advance = progress or (lambda done, total: None)

@@ -36,7 +36,7 @@ THRESHOLD_FLIPS = {"octahedral-impostor": 0.02}
 
 def encoded_samples():
     """(technique, kind) of the samples that hold an array with a role (the others have
-    nothing to compress: the depth object's sample, a shell volume without a surface)."""
+    nothing to compress: a shell volume without a surface)."""
     out = []
     for tech, kind in technique_samples():
         rep = sample(tech, kind)

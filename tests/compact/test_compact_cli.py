@@ -46,8 +46,19 @@ def test_bake_takes_compress_by_its_name_as_documented():
 
 
 def test_compress_that_changes_nothing_says_so(tmp_path):
-    """A depth object compresses nothing yet: the bake warns instead of a silent no-op."""
-    result = run_cli("bake", "demo:cup", "--as", "depth-object", "--res", "16",
-                     "--compress", "bc", "-o", tmp_path / "c.rk")
+    """A shell volume without a material (its 3D textures stay raw) compresses nothing:
+    the bake warns instead of a silent no-op."""
+    result = run_cli("bake", "demo:sphere", "--as", "shell-volume", "--texture", "clouds",
+                     "--texture-size", "16,16,8", "--compress", "bc", "-o", tmp_path / "c.rk")
     assert result.returncode == 0
     assert "--compress bc changed nothing" in result.stderr
+
+
+def test_a_depth_object_compresses_its_colour_and_normals(tmp_path):
+    result = run_cli("bake", "demo:cup", "--as", "depth-object", "--res", "16",
+                     "--compress", "bc", "-o", tmp_path / "c.rk")
+    assert result.returncode == 0 and "changed nothing" not in result.stderr
+    lines = {line.split()[0]: line for line in run_cli("info", tmp_path / "c.rk")
+             .stdout.splitlines() if line.strip()}
+    assert "on the GPU bc7" in lines["color"] and "on the GPU bc7" in lines["normal"]
+    assert "on the GPU raw" in lines["depth"]

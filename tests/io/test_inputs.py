@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import sample, technique_samples, toy_technique
 from PIL import Image
 
 import reliefkit as rk
@@ -85,3 +86,24 @@ def test_info_text_has_the_uv_and_texture_lines(tmp_path, capsys):
     lines = {line.split(":")[0].strip(): line.split(":", 1)[1].strip()
              for line in capsys.readouterr().out.splitlines()}
     assert lines["uvs"] == "True" and lines["textures"] == "2" and lines["materials"] == "3"
+
+
+@pytest.mark.parametrize("tech_kind", [
+    pytest.param(tk, id=":".join(tk)) for tk in technique_samples()])
+def test_messages_name_each_kind_as_its_file_does_not_its_class(gl, tmp_path, tech_kind):
+    from reliefkit.io.inputs import kind_of, load_input, what_it_is
+    from reliefkit.io.rk import read_manifest, save
+
+    with toy_technique():  # a plugged-in kind is named the same way
+        path = save(tmp_path / "x.rk", sample(*tech_kind))
+        obj = load_input(str(path))
+        kind = read_manifest(path)["kind"]
+        assert kind_of(obj) == kind
+        said = what_it_is(str(path), obj)
+    assert said.endswith(f" {kind} .rk") and type(obj).__name__ not in said
+
+
+def test_a_mesh_is_a_mesh():
+    from reliefkit.io.inputs import what_it_is
+
+    assert what_it_is("demo:blob", make_asset("blob")) == "demo:blob, a mesh"

@@ -196,6 +196,21 @@ def test_a_depth_object_drawn_by_slices_is_refused(gl):
                slicing="orthogonal")
 
 
+@pytest.mark.parametrize("technique, kind, reason", [
+    ("billboard", "dmbbc", "it flattens each box and hands it over to the billboard cloud by "
+                           "the object's own distance from the camera"),
+    ("slicing", "displacement", "it cuts new slice polygons through the object's own shell "
+                                "for each camera")])
+def test_a_per_object_view_hook_is_refused_with_a_reason_a_user_reads(gl, technique, kind,
+                                                                      reason):
+    """The hook's declared reason, not its docstring (no ``markup``, no cross-references)."""
+    camera = Camera.orbit((0.0, 0.0, 0.0), 30, 25, 7.0, size=(32, 32))
+    with pytest.raises(NotInstanceable) as info:
+        render(sample(technique, kind), camera, instances=PLACED)
+    assert str(info.value).endswith(f"cannot be drawn instanced: its view hook works per "
+                                    f"object ({reason})")
+
+
 def test_instanced_plans_round_trip_through_json(gl):
     from reliefkit.render.instancing import instanced
     from reliefkit.render.plan import from_json, to_json

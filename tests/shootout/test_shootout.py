@@ -115,6 +115,24 @@ def test_the_knob_is_the_largest_that_fits_within_the_tolerance(runs):
             min(over) <= max(row["n"] + 1, row["n"] * (1 + KNOB_TOLERANCE))
 
 
+def test_the_impostor_joins_a_small_budget_with_a_coarser_grid(tmp_path):
+    """At 24 KB a grid-12 atlas cannot fit (its smallest, 144², takes 76 KB); the impostor
+    takes fewer frames there, and more as the budget grows."""
+    small, large = parse_budgets("24KB,256KB")
+    shootout([lamp()], parse_kinds("octahedral-impostor"), [small, large], parse_sizes("32"),
+             tmp_path)
+    data = json.loads((tmp_path / "shootout.json").read_text())
+    rows = {r["budget"]: r for r in data["meshes"][0]["rows"]
+            if r["label"] == "octahedral-impostor"}
+    grids = {}
+    for budget, row in rows.items():
+        assert row["fits"], row
+        path = tmp_path / row["file"]
+        assert gpu_bytes_from_manifest(path) == row["bytes"] <= budget
+        grids[budget] = read_manifest(path)["params"]["grid"]
+    assert 6 <= grids[small] < 12 and grids[small] <= grids[large]
+
+
 def test_the_decimated_mesh_fits_every_budget_counted_by_hand(runs):
     _, data, _ = runs[0]
     for budget in parse_budgets(BUDGETS):

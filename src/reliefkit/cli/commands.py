@@ -25,7 +25,7 @@ from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
 from ..gl.context import gl_info
 from ..io.atomic import atomic_path, check_writable, written_together
-from ..io.inputs import DEMO_PREFIX, describe, load_input
+from ..io.inputs import DEMO_PREFIX, describe, load_input, what_it_is
 from ..io.rk import array_bytes, file_sha256, load, read_manifest, save
 from ..progress import progress_bar, waiting
 from ..render import Scene, render, render_options
@@ -199,7 +199,7 @@ def cmd_render(args) -> int:
     _check_not_empty(args.input)
     obj = _load(args.input)
     options = applicable(given_options(args), render_options(obj),
-                          f"{args.input}, a {type(obj).__name__}")
+                          what_it_is(args.input, obj))
 
     def draw(camera, msaa=args.msaa, **core):
         return render(obj, camera, light=light, msaa=msaa, **core, **options)
@@ -293,7 +293,7 @@ def _render_turntable(args, bounds, views, elevation, distance, size, background
 def _render_animation(args, obj, camera, draw, background) -> int:
     """``args.animate`` frames of ``obj``'s animation (its ``time`` render option)."""
     if ANIMATION_TIME not in {opt.name for opt in render_options(obj)}:
-        raise UsageError(f"--animate: {args.input} ({type(obj).__name__}) has no animation "
+        raise UsageError(f"--animate: {what_it_is(args.input, obj)}, has no animation "
                          "(no --time option); use --turntable for views around it")
     if given_options(args).get(ANIMATION_TIME) is not None:
         raise UsageError("--animate sets the time of each frame itself: leave out --time")

@@ -10,10 +10,10 @@ import hashlib
 import os
 from pathlib import Path
 
-from ..errors import MeshError, UsageError
+from ..errors import FormatError, MeshError, UsageError
 from ..scene.assets import make_asset
 from ..scene.mesh import RenderMesh
-from .rk import load
+from .rk import codec_of, load
 
 DEMO_PREFIX = "demo:"
 
@@ -52,6 +52,26 @@ def load_mesh(spec: str | os.PathLike, *, name: str | None = None):
 def _is_demo(spec) -> bool:
     """Only a string names a demo asset (a path object is always a file)."""
     return isinstance(spec, str) and spec.startswith(DEMO_PREFIX)
+
+
+def kind_of(obj) -> str:
+    """What users know ``obj`` as: "mesh", or the kind its .rk file names (`bake --as`,
+    `reliefkit info`), not its class; the class only for an object no codec saves."""
+    if isinstance(obj, RenderMesh):
+        return "mesh"
+    try:
+        return codec_of(obj).kind
+    except FormatError:
+        return type(obj).__name__
+
+
+def what_it_is(spec: str, obj) -> str:
+    """``spec`` and its kind for a message: "tree.rk, an octahedral-impostor .rk",
+    "demo:vehicle, a mesh"."""
+    kind = kind_of(obj)
+    article = "an" if kind[:1].lower() in "aeiou" else "a"
+    suffix = " .rk" if kind != "mesh" and str(spec).lower().endswith(".rk") else ""
+    return f"{spec}, {article} {kind}{suffix}"
 
 
 def describe(obj) -> dict:

@@ -16,6 +16,7 @@ already, or has a view hook that works per object (a visibility sort, slice stac
 of detail chosen by distance). A hook whose answer is the same for every instance (box
 matrices relative to the camera) declares it with `instance_safe`; the faces it would cull
 are left to the GPU's back-face culling, which the plan's raster state already asks for.
+Any other hook declares with `per_object` the reason a user reads when it is refused.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ DEFINE = "INSTANCED"
 #: Refused above this: 24 bytes per instance and geometry, allocated before anything is drawn.
 MAX_INSTANCES = 1 << 22
 _SAFE = "instance_safe"
+_PER_OBJECT = "per_object_reason"
 
 
 class NotInstanceable(UsageError):
@@ -43,6 +45,16 @@ def instance_safe(hook):
     keeps it, its face culling left to the GPU's back-face culling)."""
     setattr(hook, _SAFE, True)
     return hook
+
+
+def per_object(reason: str):
+    """Mark a view hook as working per object, with ``reason`` (what it does for each
+    camera, in a user's words) for the message that refuses to draw it instanced."""
+    def mark(hook):
+        setattr(hook, _PER_OBJECT, reason)
+        return hook
+
+    return mark
 
 
 def placements(translations, scales=1.0, yaws=0.0) -> np.ndarray:
@@ -120,10 +132,10 @@ def refuse_unless_instanceable(plan: DrawPlan) -> None:
         refuse(f"its multi-pass kind {plan.multipass.kind!r} draws each object by itself")
     if plan.geometry.instances is not None:
         refuse("its geometry is instanced already (one instance per primitive)")
-    if plan.per_view is not None and not getattr(resolve(plan.per_view.function), _SAFE,
-                                                 False):
-        doc = (resolve(plan.per_view.function).__doc__ or "").strip().split("\n\n")[0]
-        refuse("its view hook works per object (" + " ".join(doc.split()).rstrip(".") + ")")
+    hook = None if plan.per_view is None else resolve(plan.per_view.function)
+    if hook is not None and not getattr(hook, _SAFE, False):
+        reason = getattr(hook, _PER_OBJECT, None)
+        refuse("its view hook works per object" + (f" ({reason})" if reason else ""))
     if DEFINE not in allowed_defines(plan.program.name):
         refuse(f"its program {plan.program.name} has no {DEFINE} variant")
 

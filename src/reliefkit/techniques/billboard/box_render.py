@@ -60,6 +60,7 @@ from ...core.technique import DrawableSpec, ProgramVariant
 from ...core.transforms import invert_box
 from ...errors import UsageError
 from ...gl.uniforms import box_uniforms
+from ...render.instancing import per_object
 from ...render.plan import (
     Attribute,
     DrawPlan,
@@ -264,6 +265,8 @@ def view_lod(camera, flatten: float, lod: dict | None) -> dict:
     return {"lod": "billboard cloud" if cloud else "boxes", "flatten": flatten}
 
 
+@per_object("it flattens each box and hands it over to the billboard cloud by the "
+            "object's own distance from the camera")
 def box_view(plan: DrawPlan, camera, light, *, box_to_world, planes, flatten: float,
              lod: dict | None) -> ViewUpdate:
     """A box from ``camera``: its transforms flattened, in the camera's relative world
@@ -281,6 +284,8 @@ def box_view(plan: DrawPlan, camera, light, *, box_to_world, planes, flatten: fl
     return ViewUpdate(uniforms=uniforms, cull=cull_face(proxy, camera), stats=drawn)
 
 
+@per_object("it draws the flat cloud or the boxes by the object's own distance "
+            "from the camera")
 def cloud_view(plan: DrawPlan, camera, light, *, flatten: float, lod: dict) -> ViewUpdate:
     """The flat cloud of lod auto from ``camera``: drawn only beyond the switch distance."""
     drawn = view_lod(camera, flatten, lod)

@@ -24,10 +24,25 @@ class ImpostorParams:
                          "levels never mix frames", kind="int", lo=0, hi=64)
 
 
-#: The shootout sizes an impostor by its atlases' side at the default grid: from 12 texels a
-#: frame (8 of view inside the padding) up.
-ATLAS_SIZING = Sizing("atlas_res: texels on each atlas's side (grid 12)", 12 * 12,
-                      min(4096, MAX_ATLAS), lambda n, mesh: {"atlas_res": n})
+#: Texels a frame the shootout keeps as it sizes the atlas down: below 24 at grid 12 it
+#: takes fewer frames instead (down to `SIZING_GRIDS`' first), as many texels each.
+SIZING_FRAME_TEXELS = 24
+SIZING_GRIDS = (6, 12)
+
+
+def sizing_grid(atlas_res: int) -> int:
+    """The grid the shootout bakes an atlas of ``atlas_res`` texels a side with: 12 down to
+    `SIZING_FRAME_TEXELS` texels a frame, then fewer frames, never under 6 (12 texels a
+    frame, 8 of view inside the padding, at the smallest atlas)."""
+    lo, hi = SIZING_GRIDS
+    return max(lo, min(hi, atlas_res // SIZING_FRAME_TEXELS))
+
+
+#: The shootout sizes an impostor by its atlases' side; the grid follows (`sizing_grid`), so
+#: the bytes grow with the side and small budgets get a coarser grid.
+ATLAS_SIZING = Sizing("atlas_res: texels on each atlas's side (grid = atlas_res // 24, "
+                      "6 to 12)", SIZING_GRIDS[0] * 12, min(4096, MAX_ATLAS),
+                      lambda n, mesh: {"atlas_res": n, "grid": sizing_grid(n)})
 
 
 def bake_octahedral(source, p: ImpostorParams, progress=None):

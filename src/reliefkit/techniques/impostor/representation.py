@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...compact.encodings import encoding_of
 from ...errors import UsageError
 from ...scene.views import source_box
 
@@ -120,10 +121,20 @@ class OctahedralImpostor:
         return self.color.nbytes + self.normal.nbytes + self.depth.nbytes
 
     def bake_report(self) -> list[str]:
+        """The grid and the atlases as stored (their bytes are on the ``wrote`` line)."""
         f = self.frame
+        stored = ", ".join(f"{what} {_stored_format(array, raw)}" for what, array, raw in (
+            ("colour", self.color, "RGBA8"), ("normals", self.normal, "RGB8"),
+            ("depth", self.depth, "R8")))
         return [f"octahedral impostor: {self.grid} x {self.grid} frames "
                 f"({'hemi' if self.hemi else 'full'} map) of {f} x {f} texels, atlases "
-                f"{self.color.shape[0]}², {self.nbytes / 2**20:.2f} MiB"]
+                f"{self.color.shape[0]}²: {stored}"]
+
+
+def _stored_format(array, raw: str) -> str:
+    """The atlas's encoding (``bc7``, after ``--compress bc``) or ``raw``."""
+    encoded = encoding_of(array)
+    return raw if encoded is None else encoded.format.upper()
 
 
 def _atlas(array, name: str, channels: int | None, side: int | None = None) -> np.ndarray:

@@ -25,6 +25,7 @@ from ...bake.uv_atlas import atlas_uniforms
 from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
+from ...render.instancing import per_object
 from ...render.plan import (
     Attribute,
     DrawPlan,
@@ -280,6 +281,8 @@ def shell_textures(rep: TexturedShell, shell, origin) -> tuple[dict, dict]:
     return textures, uniforms
 
 
+@per_object("it sorts the object's own tetrahedra front to back for each "
+            "camera")
 def visibility_hook(plan, camera, light, *, cells: dict, method: str) -> ViewUpdate:
     """The view hook of a sorted shell: its tetrahedra front to back from ``camera`` as the
     instance order, and the sort's statistics."""

@@ -22,9 +22,9 @@ ARRAYS = {
                        max_size=_TEXELS),
     "mask": ArraySpec(("uint8",), ndim=3, trailing=(None, None), max_size=_TEXELS),
     "color": ArraySpec(("float32",), ndim=4, trailing=(None, None, 4), finite=True,
-                       max_size=4 * _TEXELS),
+                       max_size=4 * _TEXELS, role="color"),
     "normal": ArraySpec(("float32",), ndim=4, trailing=(None, None, 3), finite=True,
-                        max_size=3 * _TEXELS),
+                        max_size=3 * _TEXELS, role="normal"),
     "cube_to_world": ArraySpec(("float64",), ndim=2, trailing=(4, 4), finite=True),
     "source_bounds": SOURCE_BOUNDS,
 }

@@ -27,6 +27,7 @@ from ...bake.uv_atlas import atlas_uniforms
 from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
+from ...render.instancing import per_object
 from ...render.plan import Attribute, DrawPlan, Geometry, Program, Texture, ViewHook, ViewUpdate
 from ...scene.mesh import RenderMesh
 from .displacement import DisplacementMap, DisplacementVolume
@@ -159,6 +160,8 @@ def _map(data: dict) -> DisplacementMap:
                            data["wrap"])
 
 
+@per_object("it cuts new slice polygons through the object's own shell for "
+            "each camera")
 def slices_view(plan, camera, light, *, displacement, layers, volume, slicing, slices,
                 alpha_test) -> ViewUpdate:
     """View hook: this camera's slice polygons (`displacement_slices`) as the vertex

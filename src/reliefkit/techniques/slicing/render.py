@@ -38,11 +38,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...bake.project import axis_frame
+from ...compact.encodings import encoding_of
 from ...core.params import param
 from ...core.technique import DrawableSpec, ProgramVariant
 from ...errors import UsageError
 from ...gl.uniforms import box_uniforms
-from ...render.instancing import instance_safe
+from ...render.instancing import instance_safe, per_object
 from ...render.plan import (
     Attribute,
     DrawPlan,
@@ -207,14 +208,17 @@ class DepthObjectDrawable:
 
 def _textures(images) -> dict:
     """The images as texture arrays (layer k = face k): depth (empty texels at
-    `EMPTY_DEPTH`, nearest texel), premultiplied colour and normals (linear)."""
-    premultiplied = images.color.astype(np.float32)
-    premultiplied[..., :3] *= premultiplied[..., 3:]
+    `EMPTY_DEPTH`), colour (straight alpha, linear) and normals as they are, or as their
+    encodings (`reliefkit.compact`) where compressed: the shader filters the colour and
+    normals itself, premultiplied and masked by the exact depth (texturing.glsl), so an
+    empty texel adds nothing whatever it decodes to."""
     return {"u_depth": Texture(np.where(images.mask, images.depth, np.float32(EMPTY_DEPTH)),
                                "2d_array", filter="nearest", what="depth images"),
-            "u_color": Texture(premultiplied, "2d_array", what="depth-image colours"),
-            "u_normals": Texture(images.normal.astype(np.float32, copy=False), "2d_array",
-                                 what="depth-image normals")}
+            "u_color": Texture(images.color, "2d_array", filter="nearest",
+                               what="depth-image colours", encoded=encoding_of(images.color)),
+            "u_normals": Texture(images.normal, "2d_array", filter="nearest",
+                                 what="depth-image normals",
+                                 encoded=encoding_of(images.normal))}
 
 
 def _box_proxy(box, cube_to_world, near) -> tuple[Proxy, np.ndarray]:
@@ -273,6 +277,8 @@ def ray_cast_view(plan, camera, light, *, cube_to_world, planes, texturing) -> V
                              "texturing": texturing})
 
 
+@per_object("it cuts a new slice stack through the object's own cube for each "
+            "camera")
 def slices_view(plan, camera, light, *, cube_to_world, resolution, slicing, slices, passes,
                 alpha_test, texturing) -> ViewUpdate:
     """View hook of slicing: this frame's slice stack as the vertex and index arrays,

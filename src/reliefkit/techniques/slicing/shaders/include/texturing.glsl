@@ -1,7 +1,8 @@
 // View-dependent texturing of a depth object (§4.2). Include after cube_images.glsl and
 // core:include/camera.glsl.
-uniform highp sampler2DArray u_color;    // premultiplied linear RGBA, layer k = face k
-uniform highp sampler2DArray u_normals;  // world normals
+uniform highp sampler2DArray u_color;    // linear RGBA, straight alpha, layer k = face k
+uniform highp sampler2DArray u_normals;  // world normals, as sampled
+uniform vec2 u_normals_decode;           // (scale, bias) from the sampled value to the normal
 uniform vec3 u_face_normal[6];           // outward world normal of face k
 uniform float u_visible_depth;           // how far behind image k's surface q may lie and
                                          // still be seen by it (cube-side units)
@@ -45,6 +46,28 @@ void image_weights(vec3 q, vec3 towards, out float w[6]) {
 #endif
 }
 
+// Image k's premultiplied colour and normal at f, bilinear over its four nearest texels
+// (clamped to the edge, as GL_LINEAR), each weighted by whether its column is set in the
+// exact depth image: an empty texel adds nothing whatever its colour and normal decode to
+// (block-compressed, a stored 0 decodes near 0 but not to it; docs/compact.md).
+void masked_bilinear(int k, vec2 f, out vec4 color, out vec3 normal) {
+    vec2 p = clamp(f, 0.0, 1.0) * float(u_res) - 0.5;
+    ivec2 base = ivec2(floor(p));
+    vec2 t = p - vec2(base);
+    color = vec4(0.0);
+    normal = vec3(0.0);
+    for (int i = 0; i < 4; ++i) {
+        ivec2 o = ivec2(i & 1, i >> 1);
+        ivec3 texel = ivec3(clamp(base + o, ivec2(0), ivec2(u_res - 1)), k);
+        if (texelFetch(u_depth, texel, 0).r > 1.0) continue;  // empty column
+        float w = (o.x == 1 ? t.x : 1.0 - t.x) * (o.y == 1 ? t.y : 1.0 - t.y);
+        vec4 c = texelFetch(u_color, texel, 0);
+        color += w * vec4(c.rgb * c.a, c.a);
+        normal += w * (texelFetch(u_normals, texel, 0).xyz * u_normals_decode.x
+                       + u_normals_decode.y);
+    }
+}
+
 // Colour (straight alpha) and world normal blended from the images at q.
 void textured(vec3 q, vec3 towards, out vec4 color, out vec3 normal) {
     float w[6];
@@ -53,10 +76,11 @@ void textured(vec3 q, vec3 towards, out vec4 color, out vec3 normal) {
     vec3 n = vec3(0.0);
     for (int k = 0; k < 6; ++k) {
         if (w[k] <= 0.0) continue;
-        vec3 f = face_coords(k, q);
-        vec3 uvl = vec3(clamp(f.xy, 0.0, 1.0), float(k));
-        sum += w[k] * texture(u_color, uvl);
-        n += w[k] * texture(u_normals, uvl).xyz;
+        vec4 c;
+        vec3 nk;
+        masked_bilinear(k, face_coords(k, q).xy, c, nk);
+        sum += w[k] * c;
+        n += w[k] * nk;
     }
     color = sum.a > 0.0 ? vec4(sum.rgb / sum.a, 1.0) : vec4(0.5, 0.5, 0.5, 1.0);
     normal = dot(n, n) > 1e-12 ? normalize(n) : towards;
