@@ -24,6 +24,8 @@ import dataclasses
 
 import numpy as np
 
+from ..compact.blocks import level_bytes
+from ..compact.encodings import texture_bytes as raw_texture_bytes
 from ..io.rk import array_bytes
 from .mesh import RenderMesh, vertex_normals
 
@@ -35,8 +37,6 @@ COLOR_BITS = 8
 COMPACT_VERTEX_BYTES = {"positions": 8, "normals": 4, "uvs": 4, "colors": 4}
 RAW_VERTEX_BYTES = {"positions": 12, "normals": 12, "uvs": 8, "colors": 16}
 UINT16_VERTICES = 1 << 16
-BLOCK_BYTES = {"bc1": 8, "bc7": 16}  # per 4x4 block
-RGBA8_BYTES = 4
 #: A decimated mesh whose textures do not fit gives them at most this share of the budget,
 #: halving them until they do (what an artist trading texels for triangles would do).
 TEXTURE_SHARE = 0.5
@@ -69,14 +69,12 @@ def mip_chain(width: int, height: int) -> list[tuple[int, int]]:
 
 def texture_bytes(image, *, compact: bool) -> int:
     """An (h, w, 4) uint8 texture with its mips: RGBA8, or BC1 / BC7 blocks (BC7 when its alpha
-    is not all opaque)."""
-    h, w = image.shape[:2]
-    levels = mip_chain(w, h)
+    is not all opaque), counted as `reliefkit.compact` stores them."""
     if not compact:
-        return sum(lw * lh * RGBA8_BYTES for lw, lh in levels)
-    opaque = bool((np.asarray(image)[..., 3] == 255).all())
-    block = BLOCK_BYTES["bc1" if opaque else "bc7"]
-    return sum(-(-lw // 4) * -(-lh // 4) * block for lw, lh in levels)
+        return raw_texture_bytes(image, mipmaps=True)
+    h, w = image.shape[:2]
+    fmt = "bc1" if bool((np.asarray(image)[..., 3] == 255).all()) else "bc7"
+    return sum(level_bytes(fmt, lh, lw) for lw, lh in mip_chain(w, h))
 
 
 def gpu_bytes(mesh, *, compact: bool = False) -> dict[str, int]:
