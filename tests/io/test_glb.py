@@ -20,8 +20,9 @@ from reliefkit.io.gltf import glb
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 
 
-def png_bytes() -> bytes:
-    pixels = np.arange(5 * 3 * 4, dtype=np.uint8).reshape(5, 3, 4) * 4
+def png_bytes(side: int | None = None) -> bytes:
+    shape = (side, side, 4) if side else (5, 3, 4)
+    pixels = (np.arange(np.prod(shape)) * 4 % 256).astype(np.uint8).reshape(shape)
     out = io.BytesIO()
     Image.fromarray(pixels, "RGBA").save(out, format="PNG")
     return out.getvalue()
@@ -241,3 +242,30 @@ def test_arrays_glTF_cannot_hold_are_refused():
         builder.add_array(np.zeros(4, np.float64))
     with pytest.raises(FormatError, match="shape"):
         builder.add_array(np.zeros((2, 5), np.float32))
+
+
+# ------------------------------------------------------------------ Khronos validator
+
+
+def test_a_textured_triangle_validates_without_errors_or_warnings(tmp_path):
+    from gltf_validator import problems, validate
+
+    builder = glb.GlbBuilder()
+    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    position = builder.add_array(corners, target=ARRAY_BUFFER, bounds=True)
+    texcoord = builder.add_array(corners[:, :2], target=ARRAY_BUFFER)
+    index = builder.add_array(np.array([0, 1, 2], np.uint16), target=ELEMENT_ARRAY_BUFFER)
+    builder.add_png(png_bytes(side=4))
+    builder.document.update({
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": position,
+                                                   "TEXCOORD_0": texcoord},
+                                    "indices": index, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+                                                "metallicFactor": 0}}],
+        "textures": [{"source": 0}],
+    })
+    path = glb.write_glb(tmp_path / "triangle.glb", *builder.finish())
+    report = validate(path)
+    assert report["issues"]["numErrors"] == 0 and not problems(report), problems(report)
+    assert report["info"]["resources"][0]["storage"] == "glb"
