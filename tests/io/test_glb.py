@@ -269,3 +269,28 @@ def test_a_textured_triangle_validates_without_errors_or_warnings(tmp_path):
     report = validate(path)
     assert report["issues"]["numErrors"] == 0 and not problems(report), problems(report)
     assert report["info"]["resources"][0]["storage"] == "glb"
+
+
+def test_vertex_attribute_rows_are_padded_to_four_bytes(tmp_path):
+    """An RGB uint8 colour per vertex is 3 bytes: glTF wants each vertex's on a 4-byte
+    boundary, so the bufferView gets byteStride 4 (the validator's
+    MESH_PRIMITIVE_ACCESSOR_UNALIGNED otherwise)."""
+    from gltf_validator import problems, validate
+
+    colours = np.array([[255, 0, 0], [0, 255, 0], [0, 0, 255]], np.uint8)
+    builder = glb.GlbBuilder()
+    position = builder.add_array(np.eye(3, dtype=np.float32), target=ARRAY_BUFFER, bounds=True)
+    colour = builder.add_array(colours, target=ARRAY_BUFFER, normalized=True)
+    builder.document.update({
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": position, "COLOR_0": colour}}]}],
+    })
+    path = glb.write_glb(tmp_path / "colours.glb", *builder.finish())
+    gltf = pygltflib.GLTF2().load_binary(str(path))
+    view = gltf.bufferViews[gltf.accessors[colour].bufferView]
+    raw = np.frombuffer(gltf.binary_blob()[view.byteOffset:view.byteOffset + view.byteLength],
+                        np.uint8)
+    assert view.byteStride == 4 and np.array_equal(raw.reshape(3, 4)[:, :3], colours)
+    assert np.array_equal(glb.accessor_array(glb.read_glb(path), colour), colours)
+    report = validate(path)
+    assert report["issues"]["numErrors"] == 0 and not problems(report), problems(report)

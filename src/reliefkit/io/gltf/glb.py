@@ -35,6 +35,7 @@ CHUNK_BIN = 0x004E4942
 DEFAULT_MAX_BYTES = 4 << 30  # as the .rk reader's
 MAX_JSON_BYTES = 64 << 20
 ALIGN = 4
+ARRAY_BUFFER = 34962  # a bufferView's target for vertex attributes
 
 _HEADER = struct.Struct("<4sII")  # magic, version, total length
 _CHUNK = struct.Struct("<II")     # chunk length, chunk type
@@ -68,10 +69,13 @@ class GlbBuilder:
     document: dict = field(default_factory=lambda: {"asset": {"version": "2.0"}})
     _binary: bytearray = field(default_factory=bytearray)
 
-    def add_view(self, data: bytes, *, target: int | None = None) -> int:
+    def add_view(self, data: bytes, *, target: int | None = None,
+                 stride: int | None = None) -> int:
         """Append ``data`` as a bufferView starting on a 4-byte boundary; its index."""
         self._binary.extend(b"\0" * (-len(self._binary) % ALIGN))
         view = {"buffer": 0, "byteOffset": len(self._binary), "byteLength": len(data)}
+        if stride is not None:
+            view["byteStride"] = stride
         if target is not None:
             view["target"] = target
         self._binary.extend(data)
@@ -79,9 +83,10 @@ class GlbBuilder:
 
     def add_array(self, array, *, target: int | None = None, bounds: bool = False,
                   normalized: bool = False) -> int:
-        """Append a 1D (SCALAR) or 2D (n, k) array as a tightly packed bufferView and its
-        accessor; the accessor's index. ``bounds`` writes ``min``/``max`` per component
-        (glTF requires them on POSITION)."""
+        """Append a 1D (SCALAR) or 2D (n, k) array as a bufferView and its accessor; the
+        accessor's index. Rows are tightly packed, except vertex attributes (``target``
+        ARRAY_BUFFER) whose rows are padded to 4 bytes, as glTF requires. ``bounds`` writes
+        ``min``/``max`` per component (glTF requires them on POSITION)."""
         array = np.asarray(array)
         dtype = array.dtype.newbyteorder("<") if array.dtype.byteorder == ">" else array.dtype
         code = _COMPONENT_OF.get(dtype)
@@ -93,8 +98,9 @@ class GlbBuilder:
         if kind is None:
             raise FormatError(f"a glTF accessor takes an (n,) or (n, 1|2|3|4|16) array; "
                               f"got shape {array.shape}")
-        data = np.ascontiguousarray(array, dtype=dtype).tobytes()
-        accessor = {"bufferView": self.add_view(data, target=target), "componentType": code,
+        data, stride = _vertex_rows(np.ascontiguousarray(array, dtype=dtype), target)
+        view = self.add_view(data, target=target, stride=stride)
+        accessor = {"bufferView": view, "componentType": code,
                     "count": int(array.shape[0]), "type": kind}
         if normalized:
             accessor["normalized"] = True
@@ -122,6 +128,18 @@ class GlbBuilder:
     def glb(self) -> bytes:
         """The finished file's bytes."""
         return glb_bytes(*self.finish())
+
+
+def _vertex_rows(array: np.ndarray, target: int | None) -> tuple[bytes, int | None]:
+    """The array's bytes, and the byteStride its bufferView needs: vertex attribute rows
+    (``ARRAY_BUFFER``) of a size not a multiple of 4 are padded with zeros to one."""
+    rows = array.reshape(len(array), -1).view(np.uint8)
+    if target != ARRAY_BUFFER or rows.shape[1] % ALIGN == 0:
+        return array.tobytes(), None
+    stride = rows.shape[1] + (-rows.shape[1] % ALIGN)
+    padded = np.zeros((len(array), stride), np.uint8)
+    padded[:, :rows.shape[1]] = rows
+    return padded.tobytes(), stride
 
 
 def _append(document: dict, key: str, item: dict) -> int:
