@@ -294,3 +294,14 @@ def test_vertex_attribute_rows_are_padded_to_four_bytes(tmp_path):
     assert np.array_equal(glb.accessor_array(glb.read_glb(path), colour), colours)
     report = validate(path)
     assert report["issues"]["numErrors"] == 0 and not problems(report), problems(report)
+
+
+def test_empty_arrays_make_empty_accessors(tmp_path):
+    builder = glb.GlbBuilder()
+    index = builder.add_array(np.zeros((0, 3), np.uint8), target=ARRAY_BUFFER, bounds=True)
+    builder.add_array(np.ones(3, np.float32))
+    path = tmp_path / "empty.glb"
+    path.write_bytes(builder.glb())
+    read = glb.read_glb(path)
+    assert read.document["accessors"][index]["count"] == 0
+    assert glb.accessor_array(read, index).shape == (0, 3)

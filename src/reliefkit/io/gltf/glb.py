@@ -133,12 +133,12 @@ class GlbBuilder:
 def _vertex_rows(array: np.ndarray, target: int | None) -> tuple[bytes, int | None]:
     """The array's bytes, and the byteStride its bufferView needs: vertex attribute rows
     (``ARRAY_BUFFER``) of a size not a multiple of 4 are padded with zeros to one."""
-    rows = array.reshape(len(array), -1).view(np.uint8)
-    if target != ARRAY_BUFFER or rows.shape[1] % ALIGN == 0:
+    row = array.itemsize * (array.shape[1] if array.ndim == 2 else 1)
+    if target != ARRAY_BUFFER or row % ALIGN == 0:
         return array.tobytes(), None
-    stride = rows.shape[1] + (-rows.shape[1] % ALIGN)
+    stride = row + (-row % ALIGN)
     padded = np.zeros((len(array), stride), np.uint8)
-    padded[:, :rows.shape[1]] = rows
+    padded[:, :row] = np.frombuffer(array.tobytes(), np.uint8).reshape(len(array), row)
     return padded.tobytes(), stride
 
 
@@ -160,12 +160,15 @@ def glb_bytes(document: dict, binary: bytes = b"") -> bytes:
                           ensure_ascii=False)
     except ValueError as exc:  # NaN or Inf: not JSON
         raise FormatError(f"the glTF document cannot be written as JSON: {exc}") from None
-    chunks = [(CHUNK_JSON, _padded(text.encode("utf-8"), b" "))]
+    text = text.encode("utf-8")
+    total = _HEADER.size + _CHUNK.size + len(text) + 3 + (
+        _CHUNK.size + len(binary) + 3 if binary else 0)
+    if total >= 1 << 32:  # the header's length field is 32 bits
+        raise FormatError(f"a GLB holds less than 4 GiB; this one would be {total:,} bytes")
+    chunks = [(CHUNK_JSON, _padded(text, b" "))]
     if binary:
         chunks.append((CHUNK_BIN, _padded(bytes(binary), b"\0")))
     total = _HEADER.size + sum(_CHUNK.size + len(data) for _, data in chunks)
-    if total >= 1 << 32:
-        raise FormatError(f"a GLB holds less than 4 GiB; this one would be {total:,} bytes")
     out = [_HEADER.pack(MAGIC, VERSION, total)]
     for kind, data in chunks:
         out += [_CHUNK.pack(len(data), kind), data]
