@@ -147,6 +147,19 @@ def test_bad_alpha_params_in_rk_are_format_errors(tmp_path):
             _mesh_from_arrays(arrays | {"alpha_cutoffs": np.array(bad, np.float32)}, params)
 
 
+@pytest.mark.parametrize("suffix", [".glb", ".gltf"])
+@pytest.mark.parametrize("flag", [False, True])
+def test_gltf_double_sided_reaches_the_material_and_survives_rk(tmp_path, suffix, flag):
+    (material,) = load_mesh(gltf_quad(tmp_path / f"q{suffix}", doubleSided=flag)).materials
+    assert material.double_sided is flag
+    mesh = quad_mesh([Material("a"), Material("b", double_sided=flag)], [0, 1])
+    path = rk.save(tmp_path / "m.rk", mesh)
+    assert ("double_sided" in rk.read_manifest(path)["params"]) is flag
+    assert [m.double_sided for m in rk.load(path).materials] == [False, flag]
+    with pytest.raises(MeshError, match="double_sided"):
+        Material(double_sided="yes")
+
+
 # --- textures that cannot be read: the material colour and one warning, nothing on stderr
 
 

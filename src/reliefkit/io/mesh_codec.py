@@ -12,6 +12,7 @@ the defaults are left out, so older files are valid newer ones and one reader re
   `Material` default, also for files written before alpha modes existed: their texture and
   factor alpha is then ignored, as glTF's default alphaMode says);
 - ``alpha_cutoffs`` (M,) float32 MASK thresholds in [0, 1] (absent: 0.5 each);
+- param ``double_sided``: M booleans (absent: every material single-sided, the default);
 - ``origin`` (3,) float64 world point ``positions`` are relative to (absent: the zero
   vector; `RenderMesh.origin`, set for meshes far from the world origin).
 """
@@ -58,6 +59,8 @@ def _mesh_to_arrays(mesh: RenderMesh) -> tuple[dict[str, np.ndarray], dict]:
         params["alpha_modes"] = [m.alpha_mode for m in materials]
     if any(m.alpha_cutoff != _CUTOFF for m in materials):
         arrays["alpha_cutoffs"] = np.array([m.alpha_cutoff for m in materials], np.float32)
+    if any(m.double_sided for m in materials):
+        params["double_sided"] = [m.double_sided for m in materials]
     for k, m in enumerate(materials):
         if m.texture is None:
             continue
@@ -82,6 +85,9 @@ def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh
     if not isinstance(modes, list) or not all(isinstance(m, str) and m in ALPHA_MODES
                                               for m in modes):
         raise FormatError(f"mesh param 'alpha_modes' must be a list of {', '.join(ALPHA_MODES)}")
+    sides = params.get("double_sided", [False] * count)
+    if not isinstance(sides, list) or not all(isinstance(b, bool) for b in sides):
+        raise FormatError("mesh param 'double_sided' must be a list of booleans")
     cutoffs = arrays.get("alpha_cutoffs")
     if cutoffs is None:
         cutoffs = np.full(count, _CUTOFF, np.float32)
@@ -90,6 +96,7 @@ def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh
     for what, n in (("names in param 'materials'", len(names)),
                     ("modes in param 'alpha_modes'", len(modes)),
                     ("alpha_cutoffs", len(cutoffs)),
+                    ("flags in param 'double_sided'", len(sides)),
                     ("uv_transforms", count if transforms is None else len(transforms))):
         if n != count:
             raise FormatError(f"mesh has {count} material colours but {n} {what}")
@@ -99,7 +106,7 @@ def _mesh_from_arrays(arrays: dict[str, np.ndarray], params: dict) -> RenderMesh
                           f"{textured[-1]}, but the mesh has {count} materials")
     materials = [Material(names[k], colors[k], arrays.get(texture_array_name(k)),
                           None if transforms is None else transforms[k], modes[k],
-                          float(cutoffs[k])) for k in range(count)]
+                          float(cutoffs[k]), sides[k]) for k in range(count)]
     return RenderMesh(arrays["positions"], arrays["indices"], arrays["normals"],
                       arrays["colors"], arrays.get("uvs"), name=name, materials=materials,
                       material=arrays.get("material"), origin=arrays.get("origin", np.zeros(3)))

@@ -42,6 +42,9 @@ class Material:
         alpha 1) or "BLEND" (alpha kept as coverage/opacity).
     alpha_cutoff : float in [0, 1], the MASK threshold (glTF's alphaCutoff, default 0.5);
         kept but unused in the other modes.
+    double_sided : glTF's doubleSided: whether viewers draw the back faces too. reliefkit's
+        renderer draws both sides of every triangle whatever it says; it is kept so a glTF
+        export (a billboard's quads) says what a viewer must do.
     """
 
     name: str = ""
@@ -50,6 +53,7 @@ class Material:
     uv_transform: np.ndarray | None = None
     alpha_mode: str = "OPAQUE"
     alpha_cutoff: float = 0.5
+    double_sided: bool = False
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -82,6 +86,10 @@ class Material:
             raise MeshError(f"{where}: alpha_cutoff must be a number in [0, 1], "
                             f"got {self.alpha_cutoff!r}")
         set_(self, "alpha_cutoff", float(np.float32(cutoff)))  # as stored in .rk files
+        if not isinstance(self.double_sided, (bool, np.bool_)):
+            raise MeshError(f"{where}: double_sided must be True or False, "
+                            f"got {self.double_sided!r}")
+        set_(self, "double_sided", bool(self.double_sided))
 
     def __eq__(self, other) -> bool:
         if not isinstance(other, Material):
@@ -90,7 +98,8 @@ class Material:
                 and _same_or_none(self.texture, other.texture)
                 and _same_or_none(self.uv_transform, other.uv_transform)
                 and self.alpha_mode == other.alpha_mode
-                and self.alpha_cutoff == other.alpha_cutoff)
+                and self.alpha_cutoff == other.alpha_cutoff
+                and self.double_sided == other.double_sided)
 
     __hash__ = None
 

@@ -3,7 +3,8 @@
 sRGB-encoded 8-bit colours are decoded; glTF colours are linear by specification and kept.
 
 Alpha follows each format's rules. glTF: ``alphaMode`` (default OPAQUE: alpha ignored; MASK
-with ``alphaCutoff``, default 0.5; BLEND) becomes `Material.alpha_mode` / `alpha_cutoff`.
+with ``alphaCutoff``, default 0.5; BLEND) becomes `Material.alpha_mode` / `alpha_cutoff`;
+``doubleSided`` becomes `Material.double_sided`.
 OBJ/MTL: alpha comes only from ``d`` (or ``Tr`` = 1 - d, when there is no ``d``; ``Tr 1``, which
 exporters such as MeshLab write for opaque materials, is read as opaque with a warning) and
 ``map_d``; a material with d = 1 and no map_d is OPAQUE (an RGBA ``map_Kd``'s alpha channel
@@ -114,7 +115,8 @@ class SurfaceReader:
             factor = np.ones(4) if factor is None else np.asarray(factor) / 255.0
             mode, cutoff = _gltf_alpha(material)
             return Material(name, factor, self._texture(material.baseColorTexture, name),
-                            alpha_mode=mode, alpha_cutoff=cutoff)
+                            alpha_mode=mode, alpha_cutoff=cutoff,
+                            double_sided=bool(getattr(material, "doubleSided", False)))
         if isinstance(material, trimesh.visual.material.SimpleMaterial):
             image = None if _is_placeholder(material.image) else material.image
             kd = material.kwargs.get("kd")  # present only when the .mtl file gave Kd
