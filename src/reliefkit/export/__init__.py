@@ -1,0 +1,6 @@
+"""glTF export (docs/gltf.md): `export` writes one representation, `export_lod` a mesh and
+its representations as an LOD chain; `reliefkit.load` reads either back."""
+
+from .gltf import DEFAULT_FALLBACK_TRIANGLES, export
+
+__all__ = ["export", "DEFAULT_FALLBACK_TRIANGLES"]
