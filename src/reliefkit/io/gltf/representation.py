@@ -15,6 +15,7 @@ against its shape; then the hashes and finiteness. docs/gltf.md is the specifica
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -26,9 +27,10 @@ from ...errors import FormatError
 from .. import rk
 from .arrays import array_of, declared, put_array
 from .files import read_gltf
-from .glb import DEFAULT_MAX_BYTES, MAGIC, Glb, GlbBuilder, read_glb
+from .glb import DEFAULT_MAX_BYTES, MAGIC, MAX_JSON_BYTES, Glb, GlbBuilder, read_glb
 
 __all__ = ["PREFIX", "extension_name", "representation_extension", "is_gltf", "read_document",
+           "exported_by_reliefkit",
            "reliefkit_nodes", "GltfRepresentation", "read_representation", "load"]
 
 PREFIX = "RELIEFKIT_"
@@ -65,6 +67,27 @@ def is_gltf(path) -> bool:
             return fh.read(4) == MAGIC
     except OSError:
         return False
+
+
+def exported_by_reliefkit(path) -> bool:
+    """Whether a glTF file declares one of reliefkit's extensions (its JSON alone is read;
+    a file that cannot be read says False, and the mesh loader then says why)."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(20)
+            if head[:4] == MAGIC and len(head) == 20:
+                length = int.from_bytes(head[12:16], "little")
+                text = fh.read(min(length, MAX_JSON_BYTES))
+            elif path.suffix.lower() == ".gltf":
+                text = head + fh.read(MAX_JSON_BYTES)
+            else:
+                return False
+        used = json.loads(text.decode("utf-8")).get("extensionsUsed", [])
+    except (OSError, ValueError, AttributeError):
+        return False
+    return isinstance(used, list) and any(isinstance(u, str) and u.startswith(PREFIX)
+                                          for u in used)
 
 
 def read_document(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Glb:
