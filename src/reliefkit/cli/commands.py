@@ -21,9 +21,9 @@ from ..compact.compact import CompressOptions, gpu_bytes
 from ..compare import compare, metrics_markdown, write_comparison
 from ..core.params import ANIMATION_TIME, options_of
 from ..core.technique import baker, bakers, technique_of
-from ..export import export, export_lod
 from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
+from ..export import export, export_lod
 from ..gl.context import gl_info
 from ..io.atomic import atomic_path, check_writable, written_together
 from ..io.inputs import DEMO_PREFIX, describe, kind_of, load_input, what_it_is
