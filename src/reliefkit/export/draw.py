@@ -2,7 +2,8 @@
 
 What `render.plan.to_json` makes of the plans a drawable draws with its default options:
 ``plans``, ``geometries`` and ``textures`` as that JSON, and ``arrays``, each named array as a
-typed reference (`io.gltf.arrays`), vertex attributes and indices also as glTF accessors
+typed reference (`io.gltf.arrays`; uint8 textures as PNG images), vertex attributes and
+indices also as glTF accessors
 (``"accessor": i``) so a viewer's loader reads them as it reads any geometry. With shaders
 embedded, ``programs`` holds the GLSL ES 3.00 sources that reliefkit's shader loader builds
 for every program and define set the plans use (one source of truth with the OpenGL path).
@@ -30,10 +31,10 @@ def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False) -> 
     """The ``draw`` object of ``rep``'s extension (see the module)."""
     (drawable,) = make_drawables([rep], {})
     document, arrays = to_json(drawable.plans)
-    geometry = _geometry_arrays(document)
+    geometry, images = _geometry_arrays(document), _texture_arrays(document)
     refs = {}
     for name, array in arrays.items():
-        ref = put_array(builder, array)
+        ref = put_array(builder, array, png=name in images)
         if name in geometry and _accessor_able(array):
             ref["accessor"] = builder.add_array(array)
         refs[name] = ref
@@ -51,6 +52,13 @@ def _geometry_arrays(document: dict) -> set[str]:
         if isinstance(geometry.get("indices"), dict):
             names.add(geometry["indices"]["array"])
     return names
+
+
+def _texture_arrays(document: dict) -> set[str]:
+    """Texture level 0s: uint8 ones go into PNG images, as the representation's colour does
+    (the same pixels, the same image)."""
+    return {t["array"]["array"] for t in document["textures"].values()
+            if isinstance(t.get("array"), dict)}
 
 
 def _accessor_able(array: np.ndarray) -> bool:
