@@ -177,3 +177,20 @@ def test_failed_exports_leave_no_file(tmp_path, monkeypatch):
         with pytest.raises(ReliefkitError):
             rk.export(rep, locked / "x.glb", fallback=False)
         assert os.listdir(locked) == []
+
+
+@pytest.mark.parametrize("shape", [(5, 7), (5, 7, 1), (5, 7, 2), (5, 7, 3), (3, 5, 7, 4),
+                                   (5, 7, 6), (0, 4)])
+def test_typed_arrays_round_trip_as_png_or_bytes(shape):
+    from reliefkit.io.gltf.arrays import array_of, put_array
+    from reliefkit.io.gltf.glb import Glb
+
+    array = np.random.default_rng(1).integers(0, 256, shape, dtype=np.uint8)
+    builder = GlbBuilder()
+    ref = put_array(builder, array, png=True)
+    assert ("image" in ref) == (len(shape) == 2 and array.size > 0
+                                or len(shape) > 2 and shape[-1] <= 4)
+    document, binary = builder.finish()
+    back = array_of(Glb(document, binary), ref, "test")
+    assert back.dtype == array.dtype and back.shape == array.shape
+    assert back.tobytes() == array.tobytes()

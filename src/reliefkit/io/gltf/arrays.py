@@ -127,7 +127,7 @@ def _from_png(glb: Glb, index, dtype: np.dtype, shape: tuple, where: str) -> np.
         raise FormatError(f"{where}: image {index!r} names no image")
     data = image_bytes(glb, index)
     channels = 1 if len(shape) == 2 else shape[-1]
-    rows = math.prod(shape[:-2]) if len(shape) == 2 else math.prod(shape[:-3]) * shape[-3]
+    rows = shape[0] if len(shape) == 2 else math.prod(shape[:-2])  # leading dims stacked
     width = shape[-1] if len(shape) == 2 else shape[-2]
     if dtype != np.uint8 or len(shape) < 2 or channels not in _PNG_MODES:
         raise FormatError(f"{where}: a PNG holds uint8 (H, W) or (..., H, W, 1-4) arrays, "
