@@ -14,6 +14,7 @@ image) into the document's ``buffers`` / ``bufferViews`` / ``accessors`` / ``ima
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import struct
@@ -26,7 +27,8 @@ from ...errors import FormatError
 from ..atomic import atomic_path
 
 __all__ = ["Glb", "GlbBuilder", "glb_bytes", "write_glb", "read_glb", "accessor_array",
-           "image_bytes", "DEFAULT_MAX_BYTES", "MAX_JSON_BYTES"]
+           "image_bytes", "DEFAULT_MAX_BYTES", "MAX_JSON_BYTES", "ARRAY_BUFFER",
+           "ELEMENT_ARRAY_BUFFER"]
 
 MAGIC = b"glTF"
 VERSION = 2
@@ -36,6 +38,7 @@ DEFAULT_MAX_BYTES = 4 << 30  # as the .rk reader's
 MAX_JSON_BYTES = 64 << 20
 ALIGN = 4
 ARRAY_BUFFER = 34962  # a bufferView's target for vertex attributes
+ELEMENT_ARRAY_BUFFER = 34963  # ... and for indices
 
 _HEADER = struct.Struct("<4sII")  # magic, version, total length
 _CHUNK = struct.Struct("<II")     # chunk length, chunk type
@@ -68,6 +71,7 @@ class GlbBuilder:
 
     document: dict = field(default_factory=lambda: {"asset": {"version": "2.0"}})
     _binary: bytearray = field(default_factory=bytearray)
+    _pngs: dict[bytes, int] = field(default_factory=dict)  # SHA-256 of a PNG -> image
 
     def add_view(self, data: bytes, *, target: int | None = None,
                  stride: int | None = None) -> int:
@@ -111,11 +115,15 @@ class GlbBuilder:
         return _append(self.document, "accessors", accessor)
 
     def add_png(self, png: bytes) -> int:
-        """Append encoded PNG bytes as a bufferView and an image; the image's index."""
+        """Append encoded PNG bytes as a bufferView and an image; the image's index. The
+        same bytes added again are not written twice: their first image's index."""
         if not png.startswith(_PNG_SIGNATURE):
             raise FormatError("add_png takes encoded PNG bytes (no PNG signature found)")
-        image = {"bufferView": self.add_view(png), "mimeType": "image/png"}
-        return _append(self.document, "images", image)
+        digest = hashlib.sha256(png).digest()
+        if digest not in self._pngs:
+            image = {"bufferView": self.add_view(png), "mimeType": "image/png"}
+            self._pngs[digest] = _append(self.document, "images", image)
+        return self._pngs[digest]
 
     def finish(self) -> tuple[dict, bytes]:
         """The document (with ``buffers[0]`` when there is data) and the binary buffer, for
