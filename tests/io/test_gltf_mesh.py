@@ -285,6 +285,7 @@ def test_cutout_textures_are_dilated_into_their_transparent_texels_only(tmp_path
         nearest = seen[distance == distance.min()]
         assert any(np.array_equal(got[row, col, :3], texture[r, c, :3]) for r, c in nearest)
     assert not np.array_equal(got, texture)  # it did change some
+    assert problems(validate(tmp_path / "m.glb")) == []
 
 
 # --------------------------------------------------------------- sharing, sizes, options
@@ -300,6 +301,12 @@ def test_a_second_mesh_in_the_same_file_reuses_images_materials_and_the_sampler(
     assert len(document["textures"]) == 2 and len(document["materials"]) == 4
     assert [p["material"] for p in document["meshes"][0]["primitives"]] == \
         [p["material"] for p in document["meshes"][1]["primitives"]]
+
+
+def test_two_writes_of_a_mesh_are_byte_identical(tmp_path):
+    write(tmp_path / "a.glb", sampler_mesh(1e6))
+    write(tmp_path / "b.glb", sampler_mesh(1e6))
+    assert (tmp_path / "a.glb").read_bytes() == (tmp_path / "b.glb").read_bytes()
 
 
 def test_indices_are_uint32_where_a_primitive_has_more_vertices_than_uint16_reaches(tmp_path):
