@@ -354,22 +354,27 @@ def test_normal_textures_become_normal_texture_references(tmp_path):
 
 
 def test_tangents_point_along_u_and_their_sign_along_v(tmp_path):
-    """Two quads facing +z, u along +x on the first and along -x on the second (mirrored),
-    v along +y on both: glTF's bitangent cross(normal, tangent) * w must point along +v
-    (up in the written image, the normal map's +y) on both."""
-    positions = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
-    positions = np.array(positions + [(x + 2, y, z) for x, y, z in positions], np.float64)
-    uvs = [(0, 0), (1, 0), (1, 1), (0, 1), (1, 0), (0, 0), (0, 1), (1, 1)]
-    faces = [(0, 1, 2), (0, 2, 3), (4, 5, 6), (4, 6, 7)]
-    normals = np.tile([0.0, 0.0, 1.0], (8, 1))
-    mesh = RenderMesh(positions, faces, normals, np.ones((8, 4)), uvs,
-                      materials=(Material("a"), Material("b")), material=[0, 0, 1, 1])
+    """Quads facing +z: u along +x on the first and along -x on the second (mirrored), v
+    along +y on both, so glTF's bitangent cross(normal, tangent) * w must point along +v (up
+    in the written image, the normal map's +y) on both; the third's uvs span nothing, and
+    its tangents are still unit vectors in its plane."""
+    square = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+    positions = np.array([(x + 2 * k, y, z) for k in range(3) for x, y, z in square], float)
+    uvs = [(0, 0), (1, 0), (1, 1), (0, 1), (1, 0), (0, 0), (0, 1), (1, 1)] + [(0.5, 0.5)] * 4
+    faces = [(0, 1, 2), (0, 2, 3), (4, 5, 6), (4, 6, 7), (8, 9, 10), (8, 10, 11)]
+    normals = np.tile([0.0, 0.0, 1.0], (12, 1))
+    mesh = RenderMesh(positions, faces, normals, np.ones((12, 4)), uvs,
+                      materials=(Material("a"), Material("b"), Material("c")),
+                      material=[0, 0, 1, 1, 2, 2])
     bump = np.full((2, 2, 3), 128, np.uint8)
-    gltf = write(tmp_path / "t.glb", mesh, normal_textures={0: bump, 1: bump})
+    gltf = write(tmp_path / "t.glb", mesh, normal_textures={0: bump, 1: bump, 2: bump})
     by_name = primitives_by_material(gltf)
     for name, tangent in (("a", [1, 0, 0, 1]), ("b", [-1, 0, 0, -1])):
         got = accessor(gltf, by_name[name].attributes.TANGENT)
         np.testing.assert_allclose(got, np.tile(tangent, (4, 1)), atol=1e-6, err_msg=name)
+    spanless = accessor(gltf, by_name["c"].attributes.TANGENT)
+    np.testing.assert_allclose(np.linalg.norm(spanless[:, :3], axis=1), 1.0, atol=1e-6)
+    assert np.allclose(spanless[:, 2], 0.0) and set(spanless[:, 3]) <= {-1.0, 1.0}
     assert problems(validate(tmp_path / "t.glb")) == []
 
 

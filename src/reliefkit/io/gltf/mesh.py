@@ -140,10 +140,12 @@ def vertex_tangents(positions: np.ndarray, normals: np.ndarray, uvs: np.ndarray,
         np.add.at(tangent, triangles[:, corner], along_u)
         np.add.at(bitangent, triangles[:, corner], along_v)
     n = np.asarray(normals, np.float64)
+    summed = np.linalg.norm(tangent, axis=1, keepdims=True)
     tangent -= n * (n * tangent).sum(axis=1, keepdims=True)  # into the tangent plane
     length = np.linalg.norm(tangent, axis=1, keepdims=True)
     spare = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]))
-    tangent = np.where(length > 1e-12, tangent / np.maximum(length, 1e-300), spare)
+    usable = length > 1e-6 * summed  # not (nearly) along the normal, whatever the mesh's scale
+    tangent = np.where(usable, tangent / np.maximum(length, 1e-300), spare)
     tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
     w = np.where((np.cross(n, tangent) * bitangent).sum(axis=1) < 0, -1.0, 1.0)
     return np.column_stack([tangent, w]).astype(np.float32)
