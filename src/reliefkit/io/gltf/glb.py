@@ -27,7 +27,8 @@ from ...errors import FormatError
 from ..atomic import atomic_path
 
 __all__ = ["Glb", "GlbBuilder", "glb_bytes", "write_glb", "read_glb", "accessor_array",
-           "image_bytes", "DEFAULT_MAX_BYTES", "MAX_JSON_BYTES"]
+           "image_bytes", "DEFAULT_MAX_BYTES", "MAX_JSON_BYTES", "ARRAY_BUFFER",
+           "ELEMENT_ARRAY_BUFFER"]
 
 MAGIC = b"glTF"
 VERSION = 2
@@ -37,6 +38,7 @@ DEFAULT_MAX_BYTES = 4 << 30  # as the .rk reader's
 MAX_JSON_BYTES = 64 << 20
 ALIGN = 4
 ARRAY_BUFFER = 34962  # a bufferView's target for vertex attributes
+ELEMENT_ARRAY_BUFFER = 34963  # ... and for indices
 
 _HEADER = struct.Struct("<4sII")  # magic, version, total length
 _CHUNK = struct.Struct("<II")     # chunk length, chunk type
@@ -73,15 +75,17 @@ class GlbBuilder:
     #: own named ``{prefix}{k}.png`` beside the document (a .gltf), kept in `files`.
     image_files: str | None = None
     files: dict = field(default_factory=dict)    # uri -> bytes, when image_files is set
-    _views: dict = field(default_factory=dict)   # (sha256, target, stride) -> bufferView
+    _views: dict = field(default_factory=dict)   # (sha256, stride) -> bufferView
     _images: dict = field(default_factory=dict)  # bufferView or uri -> image
 
     def add_view(self, data: bytes, *, target: int | None = None,
                  stride: int | None = None) -> int:
         """Append ``data`` as a bufferView starting on a 4-byte boundary; its index. Bytes
-        already added with the same target and stride are not stored twice: their view's
+        already added without a target, with the same stride, are not stored twice: their view's
         index is returned (an export's draw plans share most arrays with its arrays)."""
-        key = (hashlib.sha256(data).digest(), target, stride)
+        # vertex and index data (a target) is never shared: glTF wants a byteStride on a
+        # view two vertex accessors use
+        key = None if target is not None else (hashlib.sha256(data).digest(), stride)
         if key in self._views:
             return self._views[key]
         self._binary.extend(b"\0" * (-len(self._binary) % ALIGN))
@@ -91,8 +95,10 @@ class GlbBuilder:
         if target is not None:
             view["target"] = target
         self._binary.extend(data)
-        self._views[key] = _append(self.document, "bufferViews", view)
-        return self._views[key]
+        index = append_item(self.document, "bufferViews", view)
+        if key is not None:
+            self._views[key] = index
+        return index
 
     def add_array(self, array, *, target: int | None = None, bounds: bool = False,
                   normalized: bool = False) -> int:
@@ -121,7 +127,7 @@ class GlbBuilder:
             flat = array.reshape(array.shape[0], -1)
             accessor["min"] = [_number(v) for v in flat.min(axis=0)]
             accessor["max"] = [_number(v) for v in flat.max(axis=0)]
-        return _append(self.document, "accessors", accessor)
+        return append_item(self.document, "accessors", accessor)
 
     def add_png(self, png: bytes) -> int:
         """Append encoded PNG bytes as a bufferView and an image; the image's index (the
@@ -138,7 +144,7 @@ class GlbBuilder:
                 self.files[uri] = png
                 image = {"uri": uri, "mimeType": "image/png"}
         if key not in self._images:
-            self._images[key] = _append(self.document, "images", image)
+            self._images[key] = append_item(self.document, "images", image)
         return self._images[key]
 
     def finish(self) -> tuple[dict, bytes]:
@@ -166,7 +172,7 @@ def _vertex_rows(array: np.ndarray, target: int | None) -> tuple[bytes, int | No
     return padded.tobytes(), stride
 
 
-def _append(document: dict, key: str, item: dict) -> int:
+def append_item(document: dict, key: str, item: dict) -> int:
     items = document.setdefault(key, [])
     items.append(item)
     return len(items) - 1
