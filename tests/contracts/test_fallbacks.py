@@ -1,7 +1,7 @@
 """Every registered kind (and the toy's) has a glTF fallback: `fallback_mesh(triangles)`
 returns a RenderMesh with triangles, within the budget where the kind has one, around the
-representation's bounds (a camera-facing card may reach past the box, not far). Each kind's own tests hold its fallback to
-the source mesh (mask IoU >= 0.9 from three views)."""
+representation's bounds (a camera-facing card may reach past the box, not far). Each
+kind's own tests hold its fallback to the source mesh (mask IoU >= 0.9 from three views)."""
 
 from __future__ import annotations
 
