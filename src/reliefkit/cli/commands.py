@@ -146,7 +146,7 @@ def cmd_export(args) -> int:
         with waiting(f"measuring {len(reps)} LOD(s) against the mesh"):
             path, lods = export_lod(mesh, reps, out, source_hash=source_hash, **common)
         for lod in lods:
-            print(f"LOD {lod['lod']}: {lod['kind']:<20} surface error "
+            print(f"LOD {lod['level']}: {lod['kind']:<20} surface error "
                   f"{lod['surface_error']:.4g}, shown from {lod['screen_coverage']:.3g} of "
                   "the screen's height down")
     else:

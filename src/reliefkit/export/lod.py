@@ -81,8 +81,8 @@ def export_lod(mesh, reps, path, *, fallback_triangles: int = DEFAULT_FALLBACK_T
     used.append("MSFT_lod")
     used.sort()
     written = write_document(path, builder, [len(document["nodes"]) - 1])
-    records = [{"lod": 0, "kind": "mesh", "surface_error": 0.0, "screen_coverage": coverages[0]}]
+    records = [{"level": 0, "kind": "mesh", "surface_error": 0.0, "screen_coverage": coverages[0]}]
     for lod, k in enumerate(order, 1):
-        records.append({"lod": lod, "kind": codec_of(reps[k]).kind,
+        records.append({"level": lod, "kind": codec_of(reps[k]).kind,
                         "surface_error": errors[k], "screen_coverage": coverages[lod]})
     return written, records
