@@ -1,8 +1,9 @@
 """What a glTF viewer that knows nothing of relief textures shows: each heightfield as a mesh.
 
-The heightfield is resampled on a grid of vertices spanning the box's bottom face, u and v
-in [0, 1] (bilinear between texel centres, clamped at the border, as the shader samples it),
-with as many cells as the triangle budget allows (no more than the field has texels); each
+The heightfield is resampled on a grid of vertices over the rectangle its non-empty texels
+span (out to the empty texels around them; the whole bottom face of a cube's part), bilinear
+between texel centres and clamped at the border as the shader samples it, with as many
+cells as the triangle budget allows (no more than the rectangle has texels); each
 vertex (u, v, h) is mapped through ``box_to_world``, projective or not. A cell whose corners
 all lie on empty texels (height 0 around them) is left out; a cell beside one keeps the ramp
 down to the floor that the relief draws there too (its walls at the footprint's edge, which
@@ -52,15 +53,29 @@ def grid_cells(width: int, height: int, triangles: int) -> tuple[int, int]:
     return across, down
 
 
-def surface_grid(relief, across: int, down: int) -> tuple[np.ndarray, np.ndarray]:
-    """((down + 1, across + 1, 3) box coordinates (u, v, h) of the grid's vertices, (F, 3)
-    corners of the triangles of its cells that touch a non-empty texel), vertex j * (across
-    + 1) + i at u = i / across, v = j / down."""
+def footprint(height: np.ndarray) -> tuple[np.ndarray, tuple[int, int]]:
+    """((2, 2) box coordinates [[u0, v0], [u1, v1]] of the rectangle the surface spans, (its
+    texels across, down)): the covered texels' rectangle out to the centres of the empty
+    texels around it, where the ramps down to the floor end, within [0, 1]."""
+    h, w = height.shape
+    columns = np.flatnonzero(height.any(axis=0))
+    rows = np.flatnonzero(height.any(axis=1))
+    lo = np.array([columns[0], rows[0]]) - 0.5   # texel coordinates of the empty centres
+    hi = np.array([columns[-1], rows[-1]]) + 1.5
+    size = np.array([w, h])
+    span = np.stack([np.maximum(lo, 0.0), np.minimum(hi, size)]) / size
+    return span, tuple(int(n) for n in np.minimum(hi - lo, size).round())
+
+
+def surface_grid(relief, span, across: int, down: int) -> tuple[np.ndarray, np.ndarray]:
+    """((down + 1, across + 1, 3) box coordinates (u, v, h) of a grid's vertices over
+    ``span`` (`footprint`), (F, 3) corners of the triangles of its cells that touch a
+    non-empty texel), vertex j * (across + 1) + i at the grid's i-th u and j-th v."""
     from ...reference.heightfield import surface_height  # numba: slow to import
 
     w, h = relief.depth_resolution
-    u = np.linspace(0.0, 1.0, across + 1)
-    v = np.linspace(0.0, 1.0, down + 1)
+    u = np.linspace(span[0][0], span[1][0], across + 1)
+    v = np.linspace(span[0][1], span[1][1], down + 1)
     uu, vv = np.meshgrid(u, v)
     heights = surface_height(relief.height, uu * w, vv * h)
     uvh = np.stack([uu, vv, heights], axis=-1)
@@ -75,9 +90,10 @@ def surface_grid(relief, across: int, down: int) -> tuple[np.ndarray, np.ndarray
 def part_mesh(relief, triangles: int):
     """(world positions (V, 3) float64, uvs (V, 2), faces (F, 3)) of one heightfield within
     ``triangles``, cut to its ``clip_bounds``, front faces towards +h."""
-    across, down = grid_cells(*relief.depth_resolution, triangles)
+    span, texels = footprint(relief.height)
+    across, down = grid_cells(*texels, triangles)
     while True:
-        uvh, faces = surface_grid(relief, across, down)
+        uvh, faces = surface_grid(relief, span, across, down)
         uvh = uvh.reshape(-1, 3)
         positions = relief.to_world(uvh)
         if np.linalg.det(relief.box_to_world) < 0:  # a mirroring map turns the winding over
@@ -158,8 +174,9 @@ def _assembled(parts, budgets, name: str) -> RenderMesh:
     positions = np.concatenate(positions)
     faces = np.concatenate(faces)
     if not len(faces):
-        raise UsageError("the heightfield's fallback has no triangle left (empty or clipped "
-                         "away)")
+        raise UsageError(f"a fallback of {sum(budgets)} triangles leaves none of the "
+                         "heightfield (its grid's corners all fall on empty texels, or the "
+                         "clip box cuts it away): allow more triangles")
     materials = [Material(name=f"{name} {k}", texture=relief.color, double_sided=True)
                  for k, relief in enumerate(parts)]
     return RenderMesh(positions, faces, vertex_normals(positions, faces),
