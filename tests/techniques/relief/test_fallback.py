@@ -3,43 +3,19 @@ triangle budget, the colour, the box mapping (projective too) and the clip box."
 
 import numpy as np
 import pytest
-from helpers import BOX, make_relief
+from helpers import BOX, make_relief, terrain_block
 
 import reliefkit as rk
 from reliefkit.io.inputs import load_mesh
 from reliefkit.metrics import mask_iou
 from reliefkit.render import render
 from reliefkit.scene.light import DirectionalLight
-from reliefkit.scene.mesh import RenderMesh, vertex_normals
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.relief.frustum import frustum_matrix
 from reliefkit.techniques.relief.representation import ReliefTexture
 
 VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
 UNLIT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
-
-
-def block(n=40):
-    """A closed terrain block over [-1, 1]^2: a smooth top, four skirts down to y = 0 and a
-    bottom, coloured by x (red), height (green) and z (blue): what a relief texture holds."""
-    x, z = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-1, 1, n))
-    y = 0.35 + 0.15 * np.sin(2.5 * x) * np.cos(1.5 * z) + 0.1 * x * z
-    top = np.stack([x, y, z], -1).reshape(-1, 3)
-    bottom = top * [1, 0, 1]
-    positions = np.concatenate([top, bottom])
-    a = (np.arange(n - 1)[:, None] * n + np.arange(n - 1)).ravel()
-    faces = [np.stack([a, a + n, a + n + 1], 1), np.stack([a, a + n + 1, a + 1], 1)]
-    ring = np.r_[np.arange(n), np.arange(2 * n - 1, n * n, n),  # the top's border, once around
-                 np.arange(n * n - 2, n * n - n - 1, -1), np.arange(n * n - 2 * n, 0, -n)]
-    r0, r1 = ring, np.roll(ring, -1)
-    faces += [np.stack([r0, r1, r1 + n * n], 1), np.stack([r0, r1 + n * n, r0 + n * n], 1)]
-    corners = np.array([0, n - 1, n * n - 1, n * n - n]) + n * n
-    faces += [corners[[0, 2, 1]][None], corners[[0, 3, 2]][None]]
-    faces = np.concatenate(faces)
-    rgb = np.stack([0.2 + 0.3 * (positions[:, 0] + 1), 0.1 + 1.2 * positions[:, 1],
-                    0.2 + 0.3 * (positions[:, 2] + 1)], -1)
-    colors = np.c_[np.clip(rgb, 0, 1), np.ones(len(positions))].astype(np.float32)
-    return RenderMesh(positions, faces, vertex_normals(positions, faces), colors, name="block")
 
 
 def ious(mesh, fallback, size=128):
@@ -49,7 +25,7 @@ def ious(mesh, fallback, size=128):
 
 @pytest.fixture(scope="module")
 def terrain_relief(gl):
-    mesh = block()
+    mesh = terrain_block()
     return mesh, rk.bake(mesh, "relief", depth_res=96)
 
 
@@ -141,7 +117,7 @@ def test_relief_fallback_is_cut_to_the_clip_box(gl):
 
 
 def test_reverse_frustum_fallback_covers_its_mesh(gl):
-    mesh = block()
+    mesh = terrain_block()
     relief = rk.bake(mesh, "relief-frustum", depth_res=96)
     fallback = relief.fallback_mesh()
     assert fallback.triangle_count <= 20_000

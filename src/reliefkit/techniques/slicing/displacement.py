@@ -213,7 +213,7 @@ class DisplacementMap:
         count = len(bary)
         faces = (small[None, :, :] + count * np.arange(len(tris))[:, None, None]).reshape(-1, 3)
         return DisplacedLattice(moved, faces, uvs.reshape(-1, 2),
-                                np.repeat(np.arange(len(tris)), count))
+                                np.repeat(np.arange(len(tris)), count), pts.reshape(-1, 3))
 
     def lattice_colors(self, lattice: DisplacedLattice) -> np.ndarray:
         """(V, 4) linear RGBA at the lattice's vertices as the renderer colours them: the
@@ -288,13 +288,15 @@ class DisplacedLattice:
     """Points of the displaced surface over a lattice of each base triangle.
 
     positions : (V, 3) float64 world; faces : (F, 3) int64; uvs : (V, 2) float64 base uvs;
-    triangle : (V,) int64 the base triangle of each vertex.
+    triangle : (V,) int64 the base triangle of each vertex; base : (V, 3) float64 world, the
+    point on the base each vertex was moved from.
     """
 
     positions: np.ndarray
     faces: np.ndarray
     uvs: np.ndarray
     triangle: np.ndarray
+    base: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
