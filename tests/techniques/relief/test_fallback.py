@@ -9,6 +9,7 @@ import reliefkit as rk
 from reliefkit.io.inputs import load_mesh
 from reliefkit.metrics import mask_iou
 from reliefkit.render import render
+from reliefkit.scene.assets import terrain_heights
 from reliefkit.scene.light import DirectionalLight
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.relief.frustum import frustum_matrix
@@ -78,21 +79,35 @@ def test_fallback_vertices_are_the_projective_box_at_their_heights(gl):
     relief = make_relief(height, box_to_world)
     fallback = relief.fallback_mesh(10_000)
     uv = fallback.uvs.astype(np.float64)
-    assert fallback.triangle_count == 2 * 17 * 12  # no more cells than texels
+    # no more cells than texels, and the walls under the border down to h = 0
+    assert fallback.triangle_count == 2 * 17 * 12 + 2 * 2 * (17 + 12)
     x = np.clip(uv[:, 0] * 17 - 0.5, 0, 16)
     y = np.clip(uv[:, 1] * 12 - 0.5, 0, 11)
     i, j = np.minimum(x.astype(int), 15), np.minimum(y.astype(int), 10)
     fx, fy = x - i, y - j
     h = ((height[j, i] * (1 - fx) + height[j, i + 1] * fx) * (1 - fy)
          + (height[j + 1, i] * (1 - fx) + height[j + 1, i + 1] * fx) * fy)
-    world = np.c_[uv, h, np.ones(len(h))] @ box_to_world.T
-    expected = world[:, :3] / world[:, 3:]
-    np.testing.assert_allclose(fallback.world_positions, expected, atol=2e-6)
+    errors = []
+    for level in (h, np.zeros_like(h)):  # on the surface, or at a wall's foot
+        world = np.c_[uv, level, np.ones(len(h))] @ box_to_world.T
+        errors.append(np.abs(fallback.world_positions - world[:, :3] / world[:, 3:]).max(1))
+    on_top = errors[0] < 2e-6
+    assert (on_top | (errors[1] < 2e-6)).all() and on_top.sum() >= 18 * 13
     # front faces away from the apex (outwards, towards +h)
-    corners = fallback.world_positions[fallback.indices]
+    tops = on_top[fallback.indices].all(axis=1)
+    corners = fallback.world_positions[fallback.indices[tops]]
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     outward = corners.mean(axis=1) - (0.1, -2.0, 0.3)
-    assert ((normal * outward).sum(axis=1) > 0).all()
+    assert tops.sum() >= 2 * 17 * 12 and ((normal * outward).sum(axis=1) > 0).all()
+
+
+def test_heightmap_fallback_has_the_sides_the_relief_draws(gl):
+    """A heightmap fills its box: the relief draws the box's sides under the border."""
+    relief = rk.relief_from_heights(terrain_heights(48))
+    fallback = relief.fallback_mesh()
+    for az, el in VIEWS:
+        camera = orbit_bounds(relief.bounds, az, el, size=(96, 96))
+        assert mask_iou(render(fallback, camera), render(relief, camera)) >= 0.97, (az, el)
 
 
 def test_relief_fallback_is_cut_to_the_clip_box(gl):

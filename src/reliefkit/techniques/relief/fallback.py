@@ -7,7 +7,13 @@ cells as the triangle budget allows (no more than the rectangle has texels); eac
 vertex (u, v, h) is mapped through ``box_to_world``, projective or not. A cell whose corners
 all lie on empty texels (height 0 around them) is left out; a cell beside one keeps the ramp
 down to the floor that the relief draws there too (its walls at the footprint's edge, which
-are the solid's sides seen from below or the side).
+are the solid's sides seen from below or the side; leaving out every cell with an empty
+corner instead took a terrain block's IoU against its mesh from 0.976 / 0.974 / 0.972 to
+0.516 / 0.514 / 0.935, the vehicle's from 0.861 / 0.881 / 0.942 to 0.816 / 0.769 / 0.948).
+Where the surface stands on the grid's
+border (a heightmap fills its box, a cube's part its face) walls go down from it to h = 0,
+the box's sides that the relief draws there: a 96² heightmap's fallback against its relief,
+mask IoU 0.797 / 0.799 / 0.980 without them, 0.999 / 0.999 / 1.000 with them.
 
 A relief object's parts keep only the outermost surface along their rays and fill what lies
 behind with steep walls (radial curtains, docs/relief.md). The fallback keeps them: leaving
@@ -15,6 +21,9 @@ out the triangles within 12 degrees of a part's rays lowered the blob cube's mas
 against its mesh from 0.937 / 0.945 / 0.812 to 0.879 / 0.907 / 0.695 (three views), as a
 steep cut cannot tell a curtain from a surface every part sees at a grazing angle (the
 blob's ring).
+
+Cut to ``clip_bounds``, the cut is left open: a bake's clip box lies around its mesh, where
+only the floor's walls could reach it.
 
 The result is open below (a relief texture knows only its top) and double-sided, so a viewer
 shows the colour under it as the relief does from below.
@@ -87,14 +96,34 @@ def surface_grid(relief, span, across: int, down: int) -> tuple[np.ndarray, np.n
     return uvh, faces[(flat[faces] > 0.0).any(axis=1)]
 
 
+def side_walls(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((4K, 3) box coordinates, (2K, 3) corners) of the walls from a grid's border down to
+    h = 0, where the surface stands on the border (a field that fills its box, a cube's
+    part): the sides of the box that the relief draws there. Each wall has its own four
+    corners and faces out of the grid."""
+    # the border once around, counter-clockwise seen from +h: the inside on the left
+    loop = np.concatenate([grid[0, :-1], grid[:-1, -1], grid[-1, ::-1][:-1],
+                           grid[::-1, 0][:-1]])
+    a, b = loop, np.roll(loop, -1, axis=0)
+    standing = (a[:, 2] > 0.0) | (b[:, 2] > 0.0)
+    a, b = a[standing], b[standing]
+    floor = np.array([1.0, 1.0, 0.0])
+    corners = np.stack([b, a, a * floor, b * floor], axis=1).reshape(-1, 3)
+    k = 4 * np.arange(len(a))[:, None]
+    return corners, np.concatenate([np.concatenate([k, k + 1, k + 2], 1),
+                                    np.concatenate([k, k + 2, k + 3], 1)])
+
+
 def part_mesh(relief, triangles: int):
     """(world positions (V, 3) float64, uvs (V, 2), faces (F, 3)) of one heightfield within
     ``triangles``, cut to its ``clip_bounds``, front faces towards +h."""
     span, texels = footprint(relief.height)
     across, down = grid_cells(*texels, triangles)
     while True:
-        uvh, faces = surface_grid(relief, span, across, down)
-        uvh = uvh.reshape(-1, 3)
+        grid, faces = surface_grid(relief, span, across, down)
+        wall_uvh, wall_faces = side_walls(grid)
+        uvh = np.concatenate([grid.reshape(-1, 3), wall_uvh])
+        faces = np.concatenate([faces, wall_faces + grid.shape[0] * grid.shape[1]])
         positions = relief.to_world(uvh)
         if np.linalg.det(relief.box_to_world) < 0:  # a mirroring map turns the winding over
             faces = faces[:, ::-1]
@@ -103,7 +132,7 @@ def part_mesh(relief, triangles: int):
             positions, uvs, faces = clipped(positions, uvs, faces, relief.clip_bounds)
         if len(faces) <= triangles or (across == 1 and down == 1):
             return positions, uvs, faces
-        # clipping cut triangles in two: a coarser grid leaves room for them
+        # the walls, and clipping's triangles cut in two: a coarser grid leaves room
         shrink = np.sqrt(triangles / len(faces))
         across, down = max(1, int(across * shrink)), max(1, int(down * shrink))
 
