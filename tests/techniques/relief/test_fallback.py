@@ -149,3 +149,14 @@ def test_relief_cube_fallback_covers_its_mesh(gl):
     assert fallback.triangle_count <= 20_000
     assert min(ious(mesh, fallback)) >= 0.9
     assert 2500 <= rep.fallback_mesh(3000).triangle_count <= 3000
+
+
+def test_too_small_a_budget_is_refused_in_words(gl):
+    from reliefkit.errors import UsageError
+    from reliefkit.techniques.relief.representation import ReliefObject
+
+    relief = make_relief(np.full((8, 8), 0.5, np.float32))
+    with pytest.raises(UsageError, match="at least 12 triangles, got 7"):
+        ReliefObject(parts=[relief] * 6).fallback_mesh(7)
+    with pytest.raises(UsageError, match="at least 2 triangles"):
+        relief.fallback_mesh(1)

@@ -44,8 +44,12 @@ def relief_fallback(relief, triangles: int) -> RenderMesh:
 
 def relief_object_fallback(obj, triangles: int) -> RenderMesh:
     """The parts of a relief object, ``triangles`` shared out by the parts' texels."""
+    if triangles < 2 * len(obj.parts):
+        raise UsageError(f"a fallback of a relief object's {len(obj.parts)} parts needs at "
+                         f"least {2 * len(obj.parts)} triangles, got {triangles}")
     texels = np.array([p.height.size for p in obj.parts], np.float64)
-    shares = np.floor(triangles * texels / texels.sum()).astype(int)
+    spare = triangles - 2 * len(obj.parts)  # two each, the rest by texels
+    shares = 2 + np.floor(spare * texels / texels.sum()).astype(int)
     return _assembled(obj.parts, list(shares), name="relief object fallback")
 
 
