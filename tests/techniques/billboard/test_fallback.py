@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from reliefkit.colorspace import srgb_decode
+from reliefkit.errors import UsageError
 from reliefkit.io.inputs import load_mesh
 from reliefkit.render import render
 from reliefkit.scene.camera import Camera
@@ -124,6 +125,9 @@ def test_the_normal_map_is_tangent_space_along_u_and_v():
     assert np.abs(texture[:, :4, :3] - encode([0.0, 0.8, 0.6])).max() <= 1
     assert np.abs(texture[:, 4:, :3] - encode([1.0, 0.0, 0.0])).max() <= 1
     np.testing.assert_array_equal(fallback_tangents(cloud), np.tile([0, 0, -1, 1], (4, 1)))
+    for page in (1, -1, True):
+        with pytest.raises(UsageError, match="page must be an atlas page of the cloud, 0..0"):
+            fallback_normal_texture(cloud, page)
 
 
 @pytest.fixture(scope="module")

@@ -13,9 +13,11 @@ The stored world normals become a tangent-space normal map per page
 (`fallback_normal_texture`), in glTF's convention: a texel's (x, y, z) are the normal's
 components along the quad's tangent T = normalize(u_axis) (increasing u), its bitangent
 B = N x T and its plane normal N = normalize(u_axis x v_axis). B points along v_axis
-(increasing v in reliefkit's uvs, up in the image as glTF's normal maps expect) when the
-rectangle's sides are perpendicular, as baked ones are; `fallback_tangents` gives T with
-w = +1 per vertex (glTF's TANGENT), so a viewer needs no MikkTSpace guess.
+(increasing v in reliefkit's uvs) when the rectangle's sides are perpendicular, as baked
+ones are: up in the picture, as glTF's normal maps expect, once the image is written
+upright (reliefkit's row 0 is v = 0, the bottom; glTF's row 0 is the top, v = 0 there).
+`fallback_tangents` gives T with w = +1 per vertex (glTF's TANGENT), so a viewer need not
+derive the frame itself.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...bake.project import dilate
+from ...errors import UsageError
 from ...scene.mesh import Material, RenderMesh
 from .quads import quad_attributes, quad_indices
 
@@ -65,6 +68,11 @@ def fallback_normal_texture(rep, page: int = 0) -> np.ndarray:
     (linear, (n + 1) / 2 * 255, alpha 255), in each quad's frame of `fallback_tangents`;
     dilated as the colour is."""
     cloud = cloud_of(rep)
+    pages = cloud.normal.shape[0]
+    if isinstance(page, bool) or not isinstance(page, int | np.integer) \
+            or not 0 <= page < pages:
+        raise UsageError(f"page must be an atlas page of the cloud, 0..{pages - 1}, "
+                         f"got {page!r}")
     tangent, bitangent, normal = _tangent_frames(cloud)
     encoded = np.empty(cloud.normal.shape[1:], np.uint8)
     encoded[...] = (128, 128, 255)  # flat, where nothing is shown
