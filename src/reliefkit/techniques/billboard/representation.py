@@ -8,7 +8,9 @@ import numpy as np
 
 from ...core.transforms import MAX_COORDINATE
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
+from . import fallback
 
 #: Texels left empty around every rectangle in the atlas, so that bilinear and mipmapped
 #: lookups near a rectangle's border never read its neighbour.
@@ -105,6 +107,13 @@ class BillboardCloud:
     @property
     def center(self) -> np.ndarray:
         return self.bounds.mean(axis=0)
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the rectangles as quads
+        textured with the atlas pages (one material each), alpha-tested at the renderer's 0.5
+        (MASK), double-sided. Always 2 triangles per rectangle, whatever ``triangles`` says:
+        the count is the cloud's. Its normal maps: `fallback.fallback_normal_texture`."""
+        return fallback.fallback_mesh(self)
 
     def memory_bytes(self) -> dict:
         """Bytes of each stored array (the atlases dominate)."""
