@@ -145,10 +145,12 @@ def cmd_export(args) -> int:
         source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
         with waiting(f"measuring {len(reps)} LOD(s) against the mesh"):
             path, lods = export_lod(mesh, reps, out, source_hash=source_hash, **common)
+        upper = 1.0
         for lod in lods:
             print(f"LOD {lod['level']}: {lod['kind']:<20} surface error "
-                  f"{lod['surface_error']:.4g}, shown from {lod['screen_coverage']:.3g} of "
-                  "the screen's height down")
+                  f"{lod['surface_error']:.4g}, shown while it covers "
+                  f"{lod['screen_coverage']:.3g} to {upper:.3g} of the screen's height")
+            upper = lod["screen_coverage"]
     else:
         if given:
             flags = ", ".join("--" + k.replace("_", "-") for k in given)
@@ -183,13 +185,12 @@ def _bake_lods(args, given: dict):
         raise UsageError(f"export --lod needs a mesh (a mesh file or demo:NAME), not "
                          f"{what_it_is(args.input, source)}")
     reps = []
-    with progress_bar(f"baking {len(kinds)} LOD(s)", len(kinds)) as advance:
-        for kind in kinds:
-            params = applicable({k: v for k, v in given.items()
-                                 if k in {o.name for o in table[kind][1].options}},
-                                table[kind][1].options, f"--lod {kind}")
-            reps.append(bake(source, kind, compress=compression, **params))
-            advance()
+    for kind in kinds:
+        params = applicable({k: v for k, v in given.items()
+                             if k in {o.name for o in table[kind][1].options}},
+                            table[kind][1].options, f"--lod {kind}")
+        with progress_bar(f"baking {kind}", 1) as advance:
+            reps.append(bake(source, kind, progress=advance, compress=compression, **params))
     return source, reps
 
 

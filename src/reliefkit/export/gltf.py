@@ -73,7 +73,9 @@ def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
     document = builder.document
     if fallback:
         mesh = fallback_of(rep, fallback_triangles)
-        child = add_render_mesh(builder, mesh, name=f"{node['name']} (fallback)")
+        maps = getattr(rep, "fallback_normal_maps", dict)()
+        child = add_render_mesh(builder, mesh, name=f"{node['name']} (fallback)",
+                                normal_textures=maps)
         document.setdefault("nodes", []).append(child)
         node["children"] = [len(document["nodes"]) - 1]
     document.setdefault("nodes", []).append(node)

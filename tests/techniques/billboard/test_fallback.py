@@ -16,7 +16,14 @@ from reliefkit.scene.camera import Camera
 from reliefkit.scene.light import DirectionalLight
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.billboard import TECHNIQUE, bake_billboard_cloud, bake_boxes
-from reliefkit.techniques.billboard.fallback import fallback_normal_texture, fallback_tangents
+from reliefkit.io.gltf.mesh import vertex_tangents
+from reliefkit.techniques.billboard.fallback import fallback_normal_texture
+
+
+def fallback_tangents(rep):
+    """The TANGENTs the glTF writer gives the fallback's vertices."""
+    mesh = rep.fallback_mesh()
+    return vertex_tangents(mesh.positions, mesh.normals, mesh.uvs, mesh.indices)
 from reliefkit.techniques.billboard.representation import BillboardCloud
 
 FLAT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour

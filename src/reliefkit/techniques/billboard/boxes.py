@@ -118,6 +118,10 @@ class BillboardBoxes:
         (`BillboardCloud.fallback_mesh`: 2 triangles per box, a fixed count)."""
         return self.cloud.fallback_mesh(triangles)
 
+    def fallback_normal_maps(self) -> dict:
+        """The normal maps of ``cloud``'s fallback, per material."""
+        return self.cloud.fallback_normal_maps()
+
     def memory_bytes(self) -> dict:
         """Bytes per map as in the paper's Table 2: colour, normals, distance textures (and
         the displacements of the shells); the flat cloud's atlases separately."""

@@ -16,8 +16,8 @@ B = N x T and its plane normal N = normalize(u_axis x v_axis). B points along v_
 (increasing v in reliefkit's uvs) when the rectangle's sides are perpendicular, as baked
 ones are: up in the picture, as glTF's normal maps expect, once the image is written
 upright (reliefkit's row 0 is v = 0, the bottom; glTF's row 0 is the top, v = 0 there).
-`fallback_tangents` gives T with w = +1 per vertex (glTF's TANGENT), so a viewer need not
-derive the frame itself.
+The glTF writer derives each vertex's TANGENT from the uvs (`io.gltf.mesh.vertex_tangents`):
+T with w = +1 on every quad, so a viewer need not derive the frame itself.
 """
 
 from __future__ import annotations
@@ -56,17 +56,17 @@ def fallback_mesh(rep) -> RenderMesh:
                       material=np.repeat(cloud.rects[:, 0], 2), origin=cloud.center)
 
 
-def fallback_tangents(rep) -> np.ndarray:
-    """(4P, 4) float32 glTF TANGENT of `fallback_mesh`'s vertices: the quad's T, w = +1."""
-    tangent, _, _ = _tangent_frames(cloud_of(rep))
-    rows = np.concatenate([tangent, np.ones((len(tangent), 1))], axis=1)
-    return np.repeat(rows, 4, axis=0).astype(np.float32)
+def fallback_normal_maps(rep) -> dict[int, np.ndarray]:
+    """Material (atlas page) -> its `fallback_normal_texture`: what the glTF export writes as
+    each material's normalTexture."""
+    return {page: fallback_normal_texture(rep, page)
+            for page in range(cloud_of(rep).normal.shape[0])}
 
 
 def fallback_normal_texture(rep, page: int = 0) -> np.ndarray:
     """(h, w, 4) uint8 tangent-space normal map of material ``page`` of `fallback_mesh`
-    (linear, (n + 1) / 2 * 255, alpha 255), in each quad's frame of `fallback_tangents`;
-    dilated as the colour is."""
+    (linear, (n + 1) / 2 * 255, alpha 255), in each quad's frame (T, N x T, N); dilated
+    as the colour is."""
     cloud = cloud_of(rep)
     pages = cloud.normal.shape[0]
     if isinstance(page, bool) or not isinstance(page, int | np.integer) \

@@ -112,8 +112,12 @@ class BillboardCloud:
         """What a glTF viewer that knows nothing of reliefkit shows: the rectangles as quads
         textured with the atlas pages (one material each), alpha-tested at the renderer's 0.5
         (MASK), double-sided. Always 2 triangles per rectangle, whatever ``triangles`` says:
-        the count is the cloud's. Its normal maps: `fallback.fallback_normal_texture`."""
+        the count is the cloud's."""
         return fallback.fallback_mesh(self)
+
+    def fallback_normal_maps(self) -> dict:
+        """The fallback's tangent-space normal map per material (atlas page)."""
+        return fallback.fallback_normal_maps(self)
 
     def memory_bytes(self) -> dict:
         """Bytes of each stored array (the atlases dominate)."""
