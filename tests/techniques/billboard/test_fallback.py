@@ -10,21 +10,22 @@ import pytest
 
 from reliefkit.colorspace import srgb_decode
 from reliefkit.errors import UsageError
+from reliefkit.io.gltf.mesh import vertex_tangents
 from reliefkit.io.inputs import load_mesh
 from reliefkit.render import render
 from reliefkit.scene.camera import Camera
 from reliefkit.scene.light import DirectionalLight
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.billboard import TECHNIQUE, bake_billboard_cloud, bake_boxes
-from reliefkit.io.gltf.mesh import vertex_tangents
 from reliefkit.techniques.billboard.fallback import fallback_normal_texture
+from reliefkit.techniques.billboard.representation import BillboardCloud
 
 
 def fallback_tangents(rep):
     """The TANGENTs the glTF writer gives the fallback's vertices."""
     mesh = rep.fallback_mesh()
     return vertex_tangents(mesh.positions, mesh.normals, mesh.uvs, mesh.indices)
-from reliefkit.techniques.billboard.representation import BillboardCloud
+
 
 FLAT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
 VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
