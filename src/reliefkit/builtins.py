@@ -28,7 +28,7 @@ from .render import render as _render
 from .render.mesh import MESH_DRAWABLE
 from .techniques import TECHNIQUES
 
-__all__ = ["registry", "bake", "load", "render", "save"]
+__all__ = ["registry", "bake", "load", "render", "save", "export"]
 
 _lock = threading.Lock()
 _filled = False
@@ -65,7 +65,14 @@ def _load(path, **kwargs):
     return rk.load(path, **kwargs)
 
 
+def _export(rep, path, **kwargs):
+    from .export import export  # the draw plans' modules: imported when exporting
+
+    return export(rep, path, **kwargs)
+
+
 bake = _with_builtins(_bake)
 load = _with_builtins(_load)
+export = _with_builtins(_export)
 render = _with_builtins(_render)
 save = _with_builtins(rk.save)

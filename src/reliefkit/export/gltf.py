@@ -16,7 +16,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import __version__
-from ..builtins import registry
 from ..errors import FormatError, UsageError
 from ..io import rk
 from ..io.gltf.files import gltf_builder, write_gltf
@@ -110,7 +109,6 @@ def export(rep, path, *, fallback: bool = True,
     embed_shaders : add the GLSL ES sources of the draw plans' programs.
     source_hash : SHA-256 of the source file (as in .rk files).
     """
-    registry()  # the kinds and drawables, when called before any other public function
     if type(fallback_triangles) is not int or fallback_triangles < 2:
         raise UsageError(f"fallback_triangles must be an integer >= 2, got {fallback_triangles!r}")
     builder = builder_for(path)

@@ -25,8 +25,8 @@ from ..io.gltf.mesh import add_render_mesh
 from ..io.rk import codec_of
 from ..metrics import compare
 from ..render import render
+from ..scene.sphere_views import cameras
 from ..scene.views import bounds_radius
-from ..shootout.views import cameras
 from .gltf import DEFAULT_FALLBACK_TRIANGLES, builder_for, representation_node, write_document
 
 __all__ = ["export_lod", "surface_error", "screen_coverages", "MEASURE_SIZE", "SCREEN_HEIGHT"]
