@@ -1,12 +1,14 @@
 """``reliefkit bench export``: what a glTF export of each kind weighs, costs and shows.
 
 Each demo asset is baked by every registered baker that takes a mesh, with its defaults (a
-baker that refuses the asset is a row saying why), and exported (`reliefkit.export`). Per
-kind: the .rk file's bytes against the .glb's (with its draw plans, without shaders), the
-export's time, the fallback mesh's triangles, and how the fallback and the representation
-each cover what the mesh covers (mask IoU from three views at 128 x 128, the fallback drawn
-by reliefkit's mesh renderer: what a viewer without reliefkit's extension shows). With
-``--quick``: one asset, the first baker.
+baker that refuses the asset is a row saying why), raw and with ``--compress bc`` (a glTF
+file holds arrays uncompressed, so block-compressed textures are what shrinks it), and
+exported (`reliefkit.export`). Per kind: the .rk file's bytes (deflated) against the
+.glb's (with its draw plans, without shaders), the export's time, the fallback mesh's
+triangles, and how the fallback and the representation each cover what the mesh covers
+(mask IoU from three views at 128 x 128, the fallback drawn by reliefkit's mesh renderer:
+what a viewer without reliefkit's extension shows). With ``--quick``: one asset, the first
+baker.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from .report import machine, machine_line, write_report
 ASSETS = ("vehicle", "tree", "blob", "torus")
 VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
 SIZE = (128, 128)
+TEXTURES = (("raw", {}), ("bc", {"compress": "bc"}))
 
 
 def run_suite(quick: bool, out: Path, log) -> tuple[str, list[Path]]:
@@ -41,13 +44,14 @@ def run_suite(quick: bool, out: Path, log) -> tuple[str, list[Path]]:
         cameras = [orbit_bounds(mesh.bounds, az, el, size=SIZE) for az, el in VIEWS]
         truths = render(mesh, cameras)
         for kind in kinds[:1] if quick else kinds:
-            log(f"{asset}: {kind}")
-            try:
-                rep = bake(mesh, kind)
-            except UsageError as exc:  # a shell volume of a mesh without uvs, say
-                rows.append({"asset": asset, "kind": kind, "refused": str(exc)})
-                continue
-            rows.append(_row(asset, kind, rep, cameras, truths))
+            for textures, compress in TEXTURES:
+                log(f"{asset}: {kind}, {textures}")
+                try:
+                    rep = bake(mesh, kind, compress=compress)
+                except UsageError as exc:  # a shell volume of a mesh without uvs, say
+                    rows.append({"asset": asset, "kind": kind, "refused": str(exc)})
+                    break
+                rows.append({"textures": textures, **_row(asset, kind, rep, cameras, truths)})
     data = {"views": VIEWS, "size": SIZE, "machine": machine(),
             "fallback_triangles": DEFAULT_FALLBACK_TRIANGLES, "rows": rows}
     return _markdown(data), write_report(out, "export", data, _markdown)
@@ -72,16 +76,18 @@ def _markdown(data: dict) -> str:
     views = ", ".join(f"{az:g}/{el:g}" for az, el in data["views"])
     lines = [f"# glTF export: bytes, time and what a viewer shows ({len(data['views'])} views "
              f"at {size[0]}x{size[1]}: {views})", "", machine_line(data["machine"]), "",
-             "| asset | kind | .rk file | .glb | export | fallback triangles | fallback IoU "
-             "(per view) | representation IoU |", "|---|---|---|---|---|---|---|---|"]
+             "| asset | kind | textures | .rk file | .glb | export | fallback triangles | "
+             "fallback IoU (per view) | representation IoU |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in data["rows"]:
         if "refused" in r:
             lines.append(f"| {r['asset']} | {r['kind']} | refused: {r['refused']} "
-                         "| | | | | |")
+                         "| | | | | | |")
             continue
         fallback = " / ".join(f"{v:.3f}" for v in r["fallback_iou"])
         own = " / ".join(f"{v:.3f}" for v in r["representation_iou"])
-        lines.append(f"| {r['asset']} | {r['kind']} | {format_bytes(r['rk_bytes'])} | "
+        lines.append(f"| {r['asset']} | {r['kind']} | {r['textures']} | "
+                     f"{format_bytes(r['rk_bytes'])} | "
                      f"{format_bytes(r['glb_bytes'])} | {r['export_seconds']:.2f} s | "
                      f"{r['triangles']:,} | {fallback} | {own} |")
     return "\n".join(lines) + "\n"

@@ -19,6 +19,7 @@ from ..errors import FormatError
 from ..gl.shaders import stage_sources
 from ..io.gltf.arrays import array_of, declared, put_array
 from ..io.gltf.glb import COMPONENT_TYPES, Glb, GlbBuilder, accessor_array
+from ..io.rk import decoded_array, stored_form
 from ..render.plan import from_json, to_json
 from ..render.registry import make_drawables
 
@@ -34,7 +35,10 @@ def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False) -> 
     geometry, images = _geometry_arrays(document), _texture_arrays(document)
     refs = {}
     for name, array in arrays.items():
-        ref = put_array(builder, array, png=name in images)
+        stored, encoding = stored_form(array)
+        ref = put_array(builder, stored, png=name in images and encoding is None)
+        if encoding is not None:  # a texture's decoded values: stored as its blocks
+            ref["encoding"] = encoding
         if name in geometry and _accessor_able(array):
             ref["accessor"] = builder.add_array(array)
         refs[name] = ref
@@ -92,7 +96,8 @@ def read_plans(glb: Glb, draw: dict, where: str = "draw") -> list:
     arrays = {}
     for name, ref in draw["arrays"].items():
         declared(ref, f"{where}: array {name!r}")
-        arrays[name] = array_of(glb, ref, f"{where}: array {name!r}")
+        arrays[name] = decoded_array(array_of(glb, ref, f"{where}: array {name!r}"),
+                                     ref.get("encoding"))
         if "accessor" in ref:
             index = ref["accessor"]
             if type(index) is not int or not 0 <= index < len(glb.document.get("accessors", [])):
