@@ -8,10 +8,12 @@ import pytest
 from shell_scenes import grid_mesh
 
 import reliefkit as rk
+from reliefkit.bake.uv_atlas import MaterialAtlas
 from reliefkit.colorspace import srgb_decode
 from reliefkit.io.inputs import load_input
 from reliefkit.metrics import mask_iou
 from reliefkit.scene.camera import Camera
+from reliefkit.scene.mesh import Material, RenderMesh
 from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.shellvolume.fallback import ALPHA_CUTOFF
 from reliefkit.techniques.shellvolume.reference import reference_render
@@ -68,3 +70,21 @@ def test_a_fur_shell_looks_like_its_torus_from_three_views(gl):
         hue = [c.sum(axis=0) / c.sum() for c in (got.color[..., :3][got.mask],
                                                  drawn.color[..., :3][covered])]
         np.testing.assert_allclose(hue[0], hue[1], atol=0.02)
+
+
+def test_the_surface_tint_is_the_vertex_colour_of_each_material():
+    grid = grid_mesh(4)
+    left = grid.world_positions[grid.indices].mean(axis=1)[:, 0] < 0
+    base = RenderMesh(grid.world_positions, grid.indices, grid.normals, grid.colors, grid.uvs,
+                      materials=[Material("a"), Material("b")], material=np.where(left, 0, 1))
+    srgb = np.array([[200, 100, 50], [30, 160, 220]], np.uint8)
+    layers = np.full((2, 2, 2, 4), 255, np.uint8)
+    layers[..., :3] = srgb[:, None, None]
+    texture = VolumeTexture(np.ones((2, 2, 2, 4), np.float32), np.zeros((2, 2, 2, 3),
+                            np.float32), "white")
+    shell = TexturedShell(base, 0.1, texture, surface=MaterialAtlas(layers, (0, 0, 1, 1)))
+    colors = shell.fallback_mesh().colors
+    x = base.world_positions[:, 0]
+    for side, k in ((x < 0, 0), (x > 0, 1)):
+        np.testing.assert_allclose(colors[side, :3], np.broadcast_to(
+            srgb_decode(srgb[k] / 255.0), (int(side.sum()), 3)), atol=1e-6)

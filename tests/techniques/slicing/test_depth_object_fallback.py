@@ -12,6 +12,7 @@ from reliefkit.errors import UsageError
 from reliefkit.io.inputs import load_input
 from reliefkit.metrics import mask_iou
 from reliefkit.scene.views import orbit_bounds
+from reliefkit.techniques.slicing.depth_images import DepthImages, cube_of, face_boxes
 from reliefkit.techniques.slicing.reference import inside
 
 VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
@@ -83,3 +84,12 @@ def test_a_budget_below_the_smallest_is_refused(gl):
     for bad in (0, 99, 2.5, True):
         with pytest.raises(UsageError, match="at least 100 triangles"):
             rep.fallback_mesh(bad)
+
+
+def test_an_empty_object_has_no_fallback():
+    n = 8  # six images that see nothing
+    cube = cube_of(load_input("demo:blob"))
+    empty = DepthImages(np.ones((6, n, n)), np.zeros((6, n, n), bool), np.zeros((6, n, n, 4)),
+                        np.zeros((6, n, n, 3)), face_boxes(cube), cube)
+    with pytest.raises(UsageError, match="carve nothing"):
+        rk.DepthObject(empty).fallback_mesh()

@@ -64,7 +64,7 @@ def column_image(rgba: np.ndarray, length: float, thickness: float) -> np.ndarra
     """(H, W, 4) float32: the (D, H, W, 4) texture's columns composited from w = 1 down to
     w = 0 over ``thickness`` (alpha the opacity over ``length``, as `VolumeTexture`):
     straight linear colour (0 where nothing is opaque) and the column's total opacity."""
-    marched = marched_volume(rgba, length, thickness).astype(np.float64)
+    marched = marched_volume(rgba, length, thickness)  # float32; one layer at a time in float64
     depth = marched.shape[0]
     steps = STEPS_PER_VOXEL * depth
     dt = thickness / steps
@@ -75,7 +75,9 @@ def column_image(rgba: np.ndarray, length: float, thickness: float) -> np.ndarra
         x = min(max((s + 0.5) / steps * depth - 0.5, 0.0), depth - 1.0)
         k = min(int(x), depth - 2) if depth > 1 else 0
         f = x - k
-        sample = marched[k] if depth == 1 else (1 - f) * marched[k] + f * marched[k + 1]
+        sample = marched[k].astype(np.float64)
+        if depth > 1:
+            sample = (1 - f) * sample + f * marched[k + 1]
         density = np.maximum(sample[..., 3], 0.0)
         a = -np.expm1(-density * dt)
         weight = (1.0 - opacity) * a

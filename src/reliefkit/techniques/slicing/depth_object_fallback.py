@@ -215,7 +215,7 @@ def _textured(images, q: np.ndarray, surface: np.ndarray, cell: float):
     facing = cosines > 0
     sees = np.stack(sees, axis=1) & facing
     usable = facing & (sees | ~sees.any(axis=1, keepdims=True))
-    weights = np.where(usable, np.pi / 2 - np.arccos(np.minimum(cosines, 1.0)), 0.0)
+    weights = np.where(usable, np.pi / 2 - np.arccos(np.clip(cosines, -1.0, 1.0)), 0.0)
     total = weights.sum(axis=1, keepdims=True)
     edge_on = total[:, 0] <= 0  # the nearest face only
     weights[edge_on] = np.eye(6)[np.argmax(cosines[edge_on], axis=1)]
