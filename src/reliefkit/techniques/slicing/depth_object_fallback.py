@@ -125,7 +125,7 @@ class CarvedField:
                                  for k in range(6)])
         # per face: distance to the nearest texel on the other side, from texel centres,
         # minus half a texel to reach the edge between them
-        self.silhouette = np.empty((6, n, n))
+        self.silhouette = np.empty((6, n, n), np.float32)
         for k in range(6):
             mask = images.mask[k]
             if mask.all() or not mask.any():
