@@ -16,17 +16,16 @@ resolution; a trial on a coarse grid measures the object's count, and the grid i
 to give `OVERSAMPLE` times the budget, then decimated to it (fast_simplification's
 quadric decimation keeps thin parts, a spider's legs, that a grid at the budget misses); a
 visual hull's grid aims at the budget itself. Where decimation falls short, the grid is
-coarsened until its own count fits. The grid is
-never finer than the images' texels (there is no more to see); a budget below
-`MIN_TRIANGLES` is refused.
+coarsened until its own count fits. The grid is never finer than the images' texels (there
+is no more to see); a budget below `MIN_TRIANGLES` is refused.
 
 **Colour and normals.** Each vertex is textured as the renderer textures a point seen
 straight on (render.py, §4.2, with the vertex normal as the view direction, so the
 colour does not depend on a view): the three images whose faces are closest to the normal,
 weighted by how much less than 90 degrees their angle is, among the images that see the
 point (within `depth_images.VISIBLE_TEXELS` plus two grid cells of its first surface:
-marching cubes and decimation each move it up to about a cell), each
-image's colour and normal bilinear over its set texels. The blended normal shades it, as
+marching cubes and decimation each move it up to about a cell), each image's colour and
+normal bilinear over its set texels. The blended normal shades it, as
 the renderer lights with it; the surface's own normal where no image has one.
 """
 
@@ -96,7 +95,7 @@ def fallback_mesh(rep, triangles: int = 20_000) -> RenderMesh:
                          f"{triangles} triangles (left {len(faces)}); ask for more")
     world = transform_points(images.cube_to_world, verts)
     surface = vertex_normals(world.astype(np.float32), faces)
-    colors, normals = _textured(images, verts, surface, 2 * cell)
+    colors, normals = _textured(field, verts, surface, 2 * cell)
     kind = "visual hull" if rep.hull else "depth object"
     return RenderMesh(world, faces, normals, colors, name=f"{kind} fallback")
 
@@ -139,14 +138,19 @@ class CarvedField:
         """(..., 3) (u, v, h) of cube points q in image k's box."""
         return transform_points(self.to_face[k], q)
 
+    def texel(self, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Column i and row j of the texel under face coordinates f (nearest, clamped)."""
+        n = self.images.resolution
+        i = np.clip(np.floor(f[..., 0] * n), 0, n - 1).astype(np.intp)
+        j = np.clip(np.floor(f[..., 1] * n), 0, n - 1).astype(np.intp)
+        return i, j
+
     def __call__(self, q: np.ndarray) -> np.ndarray:
         images = self.images
-        n = images.resolution
         out = np.full(q.shape[:-1], np.inf)
         for k in range(6):
             f = self.face_coords(k, q)
-            i = np.clip(np.floor(f[..., 0] * n), 0, n - 1).astype(np.intp)
-            j = np.clip(np.floor(f[..., 1] * n), 0, n - 1).astype(np.intp)
+            i, j = self.texel(f)
             behind = 1.0 - f[..., 2] - images.depth[k][j, i]
             silhouette = _bilinear(self.silhouette[k], f[..., 0], f[..., 1])
             np.minimum(out, np.minimum(behind, silhouette), out=out)
@@ -222,21 +226,22 @@ def _masked_bilinear(images, k: int, u, v) -> tuple[np.ndarray, np.ndarray]:
     return color, normal
 
 
-def _textured(images, q: np.ndarray, surface: np.ndarray, cell: float):
+def _textured(field: CarvedField, q: np.ndarray, surface: np.ndarray, slack: float):
     """Vertex colours (V, 4) and normals (V, 3) of cube points ``q`` whose surface normal is
-    ``surface``: the renderer's texturing seen along the normal (module docstring)."""
+    ``surface``: the renderer's texturing seen along the normal (module docstring), a point
+    seen by an image within ``slack`` more than the renderer's."""
+    images = field.images
     n = images.resolution
     faces = sorted(FACE_INDEX, key=FACE_INDEX.get)
     outward = np.array([axis_frame(face)[2] for face in faces])  # (6, 3) world axes
     cosines = np.asarray(surface, np.float64) @ outward.T  # (V, 6)
     coords, sees = [], []
     for k in range(6):
-        f = transform_points(np.linalg.inv(images.box_to_world[k]) @ images.cube_to_world, q)
-        i = np.clip(np.floor(f[:, 0] * n), 0, n - 1).astype(np.intp)
-        j = np.clip(np.floor(f[:, 1] * n), 0, n - 1).astype(np.intp)
+        f = field.face_coords(k, q)
+        i, j = field.texel(f)
         d = np.where(images.mask[k][j, i], images.depth[k][j, i], 2.0)
         coords.append(f)
-        sees.append((d <= 1.0) & (1.0 - f[:, 2] - d <= visible_depth(n, cell)))
+        sees.append((d <= 1.0) & (1.0 - f[:, 2] - d <= visible_depth(n, slack)))
     facing = cosines > 0
     sees = np.stack(sees, axis=1) & facing
     usable = facing & (sees | ~sees.any(axis=1, keepdims=True))
