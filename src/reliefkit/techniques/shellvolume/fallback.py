@@ -9,7 +9,8 @@ length dt dimming what lies below by exp(-density dt). The column is as long as 
 is thick: its mean thickness (the bake thins it only where it would fold). The result is
 one tile of the texture as an image, straight colour and the column's total opacity; the
 mesh's uvs are the base's times the texture's tiling, so a viewer's default REPEAT wrap
-tiles it as the shell does.
+tiles it as the shell does. Glow (emission) is left out, as the CPU integrator leaves it:
+a RenderMesh has no emissive colour.
 
 **The surface.** Where the base's own materials tint the volume (`TexturedShell.surface`),
 the tint is the vertex colour (glTF multiplies it by the texture), read at each vertex's uv
