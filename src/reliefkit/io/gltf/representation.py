@@ -84,7 +84,7 @@ def exported_by_reliefkit(path) -> bool:
             else:
                 return False
         used = json.loads(text.decode("utf-8")).get("extensionsUsed", [])
-    except (OSError, ValueError, AttributeError):
+    except (OSError, ValueError, AttributeError, RecursionError):
         return False
     return isinstance(used, list) and any(isinstance(u, str) and u.startswith(PREFIX)
                                           for u in used)
