@@ -119,10 +119,10 @@ class OctahedralImpostor:
         return np.stack([self.center - self.radius, self.center + self.radius])
 
     def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
-        """What a glTF viewer that knows nothing of reliefkit shows: one quad in the plane of
-        the frame nearest the start view, covering the bounding sphere's square, textured
-        with that frame (MASK at 0.5, double-sided); always 2 triangles, whatever
-        ``triangles`` says (`fallback`)."""
+        """What a glTF viewer that knows nothing of reliefkit shows: one quad facing the start
+        view, covering the bounding sphere's square, textured with what the impostor shows
+        from there (MASK at 0.5, double-sided); always 2 triangles, whatever ``triangles``
+        says (`fallback`)."""
         return fallback.fallback_mesh(self)
 
     @property
