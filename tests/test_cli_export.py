@@ -68,8 +68,12 @@ def test_lod_chain_of_a_mesh(gl, tmp_path):
     coverage = root.extras["MSFT_screencoverage"]
     assert len(ids) == 2 and len(coverage) == 3 and coverage[-1] == 0
     assert coverage == sorted(coverage, reverse=True)
-    kinds = {gltf.nodes[i].extras["reliefkit"]["kind"] for i in ids}
-    assert kinds == {"relief-object", "billboard-cloud"}
+    kinds = [gltf.nodes[i].extras["reliefkit"]["kind"] for i in ids]
+    assert kinds == ["relief-object", "billboard-cloud"]  # the most accurate first
+    # the cloud takes over where its epsilon projects to one pixel of a 1080-pixel screen
+    cloud, mesh = rk.load(out, node=ids[1]), rk.load_mesh("demo:blob")
+    radius = 0.5 * np.linalg.norm(mesh.bounds[1] - mesh.bounds[0])
+    assert coverage[1] == pytest.approx(2 * radius / (cloud.epsilon * 1080), abs=1e-6)
     assert "MSFT_lod" in gltf.extensionsUsed and not gltf.extensionsRequired
     assert problems(validate(out)) == []
 
@@ -96,3 +100,15 @@ def test_a_plain_mesh_exports_as_a_mesh(gl, tmp_path):
     assert run_cli("export", "demo:blob", "-o", out).returncode == 0
     mesh = rk.load(out)
     assert mesh.triangle_count == rk.load_mesh("demo:blob").triangle_count
+
+
+def test_info_reads_an_export_and_a_re_export_keeps_the_source_hash(gl, cube_rk, tmp_path):
+    first, second = tmp_path / "a.glb", tmp_path / "b.glb"
+    assert run_cli("export", cube_rk, "-o", first).returncode == 0
+    info = run_cli("info", first)
+    assert info.returncode == 0, info.stderr
+    for words in ("kind: relief-object", "RELIEFKIT_relief_object", "p0_height",
+                  "checksums: ok"):
+        assert words in info.stdout, info.stdout
+    assert run_cli("export", first, "-o", second).returncode == 0
+    assert second.read_bytes() == first.read_bytes()

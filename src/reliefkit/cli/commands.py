@@ -26,6 +26,7 @@ from ..errors import FormatError, MeshError, UsageError
 from ..export import export, export_lod
 from ..gl.context import gl_info
 from ..io.atomic import atomic_path, check_writable, written_together
+from ..io.gltf import representation as gltf_representation
 from ..io.inputs import DEMO_PREFIX, describe, kind_of, load_input, what_it_is
 from ..io.rk import array_bytes, file_sha256, load, read_manifest, save
 from ..progress import progress_bar, waiting
@@ -141,24 +142,27 @@ def cmd_export(args) -> int:
         if args.no_fallback:
             raise UsageError("--no-fallback does not apply to --lod: every LOD is shown "
                              "through its core mesh")
-        mesh, reps = _bake_lods(args, given)
+        mesh, kinds, reps = _bake_lods(args, given)
         source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
         with waiting(f"measuring {len(reps)} LOD(s) against the mesh"):
-            path, lods = export_lod(mesh, reps, out, source_hash=source_hash, **common)
+            path, lods = export_lod(mesh, reps, out, source_hash=source_hash, names=kinds,
+                                    **common)
+        print("LODs from the most to the least accurate (each one's error: docs/gltf.md):")
         upper = 1.0
         for lod in lods:
+            lower = lod["screen_coverage"]
+            shown = (f"shown while it covers {lower:.3g} to {upper:.3g} of the screen's height"
+                     if lower < upper else "never shown: the next LOD is as accurate")
             print(f"LOD {lod['level']}: {lod['kind']:<20} surface error "
-                  f"{lod['surface_error']:.4g}, shown while it covers "
-                  f"{lod['screen_coverage']:.3g} to {upper:.3g} of the screen's height")
-            upper = lod["screen_coverage"]
+                  f"{lod['surface_error']:.4g}, {shown}")
+            upper = lower
     else:
         if given:
             flags = ", ".join("--" + k.replace("_", "-") for k in given)
             raise UsageError(f"bake options ({flags}) need --lod and a mesh; to export an "
                              ".rk baked with them, bake it with them first")
         rep = _load(args.input)
-        source_hash = (read_manifest(args.input).get("source_hash")
-                       if Path(args.input).suffix.lower() == ".rk" else None)
+        source_hash = _source_hash_of(args.input)
         with waiting(f"exporting {what_it_is(args.input, rep)}"):
             path = export(rep, out, fallback=not args.no_fallback, source_hash=source_hash,
                           **common)
@@ -166,13 +170,23 @@ def cmd_export(args) -> int:
     return 0
 
 
+def _source_hash_of(spec: str) -> str | None:
+    """The source hash an .rk (or a glTF reliefkit exported) records; None for others."""
+    suffix = Path(spec).suffix.lower()
+    if suffix == ".rk":
+        return read_manifest(spec).get("source_hash")
+    if suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec):
+        return gltf_representation.read_manifest(spec).get("source_hash")
+    return None
+
+
 def _bake_lods(args, given: dict):
     table = bakers()
     kinds = [k.strip() for k in args.lod.split(",") if k.strip()]
     unknown = [k for k in kinds if k not in table]
     if not kinds or unknown:
-        raise UsageError(f"--lod takes representations from {', '.join(table)}; got "
-                         f"{args.lod!r}")
+        what = f"unknown {', '.join(unknown)}" if unknown else f"got {args.lod!r}"
+        raise UsageError(f"--lod takes representations from {', '.join(table)} ({what})")
     compression = {opt.name: given.pop(opt.name) for opt in options_of(CompressOptions)
                    if opt.name in given}
     declared = {opt.name for k in kinds for opt in table[k][1].options}
@@ -191,7 +205,7 @@ def _bake_lods(args, given: dict):
                             table[kind][1].options, f"--lod {kind}")
         with progress_bar(f"baking {kind}", 1) as advance:
             reps.append(bake(source, kind, progress=advance, compress=compression, **params))
-    return source, reps
+    return source, kinds, reps
 
 
 def _written_bytes(path: Path) -> int:
@@ -504,9 +518,12 @@ def _describe_file(spec: str) -> dict:
     """A mesh's counts and bounds, or an .rk file's manifest once every array is read and its
     checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
     _check_not_empty(spec)
-    if Path(spec).suffix.lower() == ".rk":
-        rep = load(spec)  # every check render makes: checksums, then the representation's own
-        manifest = read_manifest(spec)
+    suffix = Path(spec).suffix.lower()
+    exported = suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec)
+    if suffix == ".rk" or exported:
+        # every check render makes: checksums, then the representation's own
+        rep = gltf_representation.load(spec) if exported else load(spec)
+        manifest = (gltf_representation.read_manifest if exported else read_manifest)(spec)
         for name, (fmt, gpu, raw) in gpu_bytes(rep).items():
             if name in manifest["arrays"]:
                 manifest["arrays"][name]["gpu"] = {"format": fmt, "bytes": gpu, "raw_bytes": raw}

@@ -45,7 +45,7 @@ CORE_EXAMPLES = {
     "export": ["reliefkit export tree.rk -o tree.glb                 any viewer shows it; "
                "reliefkit reads it back",
                "reliefkit export car.glb --lod relief-cube,billboard-cloud -o car-lod.glb",
-               "reliefkit export tree.rk -o web/tree.gltf --embed-shaders"],
+               "reliefkit export tree.rk -o tree.gltf --embed-shaders"],
     "shootout": ["reliefkit shootout demo:tree --out out/shootout    what to ship at 64 and "
                  "256 px, 256 KB and 1 MB",
                  "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "

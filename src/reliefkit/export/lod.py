@@ -6,24 +6,29 @@ The mesh is LOD 0, a plain core glTF node; each representation is a node of its 
 ``extras.MSFT_screencoverage`` gives, per LOD, the smallest share of the screen's height at
 which it is shown (Babylon and UnityGLTF read these; other viewers show LOD 0).
 
-The thresholds come from measurement, not from a formula per kind: each representation is
-drawn beside the mesh from the shootout's six views and its surface error ``e`` (the 95th
-percentile of the world-space distance between the points both draw, worst view) is the
-error it makes. Seen at a share ``c`` of a screen ``H`` pixels high, a bounding sphere of
-radius ``r`` maps ``e`` to ``e * H * c / (2 r)`` pixels, under one pixel while
-``c < 2 r / (e H)``: below that share the representation is as good as the mesh. A
-representation drawn with no error gets share 0 as the mesh's successor; a DMBBC's own
-switch to its cloud by distance happens inside its node, as it draws.
+Each representation's error ``e`` is a world distance: the one it declares
+(``geometric_error()``: a billboard cloud's epsilon, the distance every face lies within of
+its card, whose projection below one pixel is also where a DMBBC switches to its cloud), or
+else measured: drawn beside the mesh from the six measuring views (the bounding sphere
+``S`` pixels across), its outline's mean displacement (the pixels where exactly one of the
+two covers, per pixel of the mesh's outline) in the worst view, in world units (``2r/S`` a
+pixel). Depth errors along a view ray move nothing on screen and are not counted. Seen at
+a share ``c`` of a screen ``H`` pixels high, a bounding sphere of radius ``r`` maps ``e`` to
+``e * H * c / (2 r)`` pixels, under one pixel while ``c < 2 r / (e H)``: below that share
+the representation is as good as the mesh. A measured error is taken as at least half a
+measuring pixel (what the views resolve), so no measured representation takes over above a
+share of ``2 S / H`` (0.47).
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
+import numpy as np
+
 from ..io.gltf.mesh import add_render_mesh
-from ..io.rk import codec_of
-from ..metrics import compare
+from ..io.rk import array_bytes, codec_of
+from ..metrics import mask_xor
 from ..render import render
 from ..scene.sphere_views import cameras
 from ..scene.views import bounds_radius
@@ -31,20 +36,31 @@ from .gltf import DEFAULT_FALLBACK_TRIANGLES, builder_for, representation_node, 
 
 __all__ = ["export_lod", "surface_error", "screen_coverages", "MEASURE_SIZE", "SCREEN_HEIGHT"]
 
-MEASURE_SIZE = 192   # pixels the bounding sphere spans in the measuring views
+MEASURE_SIZE = 256   # pixels the bounding sphere spans in the measuring views
 SCREEN_HEIGHT = 1080  # the screen the thresholds are for
 
 
 def surface_error(rep, mesh, size: int = MEASURE_SIZE) -> float:
-    """The worst view's 95th-percentile world distance between what ``rep`` and ``mesh``
-    draw at the same pixels (see the module)."""
-    views = cameras(mesh.bounds, size)
-    errors = []
-    for camera in views:
-        scores = compare(render(rep, camera), render(mesh, camera))
-        if not math.isnan(scores["position_p95"]):
-            errors.append(scores["position_p95"])
-    return max(errors) if errors else math.inf
+    """``rep``'s error in world units (see the module): declared, or its outline's mean
+    displacement against the mesh's in the worst measuring view (at least half a pixel)."""
+    declared = getattr(rep, "geometric_error", None)
+    if declared is not None:
+        return float(declared())
+    pixel = 2.0 * bounds_radius(mesh.bounds) / size
+    worst = 0.5 * pixel  # what the measuring views resolve
+    for camera in cameras(mesh.bounds, size):
+        test, truth = render(rep, camera), render(mesh, camera)
+        outline = _outline_pixels(truth.mask)
+        if outline:
+            worst = max(worst, mask_xor(test, truth) / outline * pixel)
+    return worst
+
+
+def _outline_pixels(mask: np.ndarray) -> int:
+    """Covered pixels with an uncovered 4-neighbour (or on the image's border)."""
+    padded = np.pad(mask, 1)
+    inner = padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:]
+    return int(np.count_nonzero(mask & ~inner))
 
 
 def screen_coverages(errors: list[float], radius: float,
@@ -58,15 +74,16 @@ def screen_coverages(errors: list[float], radius: float,
 
 def export_lod(mesh, reps, path, *, fallback_triangles: int = DEFAULT_FALLBACK_TRIANGLES,
                embed_shaders: bool = False, source_hash: str | None = None,
-               progress=None) -> tuple[Path, list[dict]]:
+               names: list[str] | None = None, progress=None) -> tuple[Path, list[dict]]:
     """Write ``mesh`` and ``reps`` as an LOD chain (see the module); the path and one record
-    per LOD (kind, surface error, screen coverage), in chain order."""
+    per LOD (``names[k]`` or the kind, surface error, screen coverage), in chain order."""
     errors = []
     for rep in reps:
         errors.append(surface_error(rep, mesh))
         if progress:
             progress()
-    order = sorted(range(len(reps)), key=lambda k: errors[k])
+    # equal errors: the larger first, so the smaller one is the one shown
+    order = sorted(range(len(reps)), key=lambda k: (errors[k], -_bytes(reps[k])))
     coverages = screen_coverages([errors[k] for k in order], bounds_radius(mesh.bounds))
     builder = builder_for(path)
     ids = [representation_node(builder, reps[k], fallback_triangles=fallback_triangles,
@@ -83,6 +100,10 @@ def export_lod(mesh, reps, path, *, fallback_triangles: int = DEFAULT_FALLBACK_T
     written = write_document(path, builder, [len(document["nodes"]) - 1])
     records = [{"level": 0, "kind": "mesh", "surface_error": 0.0, "screen_coverage": coverages[0]}]
     for lod, k in enumerate(order, 1):
-        records.append({"level": lod, "kind": codec_of(reps[k]).kind,
+        records.append({"level": lod, "kind": names[k] if names else codec_of(reps[k]).kind,
                         "surface_error": errors[k], "screen_coverage": coverages[lod]})
     return written, records
+
+
+def _bytes(rep) -> int:
+    return sum(array_bytes(rep).values())

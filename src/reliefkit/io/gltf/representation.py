@@ -31,7 +31,8 @@ from .glb import DEFAULT_MAX_BYTES, MAGIC, MAX_JSON_BYTES, Glb, GlbBuilder, read
 
 __all__ = ["PREFIX", "extension_name", "representation_extension", "is_gltf", "read_document",
            "exported_by_reliefkit",
-           "reliefkit_nodes", "GltfRepresentation", "read_representation", "load"]
+           "reliefkit_nodes", "GltfRepresentation", "read_representation", "load",
+           "read_manifest"]
 
 PREFIX = "RELIEFKIT_"
 
@@ -188,3 +189,24 @@ def load(path, *, node: int | None = None, max_bytes: int = DEFAULT_MAX_BYTES,
         raise FormatError(f"{path}: {exc}") from None
     codec = rk.codec_table(codecs).for_kind(rep.kind)
     return rk.build(codec, rep.arrays, rep.params, path)
+
+
+def read_manifest(path) -> dict:
+    """What `io.rk.read_manifest` says of an .rk, for a glTF file reliefkit exported: its
+    first representation's kind, versions, params, source hash, writer and arrays (dtype,
+    shape and sha256 as stored; an encoded array's encoding), from the JSON alone."""
+    path = Path(path)
+    glb = read_document(path)
+    found = reliefkit_nodes(glb.document)
+    if not found:
+        raise FormatError(f"{path}: no node carries a reliefkit extension (RELIEFKIT_<kind>)")
+    index, name, extension = found[0]
+    node = glb.document["nodes"][index]
+    extras = node.get("extras", {}).get("reliefkit", {}) if isinstance(node.get("extras"),
+                                                                         dict) else {}
+    arrays = {key: {k: ref[k] for k in ("dtype", "shape", "sha256", "encoding") if k in ref}
+              for key, ref in extension.get("arrays", {}).items() if isinstance(ref, dict)}
+    return {"format": "glTF 2.0", "extension": name, "kind": extension.get("kind"),
+            "kind_version": extension.get("kindVersion"), "params": extension.get("params"),
+            "source_hash": extras.get("sourceHash"),
+            "created_by": glb.document["asset"].get("generator"), "arrays": arrays}

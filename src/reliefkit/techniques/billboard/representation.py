@@ -115,6 +115,12 @@ class BillboardCloud:
         the count is the cloud's."""
         return fallback.fallback_mesh(self)
 
+    def geometric_error(self) -> float:
+        """The world distance the cloud may be off the surface: epsilon, every face within
+        it of its card (where it projects below one pixel a DMBBC draws this cloud; an LOD
+        chain switches to it there, `reliefkit.export.lod`)."""
+        return self.epsilon
+
     def fallback_normal_maps(self) -> dict:
         """The fallback's tangent-space normal map per material (atlas page)."""
         return fallback.fallback_normal_maps(self)
