@@ -175,3 +175,18 @@ def frame_of_plans(gl, rep, drawable, plans, camera, light):
         scene.drawables = [drawable]
         scene.executor.upload(plans)
         return scene.frame(camera, light)
+
+
+#: The three views the glTF fallbacks are held to (mask IoU against the source mesh).
+FALLBACK_VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
+
+
+def fallback_ious(mesh, fallback, size: int = 128) -> list[float]:
+    """Mask IoU of ``fallback`` (any drawable) against ``mesh`` from `FALLBACK_VIEWS`."""
+    from reliefkit.metrics import mask_iou
+    from reliefkit.render import render
+    from reliefkit.scene.views import orbit_bounds
+
+    cameras = [orbit_bounds(mesh.bounds, az, el, size=(size, size))
+               for az, el in FALLBACK_VIEWS]
+    return [mask_iou(render(fallback, c), render(mesh, c)) for c in cameras]

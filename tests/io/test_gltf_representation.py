@@ -194,3 +194,9 @@ def test_typed_arrays_round_trip_as_png_or_bytes(shape):
     back = array_of(Glb(document, binary), ref, "test")
     assert back.dtype == array.dtype and back.shape == array.shape
     assert back.tobytes() == array.tobytes()
+
+
+def test_a_deeply_nested_document_is_refused_in_one_line(tmp_path):
+    path = tmp_path / "deep.gltf"
+    path.write_text('{"asset": {"version": "2.0"}, "x": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    refused(path, "nests too deeply")

@@ -3,7 +3,7 @@ triangle budget, the colour, the box mapping (projective too) and the clip box."
 
 import numpy as np
 import pytest
-from helpers import BOX, make_relief, terrain_block
+from helpers import BOX, FALLBACK_VIEWS, fallback_ious, make_relief, terrain_block
 
 import reliefkit as rk
 from reliefkit.io.inputs import load_mesh
@@ -15,13 +15,8 @@ from reliefkit.scene.views import orbit_bounds
 from reliefkit.techniques.relief.frustum import frustum_matrix
 from reliefkit.techniques.relief.representation import ReliefTexture
 
-VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
 UNLIT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
 
-
-def ious(mesh, fallback, size=128):
-    cameras = [orbit_bounds(mesh.bounds, az, el, size=(size, size)) for az, el in VIEWS]
-    return [mask_iou(render(fallback, c), render(mesh, c)) for c in cameras]
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +29,7 @@ def test_relief_fallback_covers_its_mesh_from_three_views(terrain_relief):
     mesh, relief = terrain_relief
     fallback = relief.fallback_mesh()
     assert fallback.triangle_count <= 20_000
-    assert min(ious(mesh, fallback)) >= 0.9
+    assert min(fallback_ious(mesh, fallback)) >= 0.9
 
 
 def test_relief_fallback_takes_the_mesh_colour(terrain_relief):
@@ -105,7 +100,7 @@ def test_heightmap_fallback_has_the_sides_the_relief_draws(gl):
     """A heightmap fills its box: the relief draws the box's sides under the border."""
     relief = rk.relief_from_heights(terrain_heights(48))
     fallback = relief.fallback_mesh()
-    for az, el in VIEWS:
+    for az, el in FALLBACK_VIEWS:
         camera = orbit_bounds(relief.bounds, az, el, size=(96, 96))
         assert mask_iou(render(fallback, camera), render(relief, camera)) >= 0.97, (az, el)
 
@@ -138,7 +133,7 @@ def test_reverse_frustum_fallback_covers_its_mesh(gl):
     assert fallback.triangle_count <= 20_000
     points = fallback.world_positions
     assert (points >= relief.clip_bounds[0]).all() and (points <= relief.clip_bounds[1]).all()
-    assert min(ious(mesh, fallback)) >= 0.9
+    assert min(fallback_ious(mesh, fallback)) >= 0.9
 
 
 def test_relief_cube_fallback_covers_its_mesh(gl):
@@ -147,7 +142,7 @@ def test_relief_cube_fallback_covers_its_mesh(gl):
     fallback = rep.fallback_mesh()
     assert len(fallback.materials) == 6  # each part's colour
     assert fallback.triangle_count <= 20_000
-    assert min(ious(mesh, fallback)) >= 0.9
+    assert min(fallback_ious(mesh, fallback)) >= 0.9
     assert 2500 <= rep.fallback_mesh(3000).triangle_count <= 3000
 
 

@@ -3,10 +3,9 @@ its silhouette from three views, its colour, nothing where the texture is transp
 
 import numpy as np
 import pytest
-from helpers import terrain_block
+from helpers import fallback_ious, terrain_block
 
 import reliefkit as rk
-from reliefkit.metrics import mask_iou
 from reliefkit.render import render
 from reliefkit.scene.assets.surfaces import torus
 from reliefkit.scene.light import DirectionalLight
@@ -15,13 +14,8 @@ from reliefkit.techniques.slicing.displacement import DisplacementMap
 from reliefkit.techniques.slicing.displacement_bake import square_base
 from reliefkit.techniques.slicing.displacement_textures import waves
 
-VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
 UNLIT = DirectionalLight(intensity=0.0, ambient=1.0, specular=0.0)  # colour = base colour
 
-
-def ious(mesh, fallback, size=128):
-    cameras = [orbit_bounds(mesh.bounds, az, el, size=(size, size)) for az, el in VIEWS]
-    return [mask_iou(render(fallback, c), render(mesh, c)) for c in cameras]
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +35,7 @@ def test_projected_mesh_fallback_covers_its_mesh_from_three_views(projected):
     mesh, rep = projected
     fallback = rep.fallback_mesh()
     assert fallback.triangle_count <= 20_000
-    assert min(ious(mesh, fallback)) >= 0.9
+    assert min(fallback_ious(mesh, fallback)) >= 0.9
 
 
 def test_projected_mesh_fallback_takes_the_mesh_colour(projected):
@@ -58,7 +52,7 @@ def test_projected_mesh_fallback_takes_the_mesh_colour(projected):
 def test_mesh_base_fallback_is_the_displaced_surface(gl, wavy_torus):
     truth = wavy_torus.displaced_mesh(8)  # 64 triangles per base triangle
     fallback = wavy_torus.fallback_mesh()
-    assert min(ious(truth, fallback)) >= 0.95
+    assert min(fallback_ious(truth, fallback)) >= 0.95
 
 
 @pytest.mark.parametrize("budget", [1250, 5000, 20_000, 80_000])

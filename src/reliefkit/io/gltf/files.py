@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ...errors import FormatError
 from ..atomic import atomic_path, written_together
-from .glb import DEFAULT_MAX_BYTES, MAX_JSON_BYTES, Glb, GlbBuilder, check_layout
+from .glb import DEFAULT_MAX_BYTES, MAX_JSON_BYTES, Glb, GlbBuilder, check_layout, parse_document
 
 __all__ = ["gltf_builder", "write_gltf", "read_gltf"]
 
@@ -65,15 +65,7 @@ def _read(path: Path, max_bytes: int) -> Glb:
     size = path.stat().st_size
     if size > MAX_JSON_BYTES:
         raise FormatError(f"the JSON is {size:,} bytes, over the {MAX_JSON_BYTES:,}-byte limit")
-    try:
-        document = json.loads(path.read_bytes().decode("utf-8"))
-    except (UnicodeDecodeError, ValueError) as exc:
-        raise FormatError(f"not valid UTF-8 JSON ({exc})") from None
-    if not isinstance(document, dict) or not isinstance(document.get("asset"), dict):
-        raise FormatError("not a glTF document (no 'asset' object)")
-    if document["asset"].get("version") != "2.0":
-        raise FormatError(f"glTF version {document['asset'].get('version')!r}; only '2.0' "
-                          "is read")
+    document = parse_document(path.read_bytes(), "the file")
     buffers = document.get("buffers", [])
     wanted = {}
     if isinstance(buffers, list) and len(buffers) == 1 and isinstance(buffers[0], dict):

@@ -261,7 +261,7 @@ def _read(fh, size: int, max_bytes: int) -> Glb:
     if length > MAX_JSON_BYTES:
         raise FormatError(f"the JSON chunk claims {length:,} bytes, over the "
                           f"{MAX_JSON_BYTES:,}-byte limit")
-    document = _parse_json(fh.read(length))
+    document = parse_document(fh.read(length))
     binary, bin_offset = b"", _HEADER.size + _CHUNK.size + length
     offset = bin_offset
     while offset < size:
@@ -290,13 +290,16 @@ def _chunk_header(fh, offset: int, size: int) -> tuple[int, int]:
     return length, kind
 
 
-def _parse_json(data: bytes) -> dict:
+def parse_document(data: bytes, what: str = "the JSON chunk") -> dict:
+    """A glTF 2.0 JSON document from its bytes (``what`` names them in errors)."""
     try:
         document = json.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:
-        raise FormatError(f"the JSON chunk is not valid UTF-8 JSON ({exc})") from None
+        raise FormatError(f"{what} is not valid UTF-8 JSON ({exc})") from None
+    except RecursionError:
+        raise FormatError(f"{what} nests too deeply to be a glTF document (forged)") from None
     if not isinstance(document, dict) or not isinstance(document.get("asset"), dict):
-        raise FormatError("the JSON chunk is not a glTF document (no 'asset' object)")
+        raise FormatError(f"{what} is not a glTF document (no 'asset' object)")
     if document["asset"].get("version") != "2.0":
         raise FormatError(f"glTF version {document['asset'].get('version')!r}; only '2.0' "
                           "is read")
