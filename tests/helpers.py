@@ -76,6 +76,11 @@ def technique_samples() -> list[tuple[str, str]]:
     return out
 
 
+def sample_ids(samples) -> list[str]:
+    """``technique:kind`` test ids of `technique_samples`' pairs."""
+    return [f"{tech}:{kind}" for tech, kind in samples]
+
+
 def sample(technique_name: str, kind: str):
     import toy_technique
 

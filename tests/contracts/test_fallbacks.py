@@ -7,18 +7,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import sample, technique_samples, toy_technique
+from helpers import sample, sample_ids, technique_samples
 
 from reliefkit.scene.mesh import RenderMesh
 
+pytestmark = pytest.mark.usefixtures("toy_registered")
+
 SAMPLES = technique_samples()
-IDS = [f"{tech}:{kind}" for tech, kind in SAMPLES]
+IDS = sample_ids(SAMPLES)
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 @pytest.mark.parametrize("tech_kind", SAMPLES, ids=IDS)

@@ -13,7 +13,7 @@ import numpy as np
 import pygltflib
 import pytest
 from gltf_validator import problems, validate
-from helpers import frame_of_plans, sample, technique_samples, toy_technique
+from helpers import frame_of_plans, sample, sample_ids, technique_samples
 from PIL import Image
 
 import reliefkit as rk
@@ -25,14 +25,11 @@ from reliefkit.render.registry import make_drawables
 from reliefkit.scene.light import DirectionalLight
 from reliefkit.scene.views import orbit_bounds
 
+pytestmark = pytest.mark.usefixtures("toy_registered")
+
 SAMPLES = technique_samples()
-IDS = [f"{tech}:{kind}" for tech, kind in SAMPLES]
+IDS = sample_ids(SAMPLES)
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 def stored_arrays(rep) -> dict:

@@ -9,13 +9,15 @@ import json
 from pathlib import Path
 
 import pytest
-from helpers import sample, technique_samples, toy_technique
+from helpers import sample, technique_samples
 from jsonschema import Draft202012Validator
 from referencing import Registry, Resource
 
 import reliefkit as rk
 from reliefkit.builtins import registry
 from reliefkit.io.gltf.representation import extension_name, read_document, reliefkit_nodes
+
+pytestmark = pytest.mark.usefixtures("toy_registered")
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 SCHEMAS = {p.name: json.loads(p.read_text()) for p in (DOCS / "schema").glob("*.json")}
@@ -27,11 +29,6 @@ SAMPLES = technique_samples()
 def validator(name: str) -> Draft202012Validator:
     return Draft202012Validator(SCHEMAS[name], registry=REGISTRY)
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 def test_the_schemas_are_valid_json_schemas():
