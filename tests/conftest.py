@@ -66,3 +66,13 @@ def rng():
 def _strict_numpy():
     with np.errstate(all="raise"):
         yield
+
+
+@pytest.fixture(scope="module")
+def toy_registered():
+    """The toy technique in the registry for a module's tests (`technique_samples` lists its
+    kind): ``pytestmark = pytest.mark.usefixtures("toy_registered")``."""
+    from helpers import toy_technique
+
+    with toy_technique():
+        yield

@@ -6,6 +6,7 @@ import contextlib
 
 import numpy as np
 
+from reliefkit.scene.mesh import RenderMesh, vertex_normals
 from reliefkit.techniques.relief.bake import heightfield_normals
 from reliefkit.techniques.relief.representation import ReliefTexture
 
@@ -23,6 +24,29 @@ def make_relief(height, box_to_world=BOX, safety=None, rgb=(0.2, 0.6, 0.3)):
     return ReliefTexture(height=height, color=color,
                          normal=heightfield_normals(height, box_to_world),
                          box_to_world=box_to_world, safety=safety)
+
+
+def terrain_block(n=40):
+    """A closed terrain block over [-1, 1]^2: a smooth top, four skirts down to y = 0 and a
+    bottom, coloured by x (red), height (green) and z (blue): what a relief texture holds."""
+    x, z = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-1, 1, n))
+    y = 0.35 + 0.15 * np.sin(2.5 * x) * np.cos(1.5 * z) + 0.1 * x * z
+    top = np.stack([x, y, z], -1).reshape(-1, 3)
+    bottom = top * [1, 0, 1]
+    positions = np.concatenate([top, bottom])
+    a = (np.arange(n - 1)[:, None] * n + np.arange(n - 1)).ravel()
+    faces = [np.stack([a, a + n, a + n + 1], 1), np.stack([a, a + n + 1, a + 1], 1)]
+    ring = np.r_[np.arange(n), np.arange(2 * n - 1, n * n, n),  # the top's border, once around
+                 np.arange(n * n - 2, n * n - n - 1, -1), np.arange(n * n - 2 * n, 0, -n)]
+    r0, r1 = ring, np.roll(ring, -1)
+    faces += [np.stack([r0, r1, r1 + n * n], 1), np.stack([r0, r1 + n * n, r0 + n * n], 1)]
+    corners = np.array([0, n - 1, n * n - 1, n * n - n]) + n * n
+    faces += [corners[[0, 2, 1]][None], corners[[0, 3, 2]][None]]
+    faces = np.concatenate(faces)
+    rgb = np.stack([0.2 + 0.3 * (positions[:, 0] + 1), 0.1 + 1.2 * positions[:, 1],
+                    0.2 + 0.3 * (positions[:, 2] + 1)], -1)
+    colors = np.c_[np.clip(rgb, 0, 1), np.ones(len(positions))].astype(np.float32)
+    return RenderMesh(positions, faces, vertex_normals(positions, faces), colors, name="block")
 
 
 @contextlib.contextmanager
@@ -50,6 +74,11 @@ def technique_samples() -> list[tuple[str, str]]:
         assert tech.samples is not None, f"technique {tech.name} declares no samples"
         out += [(tech.name, kind) for kind in tech.samples()]
     return out
+
+
+def sample_ids(samples) -> list[str]:
+    """``technique:kind`` test ids of `technique_samples`' pairs."""
+    return [f"{tech}:{kind}" for tech, kind in samples]
 
 
 def sample(technique_name: str, kind: str):
@@ -151,3 +180,18 @@ def frame_of_plans(gl, rep, drawable, plans, camera, light):
         scene.drawables = [drawable]
         scene.executor.upload(plans)
         return scene.frame(camera, light)
+
+
+#: The three views the glTF fallbacks are held to (mask IoU against the source mesh).
+FALLBACK_VIEWS = ((30.0, 20.0), (150.0, -10.0), (270.0, 60.0))
+
+
+def fallback_ious(mesh, fallback, size: int = 128) -> list[float]:
+    """Mask IoU of ``fallback`` (any drawable) against ``mesh`` from `FALLBACK_VIEWS`."""
+    from reliefkit.metrics import mask_iou
+    from reliefkit.render import render
+    from reliefkit.scene.views import orbit_bounds
+
+    cameras = [orbit_bounds(mesh.bounds, az, el, size=(size, size))
+               for az, el in FALLBACK_VIEWS]
+    return [mask_iou(render(fallback, c), render(mesh, c)) for c in cameras]

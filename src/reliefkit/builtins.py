@@ -22,12 +22,13 @@ from .bake import bake as _bake
 from .core.technique import REGISTRY, Registry
 from .gl import shaders
 from .io import rk
+from .io.gltf import representation as gltf_representation
 from .io.mesh_codec import MESH_CODEC
 from .render import render as _render
 from .render.mesh import MESH_DRAWABLE
 from .techniques import TECHNIQUES
 
-__all__ = ["registry", "bake", "load", "render", "save"]
+__all__ = ["registry", "bake", "load", "render", "save", "export"]
 
 _lock = threading.Lock()
 _filled = False
@@ -57,7 +58,21 @@ def _with_builtins(function):
     return public
 
 
+def _load(path, **kwargs):
+    """An .rk file, or a glTF file reliefkit exported (`io.gltf.representation.load`)."""
+    if gltf_representation.is_gltf(path):
+        return gltf_representation.load(path, **kwargs)
+    return rk.load(path, **kwargs)
+
+
+def _export(rep, path, **kwargs):
+    from .export import export  # the draw plans' modules: imported when exporting
+
+    return export(rep, path, **kwargs)
+
+
 bake = _with_builtins(_bake)
-load = _with_builtins(rk.load)
+load = _with_builtins(_load)
+export = _with_builtins(_export)
 render = _with_builtins(_render)
 save = _with_builtins(rk.save)

@@ -6,21 +6,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import sample, technique_samples, toy_technique
+from helpers import sample, sample_ids, technique_samples
 
 from reliefkit.render import render
 from reliefkit.render.frame import window_depth
 from reliefkit.scene.views import orbit_bounds
 
+pytestmark = pytest.mark.usefixtures("toy_registered")
+
 SAMPLES = technique_samples()
-IDS = [f"{tech}:{kind}" for tech, kind in SAMPLES]
+IDS = sample_ids(SAMPLES)
 VIEWS = [(30.0, 35.0, 2.4), (200.0, 10.0, 2.0)]
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 def check_frame(frame, camera) -> None:

@@ -10,21 +10,18 @@ import zipfile
 
 import numpy as np
 import pytest
-from helpers import sample, technique_samples, toy_technique
+from helpers import sample, sample_ids, technique_samples
 from numpy.lib import format as npy
 
 from reliefkit.builtins import registry
 from reliefkit.errors import FormatError
 from reliefkit.io import rk
 
+pytestmark = pytest.mark.usefixtures("toy_registered")
+
 SAMPLES = technique_samples()
-IDS = [f"{tech}:{kind}" for tech, kind in SAMPLES]
+IDS = sample_ids(SAMPLES)
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 @pytest.fixture(params=SAMPLES, ids=IDS)

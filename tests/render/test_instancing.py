@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-from helpers import sample, technique_samples, toy_technique
+from helpers import sample, technique_samples
 
 from reliefkit.render import render
 from reliefkit.render.draw import Scene
@@ -22,6 +22,8 @@ from reliefkit.render.instancing import NotInstanceable, placements
 from reliefkit.scene.assets import make_asset
 from reliefkit.scene.camera import Camera
 from reliefkit.scene.light import DirectionalLight
+
+pytestmark = pytest.mark.usefixtures("toy_registered")
 
 #: The kinds drawn instanced, and the mesh (the ground truth and the decimated mesh).
 INSTANCEABLE = {("relief", "relief"), ("relief", "relief-object"),
@@ -33,11 +35,6 @@ SIZE = (128, 128)
 PLACED = placements([[-1.3, 0.0, 0.2], [1.1, 0.3, -0.6], [0.1, -0.5, 1.0]],
                     scales=[0.6, 0.8, 0.5], yaws=[0.5, -1.0, 2.5])
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 def _matrix(p) -> np.ndarray:

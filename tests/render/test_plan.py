@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 import pytest
-from helpers import frame_of_plans, sample, technique_samples, toy_technique
+from helpers import frame_of_plans, sample, sample_ids, technique_samples
 
 from reliefkit.render import render
 from reliefkit.render.executor import Executor
@@ -18,14 +18,11 @@ from reliefkit.scene.assets import make_asset
 from reliefkit.scene.light import DirectionalLight
 from reliefkit.scene.views import orbit_bounds
 
+pytestmark = pytest.mark.usefixtures("toy_registered")
+
 SAMPLES = technique_samples()
-IDS = [f"{tech}:{kind}" for tech, kind in SAMPLES]
+IDS = sample_ids(SAMPLES)
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _toy_registered():
-    with toy_technique():
-        yield
 
 
 def _objects():

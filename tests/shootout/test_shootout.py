@@ -214,8 +214,8 @@ def test_a_row_is_measured_and_timed_with_its_declared_render_options():
     declared method, never the robust default, which refuses it."""
     from reliefkit.bake import bake
     from reliefkit.render import render
+    from reliefkit.scene.sphere_views import cameras
     from reliefkit.shootout.measure import measure
-    from reliefkit.shootout.views import cameras
 
     mesh = lamp()
     cube, = (c for c in candidates() if c.label == "relief-cube")

@@ -28,6 +28,7 @@ from reliefkit.core.technique import (
 from reliefkit.errors import FormatError, UsageError
 from reliefkit.io.rk import ArraySpec, Codec
 from reliefkit.render.plan import Attribute, DrawPlan, Geometry, Program, Raster
+from reliefkit.scene.mesh import Material, RenderMesh
 
 PROGRAM = "toy:toy.glsl"
 
@@ -61,6 +62,14 @@ class ToyQuad:
 
     def summary(self) -> dict:
         return {"kind": "toy-quad", "opacity": float(self.color[3])}
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer shows: the quad's two triangles in its colour (opacity as
+        glTF's BLEND when below 1); the count is fixed."""
+        alpha = "OPAQUE" if self.color[3] >= 1 else "BLEND"
+        return RenderMesh(self.corners, [[0, 1, 2], [0, 2, 3]], np.tile(self.normal, (4, 1)),
+                          np.ones((4, 4)), name="toy-quad",
+                          materials=[Material("toy", self.color, alpha_mode=alpha)])
 
 
 CODEC = Codec(

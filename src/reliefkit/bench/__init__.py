@@ -1,6 +1,7 @@
 """Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique, or one of the
 core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering;
-`compact`: compressed textures' bytes and error).
+`compact`: compressed textures' bytes and error; `scene`: instancing; `export`: glTF
+exports' bytes, time and fallbacks).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
@@ -14,7 +15,7 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import compact, loading, platform, scene
+from . import compact, export, loading, platform, scene
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -52,7 +53,10 @@ def suites() -> dict:
                                   "per demo asset and kind", compact.run_suite),
             "scene": BenchSuite("scene", "1,000 and 10,000 instances of one asset, each "
                                 "representation against the mesh decimated to equal error",
-                                scene.run_suite, takes_mesh=True)}
+                                scene.run_suite, takes_mesh=True),
+            "export": BenchSuite("export", "glTF export per demo asset and kind: .rk against "
+                                 ".glb bytes, export time, the fallback's triangles and "
+                                 "coverage against the mesh", export.run_suite)}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 

@@ -20,12 +20,14 @@ from ..bench import run_suite
 from ..compact.compact import CompressOptions, gpu_bytes
 from ..compare import compare, metrics_markdown, write_comparison
 from ..core.params import ANIMATION_TIME, options_of
-from ..core.technique import baker, technique_of
+from ..core.technique import baker, bakers, technique_of
 from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
+from ..export import export, export_lod
 from ..gl.context import gl_info
 from ..io.atomic import atomic_path, check_writable, written_together
-from ..io.inputs import DEMO_PREFIX, describe, load_input, what_it_is
+from ..io.gltf import representation as gltf_representation
+from ..io.inputs import DEMO_PREFIX, describe, kind_of, load_input, what_it_is
 from ..io.rk import array_bytes, file_sha256, load, read_manifest, save
 from ..progress import progress_bar, waiting
 from ..render import Scene, render, render_options
@@ -124,6 +126,96 @@ def cmd_bake(args) -> int:
     for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
         print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
+
+
+def cmd_export(args) -> int:
+    out = Path(args.output)
+    if out.suffix.lower() not in (".glb", ".gltf"):
+        raise UsageError(f"-o must name a .glb or .gltf file, got {args.output}")
+    check_writable(args.output, "-o")
+    if args.fallback_triangles < 2:
+        raise UsageError(f"--fallback-triangles must be at least 2, got {args.fallback_triangles}")
+    given = given_options(args)
+    common = {"fallback_triangles": args.fallback_triangles,
+              "embed_shaders": args.embed_shaders}
+    if args.lod:
+        if args.no_fallback:
+            raise UsageError("--no-fallback does not apply to --lod: every LOD is shown "
+                             "through its core mesh")
+        mesh, kinds, reps = _bake_lods(args, given)
+        source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
+        with waiting(f"measuring {len(reps)} LOD(s) against the mesh"):
+            path, lods = export_lod(mesh, reps, out, source_hash=source_hash, names=kinds,
+                                    **common)
+        print("LODs from the most to the least accurate (each one's error: docs/gltf.md):")
+        upper = 1.0
+        for lod in lods:
+            lower = lod["screen_coverage"]
+            shown = (f"shown while it covers {lower:.3g} to {upper:.3g} of the screen's height"
+                     if lower < upper else "never shown: the next LOD is as accurate")
+            print(f"LOD {lod['level']}: {lod['kind']:<20} surface error "
+                  f"{lod['surface_error']:.4g}, {shown}")
+            upper = lower
+    else:
+        if given:
+            flags = ", ".join("--" + k.replace("_", "-") for k in given)
+            raise UsageError(f"bake options ({flags}) need --lod and a mesh; to export an "
+                             ".rk baked with them, bake it with them first")
+        rep = _load(args.input)
+        source_hash = _source_hash_of(args.input)
+        with waiting(f"exporting {what_it_is(args.input, rep)}"):
+            path = export(rep, out, fallback=not args.no_fallback, source_hash=source_hash,
+                          **common)
+    print(f"wrote {path}: {format_bytes(_written_bytes(path))}")
+    return 0
+
+
+def _source_hash_of(spec: str) -> str | None:
+    """The source hash an .rk (or a glTF reliefkit exported) records; None for others."""
+    suffix = Path(spec).suffix.lower()
+    if suffix == ".rk":
+        return read_manifest(spec).get("source_hash")
+    if suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec):
+        return gltf_representation.read_manifest(spec).get("source_hash")
+    return None
+
+
+def _bake_lods(args, given: dict):
+    table = bakers()
+    kinds = [k.strip() for k in args.lod.split(",") if k.strip()]
+    unknown = [k for k in kinds if k not in table]
+    if not kinds or unknown:
+        what = f"unknown {', '.join(unknown)}" if unknown else f"got {args.lod!r}"
+        raise UsageError(f"--lod takes representations from {', '.join(table)} ({what})")
+    compression = {opt.name: given.pop(opt.name) for opt in options_of(CompressOptions)
+                   if opt.name in given}
+    declared = {opt.name for k in kinds for opt in table[k][1].options}
+    stray = [k for k in given if k not in declared]
+    if stray:
+        raise UsageError(f"{', '.join('--' + k.replace('_', '-') for k in stray)} applies to "
+                         f"none of --lod {args.lod}")
+    source = _bake_source(args.input, "export --lod")
+    if kind_of(source) != "mesh":
+        raise UsageError(f"export --lod needs a mesh (a mesh file or demo:NAME), not "
+                         f"{what_it_is(args.input, source)}")
+    reps = []
+    for kind in kinds:
+        params = applicable({k: v for k, v in given.items()
+                             if k in {o.name for o in table[kind][1].options}},
+                            table[kind][1].options, f"--lod {kind}")
+        with progress_bar(f"baking {kind}", 1) as advance:
+            reps.append(bake(source, kind, progress=advance, compress=compression, **params))
+    return source, kinds, reps
+
+
+def _written_bytes(path: Path) -> int:
+    """Bytes of an export: the .glb, or a .gltf with its .bin and image files."""
+    if path.suffix.lower() != ".gltf":
+        return path.stat().st_size
+    stem = path.stem
+    return sum(p.stat().st_size for p in path.parent.iterdir()
+               if p == path or p.name == f"{stem}.bin"
+               or (p.name.startswith(f"{stem}_") and p.suffix == ".png"))
 
 
 def _gpu_summary(rep) -> str:
@@ -426,9 +518,12 @@ def _describe_file(spec: str) -> dict:
     """A mesh's counts and bounds, or an .rk file's manifest once every array is read and its
     checksum verified (so "checksums: ok" is only ever printed for a file that loads)."""
     _check_not_empty(spec)
-    if Path(spec).suffix.lower() == ".rk":
-        rep = load(spec)  # every check render makes: checksums, then the representation's own
-        manifest = read_manifest(spec)
+    suffix = Path(spec).suffix.lower()
+    exported = suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec)
+    if suffix == ".rk" or exported:
+        # every check render makes: checksums, then the representation's own
+        rep = gltf_representation.load(spec) if exported else load(spec)
+        manifest = (gltf_representation.read_manifest if exported else read_manifest)(spec)
         for name, (fmt, gpu, raw) in gpu_bytes(rep).items():
             if name in manifest["arrays"]:
                 manifest["arrays"][name]["gpu"] = {"format": fmt, "bytes": gpu, "raw_bytes": raw}

@@ -11,6 +11,7 @@ from ..builtins import registry
 from ..compact.compact import CompressOptions
 from ..core.params import options_of
 from ..core.technique import bakers, techniques
+from ..export.gltf import DEFAULT_FALLBACK_TRIANGLES
 from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
 from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW
@@ -20,6 +21,7 @@ from .commands import (
     cmd_bench,
     cmd_compare,
     cmd_demo,
+    cmd_export,
     cmd_info,
     cmd_render,
     cmd_shootout,
@@ -40,6 +42,10 @@ CORE_EXAMPLES = {
                "APNG)",
                "reliefkit render demo:tree --turntable 36 --size 640x480 -o spin.mp4",
                "reliefkit render demo:tree --turntable 36 -o frames/%04d.png"],
+    "export": ["reliefkit export tree.rk -o tree.glb                 any viewer shows it; "
+               "reliefkit reads it back",
+               "reliefkit export car.glb --lod relief-cube,billboard-cloud -o car-lod.glb",
+               "reliefkit export tree.rk -o tree.gltf --embed-shaders"],
     "shootout": ["reliefkit shootout demo:tree --out out/shootout    what to ship at 64 and "
                  "256 px, 256 KB and 1 MB",
                  "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "
@@ -49,7 +55,7 @@ CORE_EXAMPLES = {
              "reliefkit info model.obj                          counts and bounds of a mesh "
              "(or an .rk)"],
 }
-ORDER = ("demo", "render", "bake", "compare", "shootout", "bench", "info")
+ORDER = ("demo", "render", "bake", "compare", "export", "shootout", "bench", "info")
 
 
 def _examples(command: str | None = None) -> list[str]:
@@ -220,6 +226,31 @@ def build_parser() -> argparse.ArgumentParser:
                         + ", ".join(c.label for c in shootout_candidates()) + ")")
     p.add_argument("--out", required=True, help="output folder")
     p.set_defaults(run=cmd_shootout)
+
+    p = _command(sub, "export", "write a representation, or a mesh's LOD chain, as glTF 2.0",
+                 "Write an .rk representation (or a glTF file reliefkit exported) as glTF "
+                 "2.0 (.glb, or .gltf with its .bin and PNG files): a core mesh any viewer "
+                 "shows, and reliefkit's RELIEFKIT_<kind> extension with the representation "
+                 "and its draw plans (docs/gltf.md). With --lod, bake a mesh into the listed "
+                 "representations and write them after it as an MSFT_lod chain.")
+    p.add_argument("input", help=".rk file (or a .glb reliefkit wrote); with --lod a mesh "
+                                 "file or demo:NAME")
+    p.add_argument("-o", "--output", required=True, help="output .glb or .gltf")
+    p.add_argument("--no-fallback", action="store_true",
+                   help="write no core mesh, only the extension (viewers without reliefkit's "
+                        "extension then show nothing)")
+    p.add_argument("--embed-shaders", action="store_true",
+                   help="add the GLSL ES 3.00 sources of the draw plans' programs")
+    p.add_argument("--fallback-triangles", type=int, default=DEFAULT_FALLBACK_TRIANGLES,
+                   metavar="N", help="triangle budget of the core mesh where the kind has one "
+                                     "(default: %(default)s)")
+    p.add_argument("--lod", metavar="KIND,KIND",
+                   help="bake INPUT (a mesh) as these representations (" + ", ".join(table)
+                        + ") and write mesh + representations as an LOD chain")
+    add_options(p, [(name, b.options) for name, (_, b) in table.items()],
+                "bake options (with --lod; each applies to the kinds that declare it)")
+    add_options(p, [("compress", options_of(CompressOptions))], "compression (with --lod)")
+    p.set_defaults(run=cmd_export)
 
     names = suite_names()
     p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",

@@ -13,15 +13,21 @@ from pathlib import Path
 from ..errors import FormatError, MeshError, UsageError
 from ..scene.assets import make_asset
 from ..scene.mesh import RenderMesh
+from .gltf import representation as gltf_representation
 from .rk import codec_of, load
 
 DEMO_PREFIX = "demo:"
 
 
 def load_input(spec: str):
-    """``demo:NAME`` -> a procedural RenderMesh, ``*.rk`` -> its representation, else a mesh."""
-    if not _is_demo(spec) and Path(spec).suffix.lower() == ".rk":
-        return load(spec)
+    """``demo:NAME`` -> a procedural RenderMesh, ``*.rk`` or a glTF file reliefkit exported
+    -> its representation, else a mesh."""
+    if not _is_demo(spec):
+        suffix = Path(spec).suffix.lower()
+        if suffix == ".rk":
+            return load(spec)
+        if suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec):
+            return gltf_representation.load(spec)
     return load_mesh(spec)
 
 

@@ -46,7 +46,8 @@ from .atomic import atomic_path
 __all__ = [
     "ArraySpec", "Codec", "CodecTable", "RkFile", "use_codecs",
     "save", "load", "read_manifest", "codec_of", "write_rk", "read_rk", "file_sha256",
-    "array_bytes",
+    "array_bytes", "prepare", "check_stored", "check_finite_arrays", "stored_form",
+    "decoded_array", "build", "codec_table",
     "FORMAT_NAME", "FORMAT_VERSION", "DEFAULT_MAX_BYTES",
 ]
 
@@ -229,6 +230,11 @@ def use_codecs(table: Callable[[], CodecTable]) -> None:
 
 def _table(codecs: CodecTable | None) -> CodecTable:
     return codecs if codecs is not None else _codec_table()
+
+
+def codec_table(codecs: CodecTable | None = None) -> CodecTable:
+    """``codecs``, or the process's table (the one handed to `use_codecs`)."""
+    return _table(codecs)
 
 
 def _check_spec(kind: str, name: str, spec: ArraySpec) -> None:
@@ -464,6 +470,58 @@ def _write_zip(fh, head: dict, arrays: dict[str, np.ndarray]) -> None:
         zf.writestr(_zipinfo(MANIFEST_NAME), json.dumps(manifest, indent=2) + "\n")
 
 
+# ------------------------------------------ the same checks for other containers (io.gltf)
+
+
+def prepare(representation, *, codecs: CodecTable | None = None
+            ) -> tuple[Codec, dict[str, np.ndarray], dict]:
+    """A representation's codec, arrays and params, checked as `save` checks them (dtypes,
+    shapes, finiteness, JSON params), for a container other than .rk."""
+    codec = _table(codecs).for_object(representation)
+    arrays, params = codec.to_arrays(representation)
+    arrays = _prepare_arrays(codec, arrays)
+    if not isinstance(params, dict):
+        raise FormatError(f"params must be a dict, got {type(params).__name__}")
+    _check_json(params)
+    return codec, arrays, params
+
+
+def stored_form(array: np.ndarray) -> tuple[np.ndarray, dict | None]:
+    """What a container stores of ``array``: the array itself, or its encoded level 0 and
+    the encoding's record (everything but the bytes)."""
+    encoded = encoding_of(array)
+    return (array, None) if encoded is None else (encoded.data, _encoding_entry(encoded))
+
+
+def check_stored(codec: Codec, names: Iterable[str], declared: Mapping[str, tuple]) -> None:
+    """The arrays a container declares, before any is read: the set against the kind, each
+    ``name -> (dtype, stored shape, encoding record or None)`` against its spec, and the
+    decoded shapes against each other (`Codec.check_shapes`)."""
+    _check_array_set(codec, names)
+    shapes = {}
+    for name, (dtype, shape, encoding) in declared.items():
+        if encoding is None:
+            _check_array(codec.kind, name, codec.arrays[name], dtype, shape)
+            shapes[name] = tuple(shape)
+        else:
+            _check_encoding(codec, name, encoding, dtype, shape)
+            shapes[name] = tuple(encoding["shape"])
+    if codec.check_shapes is not None:
+        codec.check_shapes(shapes)
+
+
+def decoded_array(stored: np.ndarray, encoding: dict | None) -> np.ndarray:
+    """A stored array as the representation holds it (decoded when it has an encoding)."""
+    return _decoded(stored, encoding)
+
+
+def check_finite_arrays(codec: Codec, arrays: Mapping[str, np.ndarray]) -> None:
+    """NaN and Inf where the kind requires finite values, once the arrays are read."""
+    for name, arr in arrays.items():
+        if codec.arrays[name].finite:
+            _check_finite(name, arr)
+
+
 # --------------------------------------------------------------------------- reading
 
 
@@ -531,13 +589,18 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None 
     path = Path(path)
     codecs = _table(codecs)
     rk = read_rk(path, max_bytes=max_bytes, codecs=codecs)
-    codec = codecs.for_kind(rk.kind)
+    return build(codecs.for_kind(rk.kind), rk.arrays, rk.params, path)
+
+
+def build(codec: Codec, arrays: Mapping[str, np.ndarray], params: dict, where):
+    """The representation of validated ``arrays`` and ``params``; what it rejects is a
+    `FormatError` naming ``where`` (the file)."""
     try:
-        return codec.from_arrays(dict(rk.arrays), dict(rk.params))
+        return codec.from_arrays(dict(arrays), dict(params))
     except FormatError as exc:
-        raise FormatError(f"{path}: {exc}") from exc
+        raise FormatError(f"{where}: {exc}") from exc
     except (ReliefkitError, KeyError, TypeError, ValueError, ArithmeticError) as exc:
-        raise FormatError(f"{path}: invalid {rk.kind} data ({exc}); the file is corrupt or "
+        raise FormatError(f"{where}: invalid {codec.kind} data ({exc}); the file is corrupt or "
                           "forged") from exc
 
 
@@ -566,9 +629,7 @@ def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES,
         manifest, codec, members = _inspect(archive, max_bytes, _table(codecs))
         arrays = {name: _decoded(_read_member(archive, name, m), m.encoding)
                   for name, m in members.items()}
-        for name, arr in arrays.items():
-            if codec.arrays[name].finite:
-                _check_finite(name, arr)
+        check_finite_arrays(codec, arrays)
     return RkFile(codec.kind, manifest, manifest["params"], arrays)
 
 

@@ -230,6 +230,7 @@ class _Arrays:
     def __init__(self):
         self.named: dict[str, np.ndarray] = {}
         self._ids: dict[int, str] = {}
+        self.records: dict[int, str] = {}  # id of a shared geometry or texture -> its key
 
     def put(self, array: np.ndarray) -> str:
         key = self._ids.get(id(array))
@@ -275,9 +276,11 @@ def _decode(value, arrays: Mapping[str, np.ndarray]):
 
 
 def _record(obj, arrays: _Arrays, table: dict, kind: str) -> str:
-    """Name of the shared object ``obj`` in ``table`` (a geometry or a texture)."""
-    key = f"{kind}{id(obj)}"
-    if key not in table:
+    """Name of the shared object ``obj`` in ``table`` (a geometry or a texture): numbered
+    in the order met, so equal plans give equal documents (an export's bytes)."""
+    key = arrays.records.get(id(obj))
+    if key is None:
+        key = arrays.records[id(obj)] = f"{kind}{len(table)}"
         table[key] = {f.name: _encode(getattr(obj, f.name), arrays) for f in fields(obj)
                       if f.name != "attributes"}
         if kind == "g":

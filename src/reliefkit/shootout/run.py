@@ -17,9 +17,9 @@ from ..pictures import TILE_BACKGROUND
 from ..progress import progress_bar
 from ..render import render
 from ..scene.decimate import decimate_to_bytes, gpu_bytes, simplified
+from ..scene.sphere_views import VIEWS, cameras
 from .measure import measure
 from .sizing import Search, unfit_reason
-from .views import VIEWS, cameras
 
 DECIMATED = "decimated mesh"
 

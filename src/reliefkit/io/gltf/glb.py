@@ -14,6 +14,7 @@ image) into the document's ``buffers`` / ``bufferViews`` / ``accessors`` / ``ima
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import struct
@@ -26,7 +27,8 @@ from ...errors import FormatError
 from ..atomic import atomic_path
 
 __all__ = ["Glb", "GlbBuilder", "glb_bytes", "write_glb", "read_glb", "accessor_array",
-           "image_bytes", "DEFAULT_MAX_BYTES", "MAX_JSON_BYTES"]
+           "image_bytes", "DEFAULT_MAX_BYTES", "MAX_JSON_BYTES", "ARRAY_BUFFER",
+           "ELEMENT_ARRAY_BUFFER"]
 
 MAGIC = b"glTF"
 VERSION = 2
@@ -36,6 +38,7 @@ DEFAULT_MAX_BYTES = 4 << 30  # as the .rk reader's
 MAX_JSON_BYTES = 64 << 20
 ALIGN = 4
 ARRAY_BUFFER = 34962  # a bufferView's target for vertex attributes
+ELEMENT_ARRAY_BUFFER = 34963  # ... and for indices
 
 _HEADER = struct.Struct("<4sII")  # magic, version, total length
 _CHUNK = struct.Struct("<II")     # chunk length, chunk type
@@ -68,10 +71,23 @@ class GlbBuilder:
 
     document: dict = field(default_factory=lambda: {"asset": {"version": "2.0"}})
     _binary: bytearray = field(default_factory=bytearray)
+    #: None: images live in the binary buffer (a .glb); a prefix: each image is a file of its
+    #: own named ``{prefix}{k}.png`` beside the document (a .gltf), kept in `files`.
+    image_files: str | None = None
+    files: dict = field(default_factory=dict)    # uri -> bytes, when image_files is set
+    _views: dict = field(default_factory=dict)   # (sha256, stride) -> bufferView
+    _images: dict = field(default_factory=dict)  # bufferView or uri -> image
 
     def add_view(self, data: bytes, *, target: int | None = None,
                  stride: int | None = None) -> int:
-        """Append ``data`` as a bufferView starting on a 4-byte boundary; its index."""
+        """Append ``data`` as a bufferView starting on a 4-byte boundary; its index. Bytes
+        already added without a target, with the same stride, are not stored twice: their view's
+        index is returned (an export's draw plans share most arrays with its arrays)."""
+        # vertex and index data (a target) is never shared: glTF wants a byteStride on a
+        # view two vertex accessors use
+        key = None if target is not None else (hashlib.sha256(data).digest(), stride)
+        if key in self._views:
+            return self._views[key]
         self._binary.extend(b"\0" * (-len(self._binary) % ALIGN))
         view = {"buffer": 0, "byteOffset": len(self._binary), "byteLength": len(data)}
         if stride is not None:
@@ -79,7 +95,10 @@ class GlbBuilder:
         if target is not None:
             view["target"] = target
         self._binary.extend(data)
-        return _append(self.document, "bufferViews", view)
+        index = append_item(self.document, "bufferViews", view)
+        if key is not None:
+            self._views[key] = index
+        return index
 
     def add_array(self, array, *, target: int | None = None, bounds: bool = False,
                   normalized: bool = False) -> int:
@@ -108,14 +127,25 @@ class GlbBuilder:
             flat = array.reshape(array.shape[0], -1)
             accessor["min"] = [_number(v) for v in flat.min(axis=0)]
             accessor["max"] = [_number(v) for v in flat.max(axis=0)]
-        return _append(self.document, "accessors", accessor)
+        return append_item(self.document, "accessors", accessor)
 
     def add_png(self, png: bytes) -> int:
-        """Append encoded PNG bytes as a bufferView and an image; the image's index."""
+        """Append encoded PNG bytes as a bufferView and an image; the image's index (the
+        same image's for the same bytes)."""
         if not png.startswith(_PNG_SIGNATURE):
             raise FormatError("add_png takes encoded PNG bytes (no PNG signature found)")
-        image = {"bufferView": self.add_view(png), "mimeType": "image/png"}
-        return _append(self.document, "images", image)
+        if self.image_files is None:
+            key = self.add_view(png)
+            image = {"bufferView": key, "mimeType": "image/png"}
+        else:
+            key = hashlib.sha256(png).hexdigest()
+            if key not in self._images:
+                uri = f"{self.image_files}{len(self.files)}.png"
+                self.files[uri] = png
+                image = {"uri": uri, "mimeType": "image/png"}
+        if key not in self._images:
+            self._images[key] = append_item(self.document, "images", image)
+        return self._images[key]
 
     def finish(self) -> tuple[dict, bytes]:
         """The document (with ``buffers[0]`` when there is data) and the binary buffer, for
@@ -142,7 +172,7 @@ def _vertex_rows(array: np.ndarray, target: int | None) -> tuple[bytes, int | No
     return padded.tobytes(), stride
 
 
-def _append(document: dict, key: str, item: dict) -> int:
+def append_item(document: dict, key: str, item: dict) -> int:
     items = document.setdefault(key, [])
     items.append(item)
     return len(items) - 1
@@ -192,6 +222,7 @@ class Glb:
 
     document: dict
     binary: bytes
+    files: dict = field(default_factory=dict)  # a .gltf's image files: uri -> bytes
 
 
 def read_glb(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Glb:
@@ -230,7 +261,7 @@ def _read(fh, size: int, max_bytes: int) -> Glb:
     if length > MAX_JSON_BYTES:
         raise FormatError(f"the JSON chunk claims {length:,} bytes, over the "
                           f"{MAX_JSON_BYTES:,}-byte limit")
-    document = _parse_json(fh.read(length))
+    document = parse_document(fh.read(length))
     binary, bin_offset = b"", _HEADER.size + _CHUNK.size + length
     offset = bin_offset
     while offset < size:
@@ -243,7 +274,7 @@ def _read(fh, size: int, max_bytes: int) -> Glb:
         else:  # chunks of unknown types are skipped, as the specification asks
             fh.seek(length, os.SEEK_CUR)
         offset += _CHUNK.size + length
-    _check_layout(document, len(binary))
+    check_layout(document, len(binary))
     return Glb(document, binary)
 
 
@@ -259,13 +290,16 @@ def _chunk_header(fh, offset: int, size: int) -> tuple[int, int]:
     return length, kind
 
 
-def _parse_json(data: bytes) -> dict:
+def parse_document(data: bytes, what: str = "the JSON chunk") -> dict:
+    """A glTF 2.0 JSON document from its bytes (``what`` names them in errors)."""
     try:
         document = json.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:
-        raise FormatError(f"the JSON chunk is not valid UTF-8 JSON ({exc})") from None
+        raise FormatError(f"{what} is not valid UTF-8 JSON ({exc})") from None
+    except RecursionError:
+        raise FormatError(f"{what} nests too deeply to be a glTF document (forged)") from None
     if not isinstance(document, dict) or not isinstance(document.get("asset"), dict):
-        raise FormatError("the JSON chunk is not a glTF document (no 'asset' object)")
+        raise FormatError(f"{what} is not a glTF document (no 'asset' object)")
     if document["asset"].get("version") != "2.0":
         raise FormatError(f"glTF version {document['asset'].get('version')!r}; only '2.0' "
                           "is read")
@@ -293,18 +327,21 @@ def _index(item: dict, key: str, where: str, count: int, what: str) -> int:
     return value
 
 
-def _check_layout(document: dict, bin_length: int) -> None:
-    """Every buffer, bufferView, accessor and image range lies inside the BIN chunk."""
+def check_layout(document: dict, bin_length: int, *, files=(), external_buffer=False) -> None:
+    """Every buffer, bufferView, accessor and image range lies inside the binary buffer (a
+    GLB's BIN chunk, or with ``external_buffer`` a .gltf's one .bin file, already read), and
+    every image file is one of ``files``."""
     buffers = _items(document, "buffers")
     lengths = []
     for k, buffer in enumerate(buffers):
         where = f"buffers[{k}]"
-        if "uri" in buffer:
+        if "uri" in buffer and not external_buffer:
             raise FormatError(f"{where} refers to an external file ({buffer['uri']!r}); "
                               "only the GLB's own BIN chunk is read")
         length = _int(buffer, "byteLength", where)
         if k:
-            raise FormatError(f"{len(buffers)} buffers; a GLB has one, its BIN chunk")
+            raise FormatError(f"{len(buffers)} buffers; reliefkit reads one (a GLB's BIN "
+                              "chunk or a .gltf's .bin file)")
         if not bin_length - 3 <= length <= bin_length:
             raise FormatError(f"{where} claims {length:,} bytes; the BIN chunk holds "
                               f"{bin_length:,} (truncated or forged)")
@@ -322,6 +359,9 @@ def _check_layout(document: dict, bin_length: int) -> None:
     for k, image in enumerate(_items(document, "images")):
         if "bufferView" in image:
             _index(image, "bufferView", f"images[{k}]", len(views), "bufferView")
+        elif image.get("uri") not in files:
+            raise FormatError(f"images[{k}] refers to a file ({image.get('uri')!r}) this "
+                              "reader did not read; only its own image files are read")
 
 
 def _check_accessor(accessor: dict, where: str, views: list[dict]) -> None:
@@ -364,7 +404,11 @@ def accessor_array(glb: Glb, index: int) -> np.ndarray:
 
 
 def image_bytes(glb: Glb, index: int) -> bytes:
-    """The encoded bytes of image ``index`` (one held in a bufferView) of a validated `Glb`."""
-    view = glb.document["bufferViews"][glb.document["images"][index]["bufferView"]]
+    """The encoded bytes of image ``index`` of a validated `Glb` (held in a bufferView, or
+    a .gltf's file)."""
+    image = glb.document["images"][index]
+    if "uri" in image:
+        return glb.files[image["uri"]]
+    view = glb.document["bufferViews"][image["bufferView"]]
     start = view.get("byteOffset", 0)
     return glb.binary[start:start + view["byteLength"]]

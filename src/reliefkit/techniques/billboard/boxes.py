@@ -17,6 +17,7 @@ import numpy as np
 
 from ...core.transforms import MAX_COORDINATE, transform_points, unit_cube_corners
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
 from ...units import format_bytes
 from .representation import BillboardCloud
@@ -110,6 +111,16 @@ class BillboardBoxes:
     @property
     def center(self) -> np.ndarray:
         return self.bounds.mean(axis=0)
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the quads of ``cloud``,
+        the billboard cloud the boxes hand over to with distance
+        (`BillboardCloud.fallback_mesh`: 2 triangles per box, a fixed count)."""
+        return self.cloud.fallback_mesh(triangles)
+
+    def fallback_normal_maps(self) -> dict:
+        """The normal maps of ``cloud``'s fallback, per material."""
+        return self.cloud.fallback_normal_maps()
 
     def memory_bytes(self) -> dict:
         """Bytes per map as in the paper's Table 2: colour, normals, distance textures (and

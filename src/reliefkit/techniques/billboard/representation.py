@@ -8,7 +8,9 @@ import numpy as np
 
 from ...core.transforms import MAX_COORDINATE
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
+from . import fallback
 
 #: Texels left empty around every rectangle in the atlas, so that bilinear and mipmapped
 #: lookups near a rectangle's border never read its neighbour.
@@ -105,6 +107,23 @@ class BillboardCloud:
     @property
     def center(self) -> np.ndarray:
         return self.bounds.mean(axis=0)
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the rectangles as quads
+        textured with the atlas pages (one material each), alpha-tested at the renderer's 0.5
+        (MASK), double-sided. Always 2 triangles per rectangle, whatever ``triangles`` says:
+        the count is the cloud's."""
+        return fallback.fallback_mesh(self)
+
+    def geometric_error(self) -> float:
+        """The world distance the cloud may be off the surface: epsilon, every face within
+        it of its card (where it projects below one pixel a DMBBC draws this cloud; an LOD
+        chain switches to it there, `reliefkit.export.lod`)."""
+        return self.epsilon
+
+    def fallback_normal_maps(self) -> dict:
+        """The fallback's tangent-space normal map per material (atlas page)."""
+        return fallback.fallback_normal_maps(self)
 
     def memory_bytes(self) -> dict:
         """Bytes of each stored array (the atlases dominate)."""

@@ -9,7 +9,9 @@ import numpy as np
 
 from ...compact.encodings import encoding_of
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
+from . import fallback
 
 MIN_FRAME = 8        # texels on a frame's side, padding excluded
 MAX_ATLAS = 8192     # texels on the atlas's side (every GL 4 GPU has at least 16384)
@@ -115,6 +117,13 @@ class OctahedralImpostor:
     def bounds(self) -> np.ndarray:
         """The bounding sphere's box, (2, 3) float64 world."""
         return np.stack([self.center - self.radius, self.center + self.radius])
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: one quad facing the start
+        view, covering the bounding sphere's square, textured with what the impostor shows
+        from there (MASK at 0.5, double-sided); always 2 triangles, whatever ``triangles``
+        says (`fallback`)."""
+        return fallback.fallback_mesh(self)
 
     @property
     def nbytes(self) -> int:

@@ -15,6 +15,7 @@ from ...core.transforms import (
     unit_cube_corners,
 )
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
 
 
@@ -134,6 +135,14 @@ class ReliefTexture:
         """World positions (..., 3) -> box coordinates (..., 3)."""
         return transform_points(self.world_to_box, world)
 
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the heightfield
+        triangulated at the finest grid within ``triangles``, mapped through
+        ``box_to_world``, cut to ``clip_bounds``, textured by ``color`` (`fallback`)."""
+        from .fallback import relief_fallback  # the reference's numba: slow to import
+
+        return relief_fallback(self, triangles)
+
     def memory_bytes(self) -> dict:
         """Bytes of each array as stored."""
         arrays = {"height": self.height, "color": self.color, "normal": self.normal}
@@ -205,6 +214,14 @@ class ReliefObject:
     def bounds(self) -> np.ndarray:
         b = np.stack([p.bounds for p in self.parts])
         return np.stack([b[:, 0].min(axis=0), b[:, 1].max(axis=0)])
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: every part's heightfield
+        triangulated, ``triangles`` shared out by their texels, with the curtains the
+        parts draw between near and far surfaces (`fallback`)."""
+        from .fallback import relief_object_fallback  # the reference's numba: slow to import
+
+        return relief_object_fallback(self, triangles)
 
     def summary(self) -> dict:
         return {"kind": "relief-object", "parts": len(self.parts),

@@ -16,6 +16,7 @@ from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
+from . import fallback
 from .shell import ShellVolume, build_shell
 from .textures import VolumeTexture
 
@@ -106,6 +107,14 @@ class TexturedShell:
         moved = RenderMesh(p + offset, base.indices, base.normals, base.colors, base.uvs,
                            name=base.name)
         return build_shell(moved, self.thickness)
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the base mesh with the
+        volume's colour projected on it (composited down each column of the texture) as a
+        tiled texture, cut away where a column is mostly clear (`fallback`). Its triangles
+        are the base's own: ``triangles`` does not apply (a shell's base is already what
+        its tetrahedra are built on)."""
+        return fallback.fallback_mesh(self)
 
     def bake_report(self) -> list[str]:
         """What `reliefkit bake` says of a fresh shell."""

@@ -51,6 +51,9 @@ TEXEL_BYTES = 4 + 1 + 16 + 12
 #: Mesa the driver's copy of the textures); measured as the slope of the peak RSS from
 #: res 512 to 1024 (bake 71 B, render 85 B), with margin.
 PEAK_TEXEL_BYTES = {"bake": 76, "render": 88}
+#: Texturing (§4.2): a point this many texels (plus one slice, or one grid cell) behind
+#: image k's surface still counts as seen by image k (`visible_depth`).
+VISIBLE_TEXELS = 1.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,6 +136,13 @@ class DepthImages:
                              -1.0 if outward_positive else 2.0)
             bounds[axis, 1 if outward_positive else 0, ib, ic] = value
         return bounds
+
+
+def visible_depth(resolution: int, slack: float = 0.0) -> float:
+    """How far behind image k's surface a drawn point may be and still count as seen by it
+    (cube-side units): `VISIBLE_TEXELS`, plus ``slack`` (a slice spacing for the point
+    test, or a fallback mesh's grid cell: how far such points lie from the surface)."""
+    return VISIBLE_TEXELS / resolution + slack
 
 
 def check_side(side: float) -> None:

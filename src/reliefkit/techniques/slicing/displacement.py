@@ -33,6 +33,7 @@ from ...bake.uv_atlas import MAX_MATERIALS, MaterialAtlas, linear_tint
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh, vertex_normals
 from ...scene.views import source_box
+from .displacement_fallback import displacement_fallback
 
 MAX_TEXELS = 8192 * 8192
 MAX_TILE = 4096.0
@@ -180,11 +181,10 @@ class DisplacementMap:
         return np.stack([bilinear(self.color[..., k], u, v, self.wrap) for k in range(4)],
                         axis=-1)
 
-    def displaced_mesh(self, subdivisions: int = 16):
-        """The displaced surface as a fine RenderMesh (ground truth for coverage tests):
-        every base triangle cut into ``subdivisions``^2 triangles, each vertex moved by
-        height(uv) * scale along the linearly interpolated normal (the volume's own
-        parametrisation), coloured from the colour texture."""
+    def displaced_lattice(self, subdivisions: int) -> DisplacedLattice:
+        """Every base triangle cut into ``subdivisions``^2 triangles, each lattice vertex
+        moved by height(uv) * scale along the linearly interpolated normal (the volume's own
+        parametrisation); vertices are not shared between base triangles."""
         n = int(subdivisions)
         if n < 1 or n > 256:
             raise UsageError(f"subdivisions must be in [1, 256], got {subdivisions!r}")
@@ -212,13 +212,33 @@ class DisplacementMap:
         moved = (pts + (hgt * self.scale)[..., None] * nrm).reshape(-1, 3)
         count = len(bary)
         faces = (small[None, :, :] + count * np.arange(len(tris))[:, None, None]).reshape(-1, 3)
-        colors = np.clip(self.sample_color(uvs[..., 0], uvs[..., 1]), 0, 1)
-        colors[..., :3] *= self.tint(uvs, np.arange(len(tris))[:, None])
-        colors = colors.reshape(-1, 4)
+        return DisplacedLattice(moved, faces, uvs.reshape(-1, 2),
+                                np.repeat(np.arange(len(tris)), count), pts.reshape(-1, 3))
+
+    def lattice_colors(self, lattice: DisplacedLattice) -> np.ndarray:
+        """(V, 4) linear RGBA at the lattice's vertices as the renderer colours them: the
+        texture's colour tinted by the surface, alpha the texture's (below 0.5: nothing)."""
+        uv = lattice.uvs
+        colors = np.clip(self.sample_color(uv[:, 0], uv[:, 1]), 0, 1)
+        colors[:, :3] *= self.tint(uv, lattice.triangle)
+        return colors
+
+    def displaced_mesh(self, subdivisions: int = 16):
+        """The displaced surface as a fine RenderMesh (ground truth for coverage tests): the
+        `displaced_lattice`, coloured from the colour texture."""
+        lattice = self.displaced_lattice(subdivisions)
+        colors = self.lattice_colors(lattice)
         colors[:, 3] = 1.0
-        normals = vertex_normals(moved, faces)
-        return RenderMesh(moved, faces, normals, colors.astype(np.float32),
-                          uvs.reshape(-1, 2), name=f"{base.name} displaced")
+        normals = vertex_normals(lattice.positions, lattice.faces)
+        return RenderMesh(lattice.positions, lattice.faces, normals, colors.astype(np.float32),
+                          lattice.uvs, name=f"{self.base.name} displaced")
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the displaced surface,
+        every base triangle cut as finely as ``triangles`` allows, coloured per vertex as the
+        kind draws it. A base with more triangles than that keeps one per base triangle
+        (`displacement_fallback`)."""
+        return displacement_fallback(self, triangles)
 
     def bake_report(self) -> list[str]:
         h, w = self.height.shape
@@ -261,6 +281,22 @@ def bilinear(image: np.ndarray, s, t, wrap: bool) -> np.ndarray:
     top = img[y0, x0] * (1 - fx) + img[y0, x1] * fx
     bottom = img[y1, x0] * (1 - fx) + img[y1, x1] * fx
     return top * (1 - fy) + bottom * fy
+
+
+@dataclass(frozen=True, eq=False)
+class DisplacedLattice:
+    """Points of the displaced surface over a lattice of each base triangle.
+
+    positions : (V, 3) float64 world; faces : (F, 3) int64; uvs : (V, 2) float64 base uvs;
+    triangle : (V,) int64 the base triangle of each vertex; base : (V, 3) float64 world, the
+    point on the base each vertex was moved from.
+    """
+
+    positions: np.ndarray
+    faces: np.ndarray
+    uvs: np.ndarray
+    triangle: np.ndarray
+    base: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)

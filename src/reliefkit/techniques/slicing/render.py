@@ -21,7 +21,7 @@ time, so they take the point test.
 
 Texturing (§4.2): the three images closest to the view direction, or the single nearest
 (``texturing``), restricted to the images that see the point (a point is seen by image k
-when it lies within `VISIBLE_TEXELS` of k's first surface; ``visibility=False`` is the
+when it lies within `depth_images.VISIBLE_TEXELS` of k's first surface; ``visibility=False`` is the
 paper's texturing); lit with the blended normal unless ``unlit``.
 
 The drawable is one draw plan (`render.plan`): the six images as texture arrays, and the
@@ -55,7 +55,7 @@ from ...render.plan import (
     ViewUpdate,
 )
 from ...render.proxy import PROXY_RASTER, Proxy, box_planes, convex_proxy, cull_face
-from .depth_images import FACE_INDEX, check_memory
+from .depth_images import FACE_INDEX, check_memory, visible_depth
 from .representation import DepthObject
 from .slices import auto_slice_count, orthogonal_slices, screen_slices, view_direction
 
@@ -68,8 +68,6 @@ ALPHA_TESTS = ("point", "slab")
 EMPTY_DEPTH = 2.0          # uploaded for texels whose column is empty: no test can pass
 FINEST_TEXELS = 0.5        # automatic slices: never closer than half a texel (a slice hit
                            # lies up to one spacing / cos(angle) behind the exact one)
-VISIBLE_TEXELS = 1.5       # a point this many texels (plus one slice) behind image k's
-                           # surface still counts as seen by image k
 PROGRAMS = tuple(ProgramVariant(PROGRAM, d) for d in (
     {}, {"HULL": True}, {"TEXTURING_NEAREST": True}, {"UNLIT": True}, {"TEST_ONE": True},
     {"COLOR_ONLY": True}, {"SLAB": True}, {"RAYCAST": True}, {"RAYCAST": True, "HULL": True},
@@ -239,13 +237,6 @@ def _vertices(positions, cube) -> dict:
 def _geometry(positions, cube, triangles) -> Geometry:
     return Geometry({name: Attribute(a) for name, a in _vertices(positions, cube).items()},
                     indices=np.asarray(triangles, np.uint32))
-
-
-def visible_depth(resolution: int, slack: float = 0.0) -> float:
-    """How far behind image k's surface a drawn point may be and still count as seen by it
-    (cube-side units): `VISIBLE_TEXELS`, plus ``slack`` (a slice spacing for the point
-    test, whose points lie up to that far inside the surface)."""
-    return VISIBLE_TEXELS / resolution + slack
 
 
 def slice_stack(cube_to_world, resolution: int, slicing: str, slices: int | None, camera):

@@ -15,7 +15,9 @@ import numpy as np
 
 from ...bake.project import axis_frame
 from ...errors import UsageError
+from ...scene.mesh import RenderMesh
 from ...scene.views import source_box
+from . import depth_object_fallback
 from .depth_images import FACE_INDEX, DepthImages, visual_hull
 
 #: `DepthObject.bake_report` warns when more of one image's silhouette than this is carved
@@ -82,6 +84,14 @@ class DepthObject:
     def tested_faces(self) -> tuple[int, ...]:
         """The images a fragment is tested against: all six, or for a hull one per axis."""
         return (0, 2, 4) if self.hull else tuple(range(6))
+
+    def fallback_mesh(self, triangles: int = 20_000) -> RenderMesh:
+        """What a glTF viewer that knows nothing of reliefkit shows: the carved volume (a
+        hull's silhouettes' intersection) as a closed mesh of at most ``triangles``
+        triangles, by marching cubes on the grid that fits, with vertex colours and normals
+        from the images as the renderer textures a point seen straight on
+        (`depth_object_fallback`)."""
+        return depth_object_fallback.fallback_mesh(self, triangles)
 
     def bake_report(self) -> list[str]:
         from .reference import carved_fraction  # numba: slow to import

@@ -1,11 +1,12 @@
-"""The shootout's fixed views: around at three azimuths, from above, from below and grazing;
-each framed so that the object's bounding sphere spans exactly the screen size."""
+"""Six fixed views that measure a representation against its mesh (`reliefkit shootout`,
+the glTF export's LOD thresholds): around at three azimuths, from above, from below and
+grazing; each framed so that the object's bounding sphere spans exactly the screen size."""
 
 from __future__ import annotations
 
 import math
 
-from ..scene.views import orbit_bounds
+from .views import orbit_bounds
 
 FOV_DEG = 40.0
 #: (name, azimuth, elevation) in degrees; above and below stop short of the poles, where an
