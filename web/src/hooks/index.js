@@ -5,6 +5,7 @@
 import { boxView, cloudView } from "./billboard_box_view.js";
 import { instancedView } from "./instanced_view.js";
 import { proxyView } from "./relief_proxy_view.js";
+import { visibilityHook } from "./shellvolume_visibility_hook.js";
 import { rayCastView } from "./slicing_ray_cast_view.js";
 
 export const HOOKS = {
@@ -12,6 +13,7 @@ export const HOOKS = {
   "reliefkit.techniques.billboard.box_render:box_view": boxView,
   "reliefkit.techniques.billboard.box_render:cloud_view": cloudView,
   "reliefkit.techniques.slicing.render:ray_cast_view": rayCastView,
+  "reliefkit.techniques.shellvolume.render:visibility_hook": visibilityHook,
   "reliefkit.render.instancing:instanced_view": instancedView,
 };
 
