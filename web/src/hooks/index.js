@@ -7,12 +7,14 @@ import { instancedView } from "./instanced_view.js";
 import { proxyView } from "./relief_proxy_view.js";
 import { visibilityHook } from "./shellvolume_visibility_hook.js";
 import { rayCastView } from "./slicing_ray_cast_view.js";
+import { slicesView } from "./slicing_slices_view.js";
 
 export const HOOKS = {
   "reliefkit.techniques.relief.render:proxy_view": proxyView,
   "reliefkit.techniques.billboard.box_render:box_view": boxView,
   "reliefkit.techniques.billboard.box_render:cloud_view": cloudView,
   "reliefkit.techniques.slicing.render:ray_cast_view": rayCastView,
+  "reliefkit.techniques.slicing.render:slices_view": slicesView,
   "reliefkit.techniques.shellvolume.render:visibility_hook": visibilityHook,
   "reliefkit.render.instancing:instanced_view": instancedView,
 };
