@@ -3,6 +3,7 @@
 // README.md gives the forms of the arguments and of the update.
 
 import { boxView, cloudView } from "./billboard_box_view.js";
+import { displacementSlicesView } from "./displacement_slices_view.js";
 import { instancedView } from "./instanced_view.js";
 import { proxyView } from "./relief_proxy_view.js";
 import { visibilityHook } from "./shellvolume_visibility_hook.js";
@@ -15,6 +16,7 @@ export const HOOKS = {
   "reliefkit.techniques.billboard.box_render:cloud_view": cloudView,
   "reliefkit.techniques.slicing.render:ray_cast_view": rayCastView,
   "reliefkit.techniques.slicing.render:slices_view": slicesView,
+  "reliefkit.techniques.slicing.displacement_render:slices_view": displacementSlicesView,
   "reliefkit.techniques.shellvolume.render:visibility_hook": visibilityHook,
   "reliefkit.render.instancing:instanced_view": instancedView,
 };
