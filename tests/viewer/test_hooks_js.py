@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import base64
 import json
+import re
 import subprocess
 from dataclasses import fields
 
@@ -70,6 +71,9 @@ class NodeHooks:
     def load(self, plans) -> None:
         doc, arrays = to_json(plans)
         self._ask({"load": {"doc": doc, "arrays": {k: wire(a) for k, a in arrays.items()}}})
+
+    def names(self) -> list[str]:
+        return self._ask({"names": True})["names"]
 
     def call(self, index: int, camera, light) -> dict:
         return unwire(self._ask({"call": {"plan": index, "camera": camera_json(camera),
@@ -187,12 +191,26 @@ def compare(python, js, where: str, hook: str) -> None:
     assert diff <= RTOL, f"{where}: largest difference {diff:.3g} of {scale:.3g}"
 
 
+def flattening_cameras(plans, bounds) -> list[tuple[str, Camera]]:
+    """With lod auto, views from within the DMBBC's flattening range (§3.4.2): between
+    ``transition`` times the distance where epsilon is one pixel and that distance."""
+    lods = [p.per_view.data["lod"] for p in plans
+            if p.per_view is not None and p.per_view.data.get("lod")]
+    if not lods:
+        return []
+    lod, fov, size = lods[0], 40.0, (96, 64)
+    switch = lod["epsilon"] * size[1] / (2.0 * np.tan(np.radians(fov) / 2))
+    return [(f"flattening {f:.2f}", Camera.orbit(lod["center"], 40 * k, 15, f * switch, fov,
+                                                 size=size))
+            for k, f in enumerate(np.linspace(lod["transition"], 1.0, 5)[1:-1])]
+
+
 def check_plans(node_hooks, plans, bounds, where: str) -> int:
     """Compare every hooked plan of ``plans`` from every camera; how many calls."""
     node_hooks.load(plans)
     light = DirectionalLight()
     calls = 0
-    for name, camera in cameras(bounds):
+    for name, camera in cameras(bounds) + flattening_cameras(plans, bounds):
         for index, plan in enumerate(plans):
             if plan.per_view is None:
                 continue
@@ -260,3 +278,20 @@ def test_js_sxmpvo_orders_a_torus_shell_without_violations(node_hooks):
         assert check.pairs > 0 and check.violations == 0, (camera.eye, check)
         compare(python_update(plan, camera, light), js, f"torus from {camera.eye}",
                 "visibility_hook (torus)")
+
+
+def python_hooks() -> set[str]:
+    """Every view hook a plan in src/ names: ``ViewHook(f"{__name__}:function", ...)``."""
+    src = ROOT / "src"
+    found = set()
+    for path in src.rglob("*.py"):
+        module = ".".join(path.relative_to(src).with_suffix("").parts)
+        for name in re.findall(r'ViewHook\(\s*f"\{__name__\}:(\w+)"', path.read_text()):
+            found.add(f"{module}:{name}")
+    return found
+
+
+def test_every_python_view_hook_has_a_js_port(node_hooks):
+    hooks = python_hooks()
+    assert len(hooks) >= 8  # the scan finds the hooks it is meant to
+    assert hooks <= set(node_hooks.names()), hooks - set(node_hooks.names())

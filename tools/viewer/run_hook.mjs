@@ -3,12 +3,13 @@
 // bytes little-endian, base64).
 //   {"load": {"doc": <to_json document>, "arrays": {key: array}}}  -> {"plans": N}
 //   {"call": {"plan": i, "camera": {...}, "light": {...}}}         -> {"update": {...}}
+//   {"names": true}                                                -> {"names": [HOOKS' keys]}
 // An error answers {"error": "..."} and the process goes on.
 
 import { createInterface } from "node:readline";
 import { ndarray, typedArrayOf } from "../../web/src/hooks/ndarray.js";
 import { decodePlans } from "../../web/src/hooks/plan.js";
-import { viewUpdate } from "../../web/src/hooks/index.js";
+import { HOOKS, viewUpdate } from "../../web/src/hooks/index.js";
 
 function fromWire(a) {
   const bytes = Buffer.from(a.b64, "base64");
@@ -36,7 +37,9 @@ for await (const line of lines) {
   let answer;
   try {
     const request = JSON.parse(line);
-    if (request.load) {
+    if (request.names) {
+      answer = { names: Object.keys(HOOKS) };
+    } else if (request.load) {
       const arrays = Object.fromEntries(Object.entries(request.load.arrays).map(
         ([k, a]) => [k, fromWire(a)]));
       plans = decodePlans(request.load.doc, arrays);
