@@ -58,12 +58,19 @@ class NodeHooks:
     def __init__(self):
         node = node_or_skip("the JavaScript view hooks")
         self.process = subprocess.Popen([node, str(SCRIPT)], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, text=True, cwd=ROOT)
+                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                        text=True, cwd=ROOT)
 
     def _ask(self, request: dict) -> dict:
-        self.process.stdin.write(json.dumps(request) + "\n")
-        self.process.stdin.flush()
-        answer = json.loads(self.process.stdout.readline())
+        try:
+            self.process.stdin.write(json.dumps(request) + "\n")
+            self.process.stdin.flush()
+            line = self.process.stdout.readline()
+        except BrokenPipeError:
+            line = ""
+        if not line:
+            raise AssertionError(f"{SCRIPT.name} exited: {self.process.stderr.read()[-2000:]}")
+        answer = json.loads(line)
         if "error" in answer:
             raise AssertionError(f"the JavaScript hook failed: {answer['error']}")
         return answer
