@@ -9,32 +9,18 @@ must always validate.
 from __future__ import annotations
 
 import json
-import os
-import shutil
 import subprocess
-from pathlib import Path
 
-import pytest
+from node_tools import ROOT, node_or_skip
 
-ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "tools" / "gltf" / "validate.mjs"
 PACKAGE = ROOT / "node_modules" / "gltf-validator"
 TIMEOUT_S = 120
 
 
-def _unavailable(reason: str):
-    if os.environ.get("CI", "").lower() == "true":
-        pytest.fail(f"CI=true but the glTF validator cannot run: {reason}")
-    pytest.skip(f"glTF validator unavailable: {reason}")
-
-
 def validate(path) -> dict:
     """The validator's report for ``path`` (``report["issues"]["numErrors"]`` etc.)."""
-    node = shutil.which("node")
-    if node is None:
-        _unavailable("node is not installed (apt-get install nodejs npm)")
-    if not PACKAGE.is_dir():
-        _unavailable(f"{PACKAGE.relative_to(ROOT)} is missing (run `npm ci` in {ROOT})")
+    node = node_or_skip("the glTF validator", PACKAGE)
     done = subprocess.run([node, str(SCRIPT), str(path)], capture_output=True, text=True,
                           timeout=TIMEOUT_S, cwd=ROOT)
     if done.returncode:
