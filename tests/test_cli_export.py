@@ -75,6 +75,8 @@ def test_lod_chain_of_a_mesh(gl, tmp_path):
     radius = 0.5 * np.linalg.norm(mesh.bounds[1] - mesh.bounds[0])
     assert coverage[1] == pytest.approx(2 * radius / (cloud.epsilon * 1080), abs=1e-6)
     assert "MSFT_lod" in gltf.extensionsUsed and not gltf.extensionsRequired
+    info = run_cli("info", out)
+    assert "representations: " in info.stdout and "billboard-cloud" in info.stdout
     assert problems(validate(out)) == []
 
 

@@ -194,7 +194,8 @@ def load(path, *, node: int | None = None, max_bytes: int = DEFAULT_MAX_BYTES,
 def read_manifest(path) -> dict:
     """What `io.rk.read_manifest` says of an .rk, for a glTF file reliefkit exported: its
     first representation's kind, versions, params, source hash, writer and arrays (dtype,
-    shape and sha256 as stored; an encoded array's encoding), from the JSON alone."""
+    shape and sha256 as stored; an encoded array's encoding), from the JSON alone; with
+    several (an LOD chain) also every representation's kind, in node order."""
     path = Path(path)
     glb = read_document(path)
     found = reliefkit_nodes(glb.document)
@@ -206,7 +207,8 @@ def read_manifest(path) -> dict:
                                                                          dict) else {}
     arrays = {key: {k: ref[k] for k in ("dtype", "shape", "sha256", "encoding") if k in ref}
               for key, ref in extension.get("arrays", {}).items() if isinstance(ref, dict)}
-    return {"format": "glTF 2.0", "extension": name, "kind": extension.get("kind"),
+    others = {"representations": [e.get("kind") for _, _, e in found]} if len(found) > 1 else {}
+    return {"format": "glTF 2.0", **others, "extension": name, "kind": extension.get("kind"),
             "kind_version": extension.get("kindVersion"), "params": extension.get("params"),
             "source_hash": extras.get("sourceHash"),
             "created_by": glb.document["asset"].get("generator"), "arrays": arrays}
