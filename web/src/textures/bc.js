@@ -13,9 +13,11 @@ const BLOCKS = { bc1: [3, 8], bc4: [1, 8], bc5: [2, 16], bc7: [4, 16] };
 const QUANTIZED = { u8: 1, u16: 2 };
 
 /** Block format -> WebGL2 internal formats (linear, sRGB or null), the extensions naming
- * them and the targets they allow (gl/textures.py's BLOCK_FORMATS). */
+ * them and the targets they allow (gl/textures.py's BLOCK_FORMATS). BC1 is opaque colour
+ * here (its alpha is not kept): uploaded as RGB DXT1, whose three-colour blocks' fourth
+ * entry is opaque black, as decoded, not transparent as RGBA DXT1 would sample it. */
 export const GL_FORMATS = {
-  bc1: { linear: 0x83f1, srgb: 0x8c4d, extension: "WEBGL_compressed_texture_s3tc",
+  bc1: { linear: 0x83f0, srgb: 0x8c4c, extension: "WEBGL_compressed_texture_s3tc",
     srgbExtension: "WEBGL_compressed_texture_s3tc_srgb", targets: ["2d", "2d_array"] },
   bc4: { linear: 0x8dbb, srgb: null, extension: "EXT_texture_compression_rgtc",
     targets: ["2d", "2d_array"] },
