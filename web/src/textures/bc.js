@@ -283,6 +283,9 @@ const WEIGHTS = {
 const SUBSET_DIGITS = [null, null, PARTITIONS2, PARTITIONS3].map(
   (table) => table && table.map((row) => Uint8Array.from(row, Number)));
 const ONE_SUBSET = new Uint8Array(16);
+/** Per subset count and partition: each subset's anchor texel. */
+const SUBSET_ANCHORS = [null, [[0]], ANCHORS2.map((a) => [0, a]),
+  ANCHORS3[0].map((a, p) => [0, a, ANCHORS3[1][p]])];
 
 /** Bits [pos, pos + n) of a block, least significant first (n <= 16). */
 function bits(bytes, at, pos, n) {
@@ -298,6 +301,7 @@ function expand(value, n) {
 }
 
 const endpoints = new Uint8Array(6 * 4); // [subset][end][RGBA]
+const pBits = new Uint8Array(6); // [subset][end]
 
 function decodeBc7(bytes, at, texels) {
   let mode = 0;
@@ -322,7 +326,6 @@ function decodeBc7(bytes, at, texels) {
       pos += width;
     }
   }
-  const pBits = new Uint8Array(ends);
   if (m.pBits === 1) {
     for (let e = 0; e < ends; e++) pBits[e] = bits(bytes, at, pos++, 1);
   } else if (m.pBits === 2) {
@@ -336,11 +339,11 @@ function decodeBc7(bytes, at, texels) {
     }
   }
   const subsets = m.subsets === 1 ? ONE_SUBSET : SUBSET_DIGITS[m.subsets][partition];
-  const anchors = m.subsets === 1 ? [0] : m.subsets === 2 ? [0, ANCHORS2[partition]]
-    : [0, ANCHORS3[0][partition], ANCHORS3[1][partition]];
+  const anchors = SUBSET_ANCHORS[m.subsets][partition];
   // the indices: the primary stream, then (modes 4, 5) the second stream
   let pos2 = pos + 16 * m.indexBits - m.subsets;
-  const [weights, weights2] = [WEIGHTS[m.indexBits], WEIGHTS[m.index2Bits || m.indexBits]];
+  const weights = WEIGHTS[m.indexBits];
+  const weights2 = WEIGHTS[m.index2Bits || m.indexBits];
   for (let i = 0; i < 16; i++) {
     const s = subsets[i];
     const n = m.indexBits - (anchors[s] === i ? 1 : 0);
@@ -353,16 +356,21 @@ function decodeBc7(bytes, at, texels) {
       const alphaIndex = bits(bytes, at, pos2, n2);
       pos2 += n2;
       alphaWeight = weights2[alphaIndex];
-      if (selection) [colourWeight, alphaWeight] = [alphaWeight, colourWeight];
+      if (selection) {
+        const swapped = colourWeight;
+        colourWeight = alphaWeight;
+        alphaWeight = swapped;
+      }
     }
     for (let c = 0; c < 4; c++) {
       const w = c < 3 ? colourWeight : alphaWeight;
-      const [e0, e1] = [endpoints[8 * s + c], endpoints[8 * s + 4 + c]];
-      texels[4 * i + c] = ((64 - w) * e0 + w * e1 + 32) >> 6;
+      texels[4 * i + c] = ((64 - w) * endpoints[8 * s + c] + w * endpoints[8 * s + 4 + c] + 32) >> 6;
     }
     if (rotation) { // the alpha channel swapped with channel rotation - 1
-      const [a, b] = [4 * i + 3, 4 * i + rotation - 1];
-      [texels[a], texels[b]] = [texels[b], texels[a]];
+      const other = 4 * i + rotation - 1;
+      const alpha = texels[4 * i + 3];
+      texels[4 * i + 3] = texels[other];
+      texels[other] = alpha;
     }
   }
 }
