@@ -287,3 +287,15 @@ def test_gl_format_targets_sizes_and_mip_chains(node_bc, fmt):
 @pytest.mark.parametrize("fmt", ["u8", "u16"])
 def test_quantized_encodings_upload_decoded(node_bc, fmt):
     assert gl_format(node_bc, sample(fmt, dtype="float32"), ALL) is None
+
+
+def test_sampler_decode_follows_the_upload(node_bc):
+    """A normal map's ``<sampler>_decode``: (2, -1) on its unorm blocks, (1, 0) on the
+    decoded normals (executor.py sets the same)."""
+    unit = images(36, 44)["normals"][..., :3].astype(np.float32)
+    normals = encode(unit * 2 - 1, "bc7", scale=2.0, bias=-1.0)
+    _, record = stored_form(decoded(normals))
+    for extensions, expected in (([BPTC], [2.0, -1.0]), ([], [1.0, 0.0])):
+        answer = node_bc.ask({"glFormat": {"encoding": record, "extensions": extensions,
+                                           "texture": {}}})
+        assert answer["decode"] == expected

@@ -2,11 +2,12 @@
 // stdin, one JSON answer a line on stdout; bytes travel base64.
 //   {"decode": {"encoding": {...}, "b64": "..."}}  -> {"dtype", "shape", "b64"} (little-endian)
 //   {"glFormat": {"encoding": {...}, "extensions": [names], "texture": {...}}}
-//                                                  -> {"format": number | null, "enabled": [names]}
+//                                                  -> {"format": number | null, "decode": [scale, bias],
+//                                                     "enabled": [names]}
 // An error answers {"error": "..."} and the process goes on.
 
 import { createInterface } from "node:readline";
-import { decodeEncoded, glFormatOf } from "../../web/src/textures/bc.js";
+import { decodeEncoded, glFormatOf, samplerDecode } from "../../web/src/textures/bc.js";
 
 /** A WebGL2 context as far as glFormatOf sees it: getExtension of the named ones. */
 function fakeGl(extensions) {
@@ -27,7 +28,8 @@ for await (const line of lines) {
     } else {
       const { encoding, extensions, texture } = request.glFormat;
       const gl = fakeGl(extensions);
-      answer = { format: glFormatOf(encoding, gl, texture), enabled: gl.enabled };
+      const format = glFormatOf(encoding, gl, texture);
+      answer = { format, decode: samplerDecode(encoding, format), enabled: gl.enabled };
     }
   } catch (error) {
     answer = { error: String(error && error.stack || error) };

@@ -83,6 +83,13 @@ export function glFormatOf(encoding, gl, texture = {}) {
   return gl.getExtension(formats.extension) ? formats.linear : null;
 }
 
+/** The `<sampler>_decode` uniform (scale, bias) of a program sampling `encoding`
+ * (executor.py): the encoding's own where its unorm values are uploaded (`internalFormat`,
+ * glFormatOf's answer, not null), (1, 0) where the decoded array is. */
+export function samplerDecode(encoding, internalFormat) {
+  return internalFormat === null ? [1, 0] : [encoding.scale, encoding.bias];
+}
+
 // -- the decode -------------------------------------------------------------------------------
 
 /** What `reliefkit.compact.encodings.decoded` gives for `encoding` (the record) and its
