@@ -113,7 +113,9 @@ export function decodeEncoded(encoding, stored) {
     if (format === "u16") throw new Error("u16 cannot stand for a uint8 array");
     return { dtype, shape: [...shape], data: unorm };
   }
-  if (dtype !== "float32") throw new Error(`encoded arrays decode to uint8 or float32, not ${dtype}`);
+  if (dtype !== "float32") {
+    throw new Error(`encoded arrays decode to uint8 or float32, not ${dtype}`);
+  }
   const top = format === "u16" ? 65535 : 255;
   const data = new Float32Array(unorm.length);
   if (encoding.srgb) {
@@ -219,7 +221,8 @@ function decodeBc1(bytes, at, texels) {
       p[9 + c] = 0;
     }
   }
-  const indices = bytes[at + 4] | (bytes[at + 5] << 8) | (bytes[at + 6] << 16) | (bytes[at + 7] << 24);
+  const indices = bytes[at + 4] | (bytes[at + 5] << 8) | (bytes[at + 6] << 16)
+    | (bytes[at + 7] << 24);
   for (let i = 0; i < 16; i++) {
     const k = ((indices >>> (2 * i)) & 3) * 3;
     texels[4 * i] = p[k];
@@ -342,7 +345,10 @@ function decodeBc7(bytes, at, texels) {
   for (let e = 0; e < ends; e++) {
     for (let c = 0; c < 4; c++) {
       const width = c < 3 ? m.colourBits : m.alphaBits;
-      if (width) endpoints[4 * e + c] = expand((endpoints[4 * e + c] << withP) | (withP && pBits[e]), width + withP);
+      if (width) {
+        const value = (endpoints[4 * e + c] << withP) | (withP && pBits[e]);
+        endpoints[4 * e + c] = expand(value, width + withP);
+      }
     }
   }
   const subsets = m.subsets === 1 ? ONE_SUBSET : SUBSET_DIGITS[m.subsets][partition];
@@ -371,7 +377,8 @@ function decodeBc7(bytes, at, texels) {
     }
     for (let c = 0; c < 4; c++) {
       const w = c < 3 ? colourWeight : alphaWeight;
-      texels[4 * i + c] = ((64 - w) * endpoints[8 * s + c] + w * endpoints[8 * s + 4 + c] + 32) >> 6;
+      const [e0, e1] = [8 * s + c, 8 * s + 4 + c];
+      texels[4 * i + c] = ((64 - w) * endpoints[e0] + w * endpoints[e1] + 32) >> 6;
     }
     if (rotation) { // the alpha channel swapped with channel rotation - 1
       const other = 4 * i + rotation - 1;
