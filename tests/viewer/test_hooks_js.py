@@ -10,16 +10,14 @@ checker the Python sort is tested with (`order_check.ordering_violations`)."""
 
 from __future__ import annotations
 
-import base64
 import json
 import re
-import subprocess
 from dataclasses import fields
 
 import numpy as np
 import pytest
 from helpers import sample, sample_ids, technique_samples
-from node_tools import ROOT, node_or_skip
+from node_tools import ROOT, NodeScript, unwire, wire
 from shell_scenes import torus_mesh
 
 from reliefkit.render.instancing import instanced, placements
@@ -52,43 +50,22 @@ OPTIONS = {
 LARGEST: dict[str, float] = {}
 
 
-class NodeHooks:
+class NodeHooks(NodeScript):
     """tools/viewer/run_hook.mjs in one node process: `load` plans, `call` a plan's hook."""
 
     def __init__(self):
-        node = node_or_skip("the JavaScript view hooks")
-        self.process = subprocess.Popen([node, str(SCRIPT)], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                        text=True, cwd=ROOT)
-
-    def _ask(self, request: dict) -> dict:
-        try:
-            self.process.stdin.write(json.dumps(request) + "\n")
-            self.process.stdin.flush()
-            line = self.process.stdout.readline()
-        except BrokenPipeError:
-            line = ""
-        if not line:
-            raise AssertionError(f"{SCRIPT.name} exited: {self.process.stderr.read()[-2000:]}")
-        answer = json.loads(line)
-        if "error" in answer:
-            raise AssertionError(f"the JavaScript hook failed: {answer['error']}")
-        return answer
+        super().__init__("the JavaScript view hooks", SCRIPT)
 
     def load(self, plans) -> None:
         doc, arrays = to_json(plans)
-        self._ask({"load": {"doc": doc, "arrays": {k: wire(a) for k, a in arrays.items()}}})
+        self.ask({"load": {"doc": doc, "arrays": {k: wire(a) for k, a in arrays.items()}}})
 
     def names(self) -> list[str]:
-        return self._ask({"names": True})["names"]
+        return self.ask({"names": True})["names"]
 
     def call(self, index: int, camera, light) -> dict:
-        return unwire(self._ask({"call": {"plan": index, "camera": camera_json(camera),
-                                          "light": light_json(light)}})["update"])
-
-    def close(self):
-        self.process.stdin.close()
-        self.process.wait(timeout=30)
+        return unwire(self.ask({"call": {"plan": index, "camera": camera_json(camera),
+                                         "light": light_json(light)}})["update"])
 
 
 @pytest.fixture(scope="module")
@@ -97,24 +74,6 @@ def node_hooks():
     yield hooks
     hooks.close()
     print("\nlargest difference per hook:", json.dumps(LARGEST, indent=1))
-
-
-def wire(array: np.ndarray) -> dict:
-    a = np.ascontiguousarray(array)
-    return {"dtype": a.dtype.name, "shape": list(a.shape),
-            "b64": base64.b64encode(a.astype(a.dtype.newbyteorder("<")).tobytes()).decode()}
-
-
-def unwire(value):
-    if isinstance(value, list):
-        return [unwire(v) for v in value]
-    if not isinstance(value, dict):
-        return value
-    if "b64" in value:
-        data = np.frombuffer(base64.b64decode(value["b64"]),
-                             np.dtype(value["dtype"]).newbyteorder("<"))
-        return data.reshape(value["shape"])
-    return {k: unwire(v) for k, v in value.items()}
 
 
 def camera_json(camera: Camera) -> dict:
