@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import shlex
 import sys
 from contextlib import closing
 from pathlib import Path
@@ -44,6 +45,8 @@ from ..scene.views import (
 )
 from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, shootout
 from ..units import format_bytes
+from ..viewer import server as view_server
+from ..viewer import site as view_site
 from .options import applicable, given_options
 
 MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
@@ -540,3 +543,19 @@ def cmd_demo(args) -> int:
     return 0
 
 
+
+
+def cmd_view(args) -> int:
+    if not 0 <= args.port <= 65535:
+        raise UsageError(f"--port must be within 0..65535, got {args.port}")
+    for spec in args.inputs:
+        _check_not_empty(spec)
+    with waiting("exporting the inputs"):
+        files = view_site.site_files(view_site.load_inputs(args.inputs))
+    if args.export_html:
+        paths = view_site.export_html(files, args.export_html)
+        print(f"wrote {len(paths)} files into {args.export_html} (index.html: serve the folder, "
+              "e.g. python -m http.server -d " + shlex.quote(args.export_html) + ")")
+        return 0
+    view_server.serve(files, args.port, open_browser=not args.no_browser)
+    return 0

@@ -25,6 +25,7 @@ from .commands import (
     cmd_info,
     cmd_render,
     cmd_shootout,
+    cmd_view,
 )
 from .exits import EXIT_USAGE
 from .options import add_flag, add_options
@@ -46,6 +47,9 @@ CORE_EXAMPLES = {
                "reliefkit reads it back",
                "reliefkit export car.glb --lod relief-cube,billboard-cloud -o car-lod.glb",
                "reliefkit export tree.rk -o tree.gltf --embed-shaders"],
+    "view": ["reliefkit view tree.rk demo:tree                    in the browser, side by side",
+             "reliefkit view car.glb --no-browser --port 8000   print the URL only",
+             "reliefkit view tree.rk --export-html site/        a folder any static server shows"],
     "shootout": ["reliefkit shootout demo:tree --out out/shootout    what to ship at 64 and "
                  "256 px, 256 KB and 1 MB",
                  "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "
@@ -55,7 +59,7 @@ CORE_EXAMPLES = {
              "reliefkit info model.obj                          counts and bounds of a mesh "
              "(or an .rk)"],
 }
-ORDER = ("demo", "render", "bake", "compare", "export", "shootout", "bench", "info")
+ORDER = ("demo", "render", "bake", "compare", "export", "view", "shootout", "bench", "info")
 
 
 def _examples(command: str | None = None) -> list[str]:
@@ -251,6 +255,21 @@ def build_parser() -> argparse.ArgumentParser:
                 "bake options (with --lod; each applies to the kinds that declare it)")
     add_options(p, [("compress", options_of(CompressOptions))], "compression (with --lod)")
     p.set_defaults(run=cmd_export)
+
+    p = _command(sub, "view", "look at representations in the browser, drawn by their shaders",
+                 "Serve a page on 127.0.0.1 that draws each input's draw plans with the "
+                 "GLSL ES sources of reliefkit's shaders in WebGL2, side by side from one "
+                 "camera (?view=AZ,EL,DIST&size=WxH in its URL; drag to orbit, wheel to "
+                 "zoom); Ctrl-C stops it. docs/viewer.md.")
+    p.add_argument("inputs", nargs="+", metavar="INPUT",
+                   help=".rk file, a .glb reliefkit wrote, a mesh file or demo:NAME")
+    p.add_argument("--port", type=int, default=0, metavar="N",
+                   help="port on 127.0.0.1 (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="print the URL, open no browser")
+    p.add_argument("--export-html", metavar="DIR",
+                   help="write the page, its bundle and the GLB files into DIR (viewable from "
+                        "any static web server) instead of serving")
+    p.set_defaults(run=cmd_view)
 
     names = suite_names()
     p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",
