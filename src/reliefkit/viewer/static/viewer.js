@@ -1,0 +1,704 @@
+// web/src/camera.js
+var rad = (deg) => deg * Math.PI / 180;
+var sub = (a, b) => a.map((x, i) => x - b[i]);
+var norm = (a) => Math.hypot(...a);
+var scale = (a, s) => a.map((x) => x * s);
+var cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+function parseView(text) {
+  const parts = text.split(",").map(Number);
+  if (![2, 3].includes(parts.length) || !parts.every(Number.isFinite) || Math.abs(parts[1]) >= 90 || parts.length === 3 && !(parts[2] > 0)) {
+    throw new Error(`view must be AZ,EL or AZ,EL,DIST with |EL| < 90 (e.g. 30,25,2.6), got '${text}'`);
+  }
+  return [parts[0], parts[1], parts.length === 3 ? parts[2] : null];
+}
+function parseSize(text) {
+  const m = /^(\d{1,5})x(\d{1,5})$/.exec(text);
+  if (!m || +m[1] < 1 || +m[2] < 1 || +m[1] > 8192 || +m[2] > 8192) {
+    throw new Error(`size must be WxH within 1..8192 (e.g. 512x512), got '${text}'`);
+  }
+  return [+m[1], +m[2]];
+}
+function lookAt(eye, target, up = [0, 1, 0]) {
+  const forward = sub(target, eye);
+  const f = scale(forward, 1 / norm(forward));
+  let side = cross(f, up);
+  if (norm(side) < 1e-9) side = cross(f, Math.abs(f[1]) > 0.5 ? [0, 0, -1] : [0, 1, 0]);
+  const s = scale(side, 1 / norm(side));
+  const u = cross(s, f);
+  const rows = [s, u, scale(f, -1)];
+  const view = identity();
+  for (let r = 0; r < 3; r++) {
+    for (let c = 0; c < 3; c++) view[r * 4 + c] = rows[r][c];
+    view[r * 4 + 3] = -(rows[r][0] * eye[0] + rows[r][1] * eye[1] + rows[r][2] * eye[2]);
+  }
+  return view;
+}
+function perspective(fovDeg, aspect, near, far) {
+  const f = 1 / Math.tan(rad(fovDeg) / 2);
+  const p = new Array(16).fill(0);
+  p[0] = f / aspect;
+  p[5] = f;
+  p[10] = (far + near) / (near - far);
+  p[11] = 2 * far * near / (near - far);
+  p[14] = -1;
+  return p;
+}
+function orbitBounds(bounds, az, el, dist, size, frame) {
+  const [w, h] = size;
+  if (dist === null) {
+    const halfV = rad(frame.fov) / 2;
+    const halfH = Math.atan(Math.tan(halfV) * w / h);
+    dist = frame.fit_margin / Math.sin(Math.min(halfV, halfH));
+  }
+  const diag = norm(sub(bounds[1], bounds[0])) / 2;
+  const radius = diag > 0 ? diag : 1;
+  const d = dist * radius;
+  const near = Math.max(d - 1.05 * radius, 5e-3 * d);
+  const far = d + 1.05 * radius;
+  const target = [0, 1, 2].map((i) => (bounds[0][i] + bounds[1][i]) / 2);
+  const [a, e] = [rad(az), rad(el)];
+  const eye = [0, 1, 2].map((i) => target[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
+  return { eye, target, size, near, far, view: lookAt(eye, target), proj: perspective(frame.fov, w / h, near, far), distance: dist };
+}
+function cameraUniforms(camera) {
+  const origin = camera.target;
+  const view = multiply(camera.view, translation(origin));
+  const toEye = sub(camera.eye, camera.target);
+  return {
+    u_view: view,
+    u_proj: camera.proj,
+    u_inv_view_proj: invert(multiply(camera.proj, view)),
+    u_eye: sub(camera.eye, origin),
+    u_orthographic: false,
+    u_view_dir: scale(toEye, 1 / norm(toEye)),
+    u_viewport: camera.size
+  };
+}
+function modelOffset(camera, origin) {
+  return { u_model_offset: sub(origin || [0, 0, 0], camera.target) };
+}
+function lightUniforms(light, az, el) {
+  const [a, e] = [rad(az), rad(el)];
+  return { ...light.uniforms, u_light_dir: [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)] };
+}
+function identity() {
+  return [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+}
+function translation(t) {
+  const m = identity();
+  [m[3], m[7], m[11]] = t;
+  return m;
+}
+function multiply(a, b) {
+  const out = new Array(16).fill(0);
+  for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) for (let k = 0; k < 4; k++) out[r * 4 + c] += a[r * 4 + k] * b[k * 4 + c];
+  return out;
+}
+function invert(m) {
+  const a = [0, 1, 2, 3].map((r) => [...m.slice(r * 4, r * 4 + 4), ...identity().slice(r * 4, r * 4 + 4)]);
+  for (let c = 0; c < 4; c++) {
+    let p = c;
+    for (let r = c + 1; r < 4; r++) if (Math.abs(a[r][c]) > Math.abs(a[p][c])) p = r;
+    [a[c], a[p]] = [a[p], a[c]];
+    const pivot = a[c][c];
+    for (let k = 0; k < 8; k++) a[c][k] /= pivot;
+    for (let r = 0; r < 4; r++) {
+      if (r === c) continue;
+      const f = a[r][c];
+      for (let k = 0; k < 8; k++) a[r][k] -= f * a[c][k];
+    }
+  }
+  return a.flatMap((row) => row.slice(4));
+}
+
+// web/src/plans.js
+function decode(value, arrays) {
+  if (Array.isArray(value)) return value.map((v) => decode(v, arrays));
+  if (value === null || typeof value !== "object") return value;
+  if ("array" in value) return arrays[value.array];
+  if ("scalar" in value) return value.value;
+  if ("tuple" in value) return value.tuple.map((v) => decode(v, arrays));
+  if ("encoded" in value) return { encoded: decodeFields(value.encoded, arrays) };
+  return decodeFields(value.dict, arrays);
+}
+function decodeFields(object, arrays) {
+  return Object.fromEntries(Object.entries(object).map(([k, v]) => [k, decode(v, arrays)]));
+}
+function decodePlans(draw, arrays) {
+  const geometries = {};
+  for (const [key, g] of Object.entries(draw.geometries)) {
+    const { attributes, ...rest } = g;
+    const attrs = Object.fromEntries(Object.entries(attributes).map(([name, a]) => {
+      const [array, perInstance] = decode(a, arrays);
+      return [name, { array, perInstance }];
+    }));
+    geometries[key] = { key, attributes: attrs, ...decodeFields(rest, arrays) };
+  }
+  const textures = {};
+  for (const [key, t] of Object.entries(draw.textures)) textures[key] = { key, ...decodeFields(t, arrays) };
+  return draw.plans.map((entry) => {
+    const [name, defines] = decode(entry.program, arrays);
+    const multipass = decode(entry.multipass, arrays);
+    const hook = decode(entry.per_view, arrays);
+    return {
+      name: entry.name,
+      program: { name, defines },
+      geometry: geometries[entry.geometry],
+      textures: Object.fromEntries(Object.entries(entry.textures).map(([s, k]) => [s, textures[k]])),
+      uniforms: decode(entry.uniforms, arrays),
+      raster: decode(entry.raster, arrays),
+      renderPass: entry.render_pass,
+      origin: decode(entry.origin, arrays),
+      first: entry.first,
+      count: entry.count,
+      perView: hook && { function: hook[0], data: hook[1] },
+      multipass: multipass && { kind: multipass[0], programs: multipass[1], params: multipass[2] }
+    };
+  });
+}
+function programKey(name, defines) {
+  const sorted = Object.keys(defines || {}).sort().map((k) => [k, defines[k]]);
+  return `${name} ${JSON.stringify(sorted)}`;
+}
+
+// web/src/textures.js
+var FORMATS = {
+  // dtype -> [internal formats by channel count, format by channel count, type]
+  uint8: ["R8 RG8 RGB8 RGBA8", "RED RG RGB RGBA", "UNSIGNED_BYTE"],
+  float32: ["R32F RG32F RGB32F RGBA32F", "RED RG RGB RGBA", "FLOAT"],
+  float16: ["R16F RG16F RGB16F RGBA16F", "RED RG RGB RGBA", "HALF_FLOAT"],
+  uint16: ["R16UI RG16UI RGB16UI RGBA16UI", "RED_INTEGER RG_INTEGER RGB_INTEGER RGBA_INTEGER", "UNSIGNED_SHORT"]
+};
+var TARGETS = { "2d": "TEXTURE_2D", "3d": "TEXTURE_3D", "2d_array": "TEXTURE_2D_ARRAY" };
+function uploadTexture(gl, t) {
+  if (t.encoded) throw new Error(`${t.what}: block-compressed textures are not drawn by the viewer yet`);
+  const target = gl[TARGETS[t.target]];
+  const levels = t.levels || [t.array];
+  const { shape, dtype } = levels[0];
+  const planar = t.target === "2d";
+  const dims = planar ? 2 : 3;
+  const channels = shape.length > dims ? shape[dims] : 1;
+  const format = FORMATS[dtype];
+  if (!format || channels < 1 || channels > 4) throw new Error(`${t.what}: a ${dtype} texture of ${channels} channels is not supported`);
+  let internal = gl[format[0].split(" ")[channels - 1]];
+  if (t.srgb) {
+    if (dtype !== "uint8" || channels !== 4) throw new Error(`${t.what}: sRGB textures must be RGBA uint8`);
+    internal = gl.SRGB8_ALPHA8;
+  }
+  const fmt = gl[format[1].split(" ")[channels - 1]];
+  const type = gl[format[2]];
+  const tex = gl.createTexture();
+  gl.bindTexture(target, tex);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  levels.forEach((level, k) => {
+    const [d, h, w] = planar ? [1, ...level.shape.slice(0, 2)] : level.shape.slice(0, 3);
+    const data = level.dtype === "float64" ? new Float32Array(level.data) : level.data;
+    if (planar) gl.texImage2D(target, k, internal, w, h, 0, fmt, type, data);
+    else gl.texImage3D(target, k, internal, w, h, d, 0, fmt, type, data);
+  });
+  const integer = dtype === "uint16";
+  const nearest = t.filter === "nearest" || integer;
+  let minify = nearest ? gl.NEAREST : gl.LINEAR;
+  if (t.levels) {
+    gl.texParameteri(target, gl.TEXTURE_MAX_LEVEL, t.levels.length - 1);
+    minify = gl.NEAREST_MIPMAP_NEAREST;
+  } else if (t.mipmaps && !nearest) {
+    gl.generateMipmap(target);
+    minify = gl.LINEAR_MIPMAP_LINEAR;
+  }
+  gl.texParameteri(target, gl.TEXTURE_MIN_FILTER, minify);
+  gl.texParameteri(target, gl.TEXTURE_MAG_FILTER, nearest ? gl.NEAREST : gl.LINEAR);
+  const wraps = [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R];
+  (t.wrap || []).slice(0, planar ? 2 : 3).forEach((w, i) => {
+    gl.texParameteri(target, wraps[i], w === "repeat" ? gl.REPEAT : gl.CLAMP_TO_EDGE);
+  });
+  return { tex, target };
+}
+
+// web/src/present.glsl
+var present_default = "#version 300 es\n// The picture `reliefkit render` writes (render/frame.py Frame.rgba8, colorspace.to_rgba8):\n// where the opaque pass covered a pixel (position.w > 0.5), its linear colour sRGB-encoded\n// with straight alpha; elsewhere transparent. VERTEX_SHADER / FRAGMENT_SHADER pick the stage.\nprecision highp float;\n#ifdef VERTEX_SHADER\nvoid main() {  // one full-screen triangle\n    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n}\n#else\nuniform sampler2D u_color;\nuniform sampler2D u_position;\nout vec4 f_out;\n\nvec3 srgb_encode(vec3 x) {\n    x = clamp(x, 0.0, 1.0);\n    return mix(1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, 12.92 * x, lessThanEqual(x, vec3(0.0031308)));\n}\n\nvoid main() {\n    ivec2 p = ivec2(gl_FragCoord.xy);\n    vec4 color = texelFetch(u_color, p, 0);\n    bool covered = texelFetch(u_position, p, 0).w > 0.5;\n    f_out = covered ? vec4(srgb_encode(color.rgb), clamp(color.a, 0.0, 1.0)) : vec4(0.0);\n}\n#endif\n";
+
+// web/src/executor.js
+var FRAME_ATTACHMENTS = 3;
+var MODES = { triangles: "TRIANGLES", points: "POINTS", lines: "LINES", triangle_strip: "TRIANGLE_STRIP" };
+var BLEND = { under: ["ONE_MINUS_DST_ALPHA", "ONE"], add: ["ONE", "ONE"] };
+var Unsupported = class extends Error {
+};
+function createContext(canvas) {
+  const gl = canvas.getContext("webgl2", { alpha: true, premultipliedAlpha: false, antialias: false, preserveDrawingBuffer: true });
+  if (!gl) throw new Error("this browser has no WebGL2: the viewer needs it");
+  if (!gl.getExtension("EXT_color_buffer_float")) throw new Error("this browser cannot render to float textures (EXT_color_buffer_float)");
+  gl.getExtension("OES_texture_float_linear");
+  return gl;
+}
+var Executor = class {
+  constructor(gl, draw, name) {
+    this.gl = gl;
+    this.name = name;
+    this.sources = new Map(draw.programs.map((p) => [programKey(p.program, p.defines), p]));
+    this.programs = /* @__PURE__ */ new Map();
+    this.buffers = /* @__PURE__ */ new Map();
+    this.vaos = /* @__PURE__ */ new Map();
+    this.textures = /* @__PURE__ */ new Map();
+    this.depthClamp = gl.getExtension("EXT_depth_clamp");
+    this.present = this.link("present.glsl", sourcePair(present_default));
+  }
+  /** Plans this executor draws as they are; throws `Unsupported` for the others. */
+  check(plan) {
+    if (plan.perView) throw new Unsupported(`${plan.name}: its view hook ${plan.perView.function} is not supported by the viewer yet`);
+    if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
+    if (plan.renderPass !== "opaque") throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
+    if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
+  }
+  program(program) {
+    const key = programKey(program.name, program.defines);
+    if (!this.programs.has(key)) {
+      const sources = this.sources.get(key);
+      if (!sources) throw new Error(`${this.name}: no embedded shader for ${key}`);
+      this.programs.set(key, this.link(program.name, { vertex: sources.vertex, fragment: sources.fragment }));
+    }
+    return this.programs.get(key);
+  }
+  link(name, { vertex, fragment }) {
+    const gl = this.gl;
+    const prog = gl.createProgram();
+    for (const [type, source, stage] of [[gl.VERTEX_SHADER, vertex, "vertex"], [gl.FRAGMENT_SHADER, fragment, "fragment"]]) {
+      const shader = gl.createShader(type);
+      gl.shaderSource(shader, source);
+      gl.compileShader(shader);
+      if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
+        throw new Error(`the ${stage} shader of ${name} does not compile in this browser: ${gl.getShaderInfoLog(shader).trim()}`);
+      }
+      gl.attachShader(prog, shader);
+    }
+    gl.linkProgram(prog);
+    if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) {
+      throw new Error(`${name} does not link in this browser: ${gl.getProgramInfoLog(prog).trim()}`);
+    }
+    const uniforms = /* @__PURE__ */ new Map();
+    for (let i = 0; i < gl.getProgramParameter(prog, gl.ACTIVE_UNIFORMS); i++) {
+      const info = gl.getActiveUniform(prog, i);
+      uniforms.set(info.name.replace(/\[0\]$/, ""), { location: gl.getUniformLocation(prog, info.name), type: info.type, size: info.size });
+    }
+    return { prog, uniforms, name };
+  }
+  buffer(array, target) {
+    if (!this.buffers.has(array)) {
+      const gl = this.gl;
+      const buf = gl.createBuffer();
+      gl.bindBuffer(target, buf);
+      gl.bufferData(target, array.data, gl.STATIC_DRAW);
+      this.buffers.set(array, buf);
+    }
+    return this.buffers.get(array);
+  }
+  vertexArray(linked, geometry) {
+    const gl = this.gl;
+    const key = `${linked.name} ${geometry.key}`;
+    if (!this.vaos.has(key)) {
+      const vao = gl.createVertexArray();
+      gl.bindVertexArray(vao);
+      for (const [name, attr] of Object.entries(geometry.attributes)) {
+        const loc = gl.getAttribLocation(linked.prog, name);
+        if (loc < 0) continue;
+        const { shape, dtype } = attr.array;
+        const comps = shape.length === 2 ? shape[1] : 1;
+        gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer(attr.array, gl.ARRAY_BUFFER));
+        gl.enableVertexAttribArray(loc);
+        if (dtype === "int32") gl.vertexAttribIPointer(loc, comps, gl.INT, 0, 0);
+        else if (dtype === "float32") gl.vertexAttribPointer(loc, comps, gl.FLOAT, false, 0, 0);
+        else throw new Error(`${geometry.key}: vertex array ${name} is ${dtype}, not float32 or int32`);
+        gl.vertexAttribDivisor(loc, attr.perInstance ? 1 : 0);
+      }
+      if (geometry.indices) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer(geometry.indices, gl.ELEMENT_ARRAY_BUFFER));
+      gl.bindVertexArray(null);
+      this.vaos.set(key, vao);
+    }
+    return this.vaos.get(key);
+  }
+  texture(t) {
+    if (!this.textures.has(t)) this.textures.set(t, uploadTexture(this.gl, t));
+    return this.textures.get(t);
+  }
+  /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas. */
+  frame(plans, camera, light, targets) {
+    const gl = this.gl;
+    const [w, h] = camera.size;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
+    gl.viewport(0, 0, w, h);
+    gl.depthMask(true);
+    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    for (const plan of plans) this.draw(plan, camera, light);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.viewport(0, 0, w, h);
+    this.setRaster({ depth_test: false, cull: "none", blend: "none", depth_write: false });
+    gl.useProgram(this.present.prog);
+    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position });
+    for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
+    gl.bindVertexArray(null);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+  draw(plan, camera, light) {
+    const gl = this.gl;
+    const linked = this.program(plan.program);
+    const vao = this.vertexArray(linked, plan.geometry);
+    gl.useProgram(linked.prog);
+    const samplers = this.bindTextures(plan.textures);
+    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light, ...plan.uniforms, ...samplers };
+    for (const [name, value] of Object.entries(values)) setUniform(gl, linked, name, value);
+    this.setRaster(plan.raster);
+    gl.bindVertexArray(vao);
+    const { mode, count, first, instances, indexed } = counts(gl, plan);
+    if (indexed && instances != null) gl.drawElementsInstanced(mode, count, gl.UNSIGNED_INT, first * 4, instances);
+    else if (indexed) gl.drawElements(mode, count, gl.UNSIGNED_INT, first * 4);
+    else if (instances != null) gl.drawArraysInstanced(mode, first, count, instances);
+    else gl.drawArrays(mode, first, count);
+    gl.bindVertexArray(null);
+  }
+  /** Bind textures (sampler name -> plan texture or {tex, target}) to units 0, 1, ...;
+   *  the sampler uniforms and each one's `<sampler>_decode` (1, 0: no encoding). */
+  bindTextures(textures) {
+    const gl = this.gl;
+    const out = {};
+    const units = /* @__PURE__ */ new Map();
+    for (const [name, t] of Object.entries(textures)) {
+      const made = t.tex ? t : this.texture(t);
+      if (!units.has(made)) {
+        units.set(made, units.size);
+        gl.activeTexture(gl.TEXTURE0 + units.get(made));
+        gl.bindTexture(made.target, made.tex);
+      }
+      out[name] = units.get(made);
+      out[`${name}_decode`] = [1, 0];
+    }
+    return out;
+  }
+  setRaster(r) {
+    const gl = this.gl;
+    (r.depth_test ? gl.enable : gl.disable).call(gl, gl.DEPTH_TEST);
+    gl.depthFunc(r.depth_func === "<=" ? gl.LEQUAL : gl.LESS);
+    gl.depthMask(!!r.depth_write);
+    if (this.depthClamp) (r.depth_clamp ? gl.enable : gl.disable).call(gl, this.depthClamp.DEPTH_CLAMP_EXT);
+    if (r.cull && r.cull !== "none") {
+      gl.enable(gl.CULL_FACE);
+      gl.cullFace(r.cull === "front" ? gl.FRONT : gl.BACK);
+    } else gl.disable(gl.CULL_FACE);
+    gl.frontFace(r.front_face === "cw" ? gl.CW : gl.CCW);
+    if (r.blend && r.blend !== "none") {
+      gl.enable(gl.BLEND);
+      gl.blendFunc(gl[BLEND[r.blend][0]], gl[BLEND[r.blend][1]]);
+    } else gl.disable(gl.BLEND);
+  }
+};
+function createTargets(gl, [w, h]) {
+  const make = (internal, format, type, attachment) => {
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, internal, w, h, 0, format, type, null);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
+    return { tex, target: gl.TEXTURE_2D };
+  };
+  const fbo = gl.createFramebuffer();
+  gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+  const attachments = [...Array(FRAME_ATTACHMENTS).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
+  const [color, position] = attachments.map((a) => make(gl.RGBA32F, gl.RGBA, gl.FLOAT, a));
+  make(gl.DEPTH_COMPONENT32F, gl.DEPTH_COMPONENT, gl.FLOAT, gl.DEPTH_ATTACHMENT);
+  gl.drawBuffers(attachments);
+  const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`the ${w}x${h} float render targets are incomplete (status 0x${status.toString(16)})`);
+  return { fbo, color, position };
+}
+function counts(gl, plan) {
+  const g = plan.geometry;
+  let count = plan.count;
+  if (count == null) {
+    if (g.indices) count = g.indices.data.length;
+    else if (g.vertices != null) count = g.vertices;
+    else count = Math.min(...Object.values(g.attributes).filter((a) => !a.perInstance).map((a) => a.array.shape[0]));
+  }
+  return { mode: gl[MODES[g.primitive]], count, first: plan.first || 0, instances: g.instances, indexed: !!g.indices };
+}
+function sourcePair(text) {
+  const [version, ...rest] = text.split("\n");
+  const body = rest.join("\n");
+  return { vertex: `${version}
+#define VERTEX_SHADER
+${body}`, fragment: `${version}
+#define FRAGMENT_SHADER
+${body}` };
+}
+function flat(value) {
+  if (value && value.data && value.shape) return Array.from(value.data, Number);
+  if (Array.isArray(value)) return value.flatMap(flat);
+  return [typeof value === "boolean" ? Number(value) : value];
+}
+function setUniform(gl, linked, name, value) {
+  const u = linked.uniforms.get(name);
+  if (!u) return;
+  const T = gl;
+  if (Array.isArray(value) && u.size === 1 && Array.isArray(value[0]) && ![T.FLOAT_MAT3, T.FLOAT_MAT4].includes(u.type)) value = value[0];
+  const v = flat(value);
+  const n = {
+    [T.FLOAT_MAT4]: 16,
+    [T.FLOAT_MAT3]: 9,
+    [T.FLOAT_VEC2]: 2,
+    [T.FLOAT_VEC3]: 3,
+    [T.FLOAT_VEC4]: 4,
+    [T.INT_VEC2]: 2,
+    [T.INT_VEC3]: 3,
+    [T.INT_VEC4]: 4,
+    [T.BOOL_VEC2]: 2,
+    [T.BOOL_VEC3]: 3,
+    [T.BOOL_VEC4]: 4
+  }[u.type] || 1;
+  const data = v.slice(0, n * u.size);
+  switch (u.type) {
+    case T.FLOAT:
+      return gl.uniform1fv(u.location, data);
+    case T.FLOAT_VEC2:
+      return gl.uniform2fv(u.location, data);
+    case T.FLOAT_VEC3:
+      return gl.uniform3fv(u.location, data);
+    case T.FLOAT_VEC4:
+      return gl.uniform4fv(u.location, data);
+    case T.FLOAT_MAT3:
+      return gl.uniformMatrix3fv(u.location, true, data);
+    case T.FLOAT_MAT4:
+      return gl.uniformMatrix4fv(u.location, true, data);
+    case T.UNSIGNED_INT:
+      return gl.uniform1uiv(u.location, data);
+    case T.INT_VEC2:
+    case T.BOOL_VEC2:
+      return gl.uniform2iv(u.location, data);
+    case T.INT_VEC3:
+    case T.BOOL_VEC3:
+      return gl.uniform3iv(u.location, data);
+    case T.INT_VEC4:
+    case T.BOOL_VEC4:
+      return gl.uniform4iv(u.location, data);
+    default:
+      return gl.uniform1iv(u.location, data);
+  }
+}
+
+// web/src/glb.js
+var MAGIC = 1179937895;
+var JSON_CHUNK = 1313821514;
+var BIN_CHUNK = 5130562;
+var TYPED = {
+  bool: Uint8Array,
+  int8: Int8Array,
+  uint8: Uint8Array,
+  int16: Int16Array,
+  uint16: Uint16Array,
+  int32: Int32Array,
+  uint32: Uint32Array,
+  float16: Uint16Array,
+  float32: Float32Array,
+  float64: Float64Array,
+  int64: BigInt64Array,
+  uint64: BigUint64Array
+};
+function parseGlb(buffer, name) {
+  const data = new DataView(buffer);
+  if (buffer.byteLength < 20 || data.getUint32(0, true) !== MAGIC) {
+    throw new Error(`${name} is not a GLB file`);
+  }
+  if (data.getUint32(4, true) !== 2 || data.getUint32(8, true) > buffer.byteLength) {
+    throw new Error(`${name}: not a glTF 2.0 GLB, or truncated`);
+  }
+  let json = null;
+  let bin = new ArrayBuffer(0);
+  for (let at = 12; at + 8 <= buffer.byteLength; ) {
+    const length = data.getUint32(at, true);
+    const type = data.getUint32(at + 4, true);
+    if (at + 8 + length > buffer.byteLength) throw new Error(`${name}: a chunk runs past the end`);
+    const body = buffer.slice(at + 8, at + 8 + length);
+    if (type === JSON_CHUNK) json = JSON.parse(new TextDecoder().decode(body));
+    else if (type === BIN_CHUNK) bin = body;
+    at += 8 + length;
+  }
+  if (json === null) throw new Error(`${name}: no JSON chunk`);
+  return { json, bin, name };
+}
+function drawOf(glb) {
+  for (const node of glb.json.nodes || []) {
+    for (const [ext, value] of Object.entries(node.extensions || {})) {
+      if (!ext.startsWith("RELIEFKIT_")) continue;
+      if (!value.draw) throw new Error(`${glb.name}: ${ext} holds no draw plans`);
+      if (!Array.isArray(value.draw.programs)) {
+        throw new Error(`${glb.name}: its draw plans carry no shaders (export with --embed-shaders)`);
+      }
+      return value.draw;
+    }
+  }
+  throw new Error(`${glb.name}: no RELIEFKIT_ extension (not exported by reliefkit)`);
+}
+async function readArrays(gl, glb, draw) {
+  const out = {};
+  for (const [name, ref] of Object.entries(draw.arrays)) {
+    const Typed = TYPED[ref.dtype];
+    if (!Typed || !Array.isArray(ref.shape)) throw new Error(`${glb.name}: array ${name} has no known dtype`);
+    if (ref.encoding) throw new Error(`${glb.name}: array ${name} is block-compressed, which the viewer does not draw yet`);
+    const count = ref.shape.reduce((a, b) => a * b, 1);
+    let data;
+    if ("image" in ref) data = await pngValues(gl, glb, ref.image, ref.shape);
+    else if ("bufferView" in ref) data = new Typed(viewBytes(glb, ref.bufferView, count * Typed.BYTES_PER_ELEMENT, name));
+    else data = new Typed(count);
+    out[name] = { dtype: ref.dtype, shape: ref.shape, data };
+  }
+  return out;
+}
+function viewBytes(glb, index, length, name) {
+  const view = (glb.json.bufferViews || [])[index];
+  if (!view || view.byteLength !== length || (view.byteOffset || 0) + length > glb.bin.byteLength) {
+    throw new Error(`${glb.name}: array ${name}'s bufferView does not hold it (truncated or forged)`);
+  }
+  const start = view.byteOffset || 0;
+  return glb.bin.slice(start, start + length);
+}
+async function pngValues(gl, glb, index, shape) {
+  const image = (glb.json.images || [])[index];
+  if (!image) throw new Error(`${glb.name}: image ${index} is missing`);
+  const view = glb.json.bufferViews[image.bufferView];
+  const bytes = glb.bin.slice(view.byteOffset || 0, (view.byteOffset || 0) + view.byteLength);
+  const bitmap = await createImageBitmap(
+    new Blob([bytes], { type: "image/png" }),
+    { premultiplyAlpha: "none", colorSpaceConversion: "none" }
+  );
+  const rgba = readBitmap(gl, bitmap);
+  const channels = shape.length === 2 ? 1 : shape[shape.length - 1];
+  if (channels === 4) return rgba;
+  const pick = { 1: [0], 2: [0, 3], 3: [0, 1, 2] }[channels];
+  const out = new Uint8Array(rgba.length / 4 * channels);
+  for (let p = 0, q = 0; p < rgba.length; p += 4) for (const c of pick) out[q++] = rgba[p + c];
+  return out;
+}
+function readBitmap(gl, bitmap) {
+  const tex = gl.createTexture();
+  const fbo = gl.createFramebuffer();
+  try {
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.pixelStorei(gl.UNPACK_FLIP_Y_WEBGL, false);
+    gl.pixelStorei(gl.UNPACK_PREMULTIPLY_ALPHA_WEBGL, false);
+    gl.pixelStorei(gl.UNPACK_COLORSPACE_CONVERSION_WEBGL, gl.NONE);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, gl.RGBA, gl.UNSIGNED_BYTE, bitmap);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+    const out = new Uint8Array(bitmap.width * bitmap.height * 4);
+    gl.readPixels(0, 0, bitmap.width, bitmap.height, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return out;
+  } finally {
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.deleteFramebuffer(fbo);
+    gl.deleteTexture(tex);
+    bitmap.close();
+  }
+}
+
+// web/src/main.js
+var state = window.reliefkit = { ready: false, errors: [], frames: 0 };
+function report(message) {
+  state.errors.push(message);
+  const box = document.getElementById("messages");
+  const line = document.createElement("p");
+  line.className = "error";
+  line.textContent = message;
+  box.appendChild(line);
+  fetch("log", { method: "POST", body: message }).catch(() => {
+  });
+}
+window.addEventListener("error", (e) => report(`error: ${e.message}`));
+window.addEventListener("unhandledrejection", (e) => report(`error: ${e.reason && e.reason.message ? e.reason.message : e.reason}`));
+async function fetchOk(url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`cannot load ${url} (${response.status} ${response.statusText})`);
+  return response;
+}
+async function openInput(input, size) {
+  const panel = document.createElement("figure");
+  const canvas = document.createElement("canvas");
+  [canvas.width, canvas.height] = size;
+  canvas.style.width = `${size[0]}px`;
+  canvas.style.height = `${size[1]}px`;
+  const caption = document.createElement("figcaption");
+  caption.textContent = `${input.name} (${input.kind})`;
+  panel.append(canvas, caption);
+  document.getElementById("panels").appendChild(panel);
+  try {
+    const gl = createContext(canvas);
+    const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
+    const draw = drawOf(glb);
+    const plans = decodePlans(draw, await readArrays(gl, glb, draw));
+    const executor = new Executor(gl, draw, input.name);
+    const drawn = [];
+    for (const plan of plans) {
+      try {
+        executor.check(plan);
+        executor.program(plan.program);
+        drawn.push(plan);
+      } catch (e) {
+        if (!(e instanceof Unsupported)) throw e;
+        report(`${input.name}: ${e.message}`);
+      }
+    }
+    return { canvas, executor, plans: drawn, targets: createTargets(gl, size) };
+  } catch (e) {
+    report(`${input.name}: ${e.message}`);
+    return null;
+  }
+}
+function union(boxes) {
+  return [0, 1].map((k) => [0, 1, 2].map((i) => (k ? Math.max : Math.min)(...boxes.map((b) => b[k][i]))));
+}
+async function main() {
+  const params = new URLSearchParams(location.search);
+  const manifest = await (await fetchOk("inputs.json")).json();
+  const frame = manifest.camera;
+  let [az, el, dist] = parseView(params.get("view") || frame.default_view);
+  const size = parseSize(params.get("size") || frame.default_size);
+  const [lightAz, lightEl] = parseView(params.get("light") || manifest.light.angles);
+  const light = lightUniforms(manifest.light, lightAz, lightEl);
+  const bounds = union(manifest.inputs.map((i) => i.bounds));
+  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size)))).filter(Boolean);
+  const render = () => {
+    const camera = orbitBounds(bounds, az, el, dist, size, frame);
+    dist = camera.distance;
+    for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
+    for (const p of panels) p.executor.gl.finish();
+    state.view = [az, el, dist];
+    state.frames += 1;
+    state.ready = true;
+  };
+  let pending = false;
+  const redraw = () => {
+    if (!pending) {
+      pending = true;
+      requestAnimationFrame(() => {
+        pending = false;
+        render();
+      });
+    }
+  };
+  for (const p of panels) {
+    p.canvas.addEventListener("pointerdown", (e) => p.canvas.setPointerCapture(e.pointerId));
+    p.canvas.addEventListener("pointermove", (e) => {
+      if (!p.canvas.hasPointerCapture(e.pointerId)) return;
+      az -= e.movementX * 0.4;
+      el = Math.max(-89, Math.min(89, el + e.movementY * 0.4));
+      redraw();
+    });
+    p.canvas.addEventListener("wheel", (e) => {
+      e.preventDefault();
+      dist = Math.max(0.01, Math.min(1e4, dist * Math.exp(e.deltaY * 1e-3)));
+      redraw();
+    }, { passive: false });
+  }
+  render();
+}
+main().catch((e) => report(`error: ${e.message}`)).finally(() => {
+  state.loaded = true;
+});

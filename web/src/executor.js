@@ -1,0 +1,268 @@
+// The page's executor: render/executor.py in WebGL2. Each plan's program (the GLSL ES sources
+// the export embedded), geometry and textures are made once; a frame draws the opaque plans
+// into the AOV targets that gl/targets.py makes (colour, position + coverage, normal; a float
+// depth texture) with the uniforms the Python executor sets, then presents the picture
+// `reliefkit render` writes (present.glsl).
+
+import { cameraUniforms, modelOffset } from './camera.js';
+import { programKey } from './plans.js';
+import { uploadTexture } from './textures.js';
+import PRESENT from './present.glsl';
+
+const FRAME_ATTACHMENTS = 3;
+const MODES = { triangles: 'TRIANGLES', points: 'POINTS', lines: 'LINES', triangle_strip: 'TRIANGLE_STRIP' };
+const BLEND = { under: ['ONE_MINUS_DST_ALPHA', 'ONE'], add: ['ONE', 'ONE'] };
+
+/** A plan this executor cannot draw yet, named in a user's words. */
+export class Unsupported extends Error {}
+
+export function createContext(canvas) {
+  const gl = canvas.getContext('webgl2', { alpha: true, premultipliedAlpha: false, antialias: false, preserveDrawingBuffer: true });
+  if (!gl) throw new Error('this browser has no WebGL2: the viewer needs it');
+  if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('this browser cannot render to float textures (EXT_color_buffer_float)');
+  gl.getExtension('OES_texture_float_linear');
+  return gl;
+}
+
+export class Executor {
+  constructor(gl, draw, name) {
+    this.gl = gl;
+    this.name = name;
+    this.sources = new Map(draw.programs.map((p) => [programKey(p.program, p.defines), p]));
+    this.programs = new Map();
+    this.buffers = new Map();
+    this.vaos = new Map();
+    this.textures = new Map();
+    this.depthClamp = gl.getExtension('EXT_depth_clamp');
+    this.present = this.link('present.glsl', sourcePair(PRESENT));
+  }
+
+  /** Plans this executor draws as they are; throws `Unsupported` for the others. */
+  check(plan) {
+    if (plan.perView) throw new Unsupported(`${plan.name}: its view hook ${plan.perView.function} is not supported by the viewer yet`);
+    if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
+    if (plan.renderPass !== 'opaque') throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
+    if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
+  }
+
+  program(program) {
+    const key = programKey(program.name, program.defines);
+    if (!this.programs.has(key)) {
+      const sources = this.sources.get(key);
+      if (!sources) throw new Error(`${this.name}: no embedded shader for ${key}`);
+      this.programs.set(key, this.link(program.name, { vertex: sources.vertex, fragment: sources.fragment }));
+    }
+    return this.programs.get(key);
+  }
+
+  link(name, { vertex, fragment }) {
+    const gl = this.gl;
+    const prog = gl.createProgram();
+    for (const [type, source, stage] of [[gl.VERTEX_SHADER, vertex, 'vertex'], [gl.FRAGMENT_SHADER, fragment, 'fragment']]) {
+      const shader = gl.createShader(type);
+      gl.shaderSource(shader, source);
+      gl.compileShader(shader);
+      if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
+        throw new Error(`the ${stage} shader of ${name} does not compile in this browser: ${gl.getShaderInfoLog(shader).trim()}`);
+      }
+      gl.attachShader(prog, shader);
+    }
+    gl.linkProgram(prog);
+    if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) {
+      throw new Error(`${name} does not link in this browser: ${gl.getProgramInfoLog(prog).trim()}`);
+    }
+    const uniforms = new Map();
+    for (let i = 0; i < gl.getProgramParameter(prog, gl.ACTIVE_UNIFORMS); i++) {
+      const info = gl.getActiveUniform(prog, i);
+      uniforms.set(info.name.replace(/\[0\]$/, ''), { location: gl.getUniformLocation(prog, info.name), type: info.type, size: info.size });
+    }
+    return { prog, uniforms, name };
+  }
+
+  buffer(array, target) {
+    if (!this.buffers.has(array)) {
+      const gl = this.gl;
+      const buf = gl.createBuffer();
+      gl.bindBuffer(target, buf);
+      gl.bufferData(target, array.data, gl.STATIC_DRAW);
+      this.buffers.set(array, buf);
+    }
+    return this.buffers.get(array);
+  }
+
+  vertexArray(linked, geometry) {
+    const gl = this.gl;
+    const key = `${linked.name} ${geometry.key}`;
+    if (!this.vaos.has(key)) {
+      const vao = gl.createVertexArray();
+      gl.bindVertexArray(vao);
+      for (const [name, attr] of Object.entries(geometry.attributes)) {
+        const loc = gl.getAttribLocation(linked.prog, name);
+        if (loc < 0) continue;
+        const { shape, dtype } = attr.array;
+        const comps = shape.length === 2 ? shape[1] : 1;
+        gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer(attr.array, gl.ARRAY_BUFFER));
+        gl.enableVertexAttribArray(loc);
+        if (dtype === 'int32') gl.vertexAttribIPointer(loc, comps, gl.INT, 0, 0);
+        else if (dtype === 'float32') gl.vertexAttribPointer(loc, comps, gl.FLOAT, false, 0, 0);
+        else throw new Error(`${geometry.key}: vertex array ${name} is ${dtype}, not float32 or int32`);
+        gl.vertexAttribDivisor(loc, attr.perInstance ? 1 : 0);
+      }
+      if (geometry.indices) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer(geometry.indices, gl.ELEMENT_ARRAY_BUFFER));
+      gl.bindVertexArray(null);
+      this.vaos.set(key, vao);
+    }
+    return this.vaos.get(key);
+  }
+
+  texture(t) {
+    if (!this.textures.has(t)) this.textures.set(t, uploadTexture(this.gl, t));
+    return this.textures.get(t);
+  }
+
+  /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas. */
+  frame(plans, camera, light, targets) {
+    const gl = this.gl;
+    const [w, h] = camera.size;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
+    gl.viewport(0, 0, w, h);
+    gl.depthMask(true);
+    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    for (const plan of plans) this.draw(plan, camera, light);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.viewport(0, 0, w, h);
+    this.setRaster({ depth_test: false, cull: 'none', blend: 'none', depth_write: false });
+    gl.useProgram(this.present.prog);
+    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position });
+    for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
+    gl.bindVertexArray(null);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+
+  draw(plan, camera, light) {
+    const gl = this.gl;
+    const linked = this.program(plan.program);
+    const vao = this.vertexArray(linked, plan.geometry);
+    gl.useProgram(linked.prog);
+    const samplers = this.bindTextures(plan.textures);
+    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light, ...plan.uniforms, ...samplers };
+    for (const [name, value] of Object.entries(values)) setUniform(gl, linked, name, value);
+    this.setRaster(plan.raster);
+    gl.bindVertexArray(vao);
+    const { mode, count, first, instances, indexed } = counts(gl, plan);
+    if (indexed && instances != null) gl.drawElementsInstanced(mode, count, gl.UNSIGNED_INT, first * 4, instances);
+    else if (indexed) gl.drawElements(mode, count, gl.UNSIGNED_INT, first * 4);
+    else if (instances != null) gl.drawArraysInstanced(mode, first, count, instances);
+    else gl.drawArrays(mode, first, count);
+    gl.bindVertexArray(null);
+  }
+
+  /** Bind textures (sampler name -> plan texture or {tex, target}) to units 0, 1, ...;
+   *  the sampler uniforms and each one's `<sampler>_decode` (1, 0: no encoding). */
+  bindTextures(textures) {
+    const gl = this.gl;
+    const out = {};
+    const units = new Map();
+    for (const [name, t] of Object.entries(textures)) {
+      const made = t.tex ? t : this.texture(t);
+      if (!units.has(made)) {
+        units.set(made, units.size);
+        gl.activeTexture(gl.TEXTURE0 + units.get(made));
+        gl.bindTexture(made.target, made.tex);
+      }
+      out[name] = units.get(made);
+      out[`${name}_decode`] = [1, 0];
+    }
+    return out;
+  }
+
+  setRaster(r) {
+    const gl = this.gl;
+    (r.depth_test ? gl.enable : gl.disable).call(gl, gl.DEPTH_TEST);
+    gl.depthFunc(r.depth_func === '<=' ? gl.LEQUAL : gl.LESS);
+    gl.depthMask(!!r.depth_write);
+    if (this.depthClamp) (r.depth_clamp ? gl.enable : gl.disable).call(gl, this.depthClamp.DEPTH_CLAMP_EXT);
+    if (r.cull && r.cull !== 'none') {
+      gl.enable(gl.CULL_FACE);
+      gl.cullFace(r.cull === 'front' ? gl.FRONT : gl.BACK);
+    } else gl.disable(gl.CULL_FACE);
+    gl.frontFace(r.front_face === 'cw' ? gl.CW : gl.CCW);
+    if (r.blend && r.blend !== 'none') {
+      gl.enable(gl.BLEND);
+      gl.blendFunc(gl[BLEND[r.blend][0]], gl[BLEND[r.blend][1]]);
+    } else gl.disable(gl.BLEND);
+  }
+}
+
+/** The AOV targets of a WxH frame (gl/targets.py render_target). */
+export function createTargets(gl, [w, h]) {
+  const make = (internal, format, type, attachment) => {
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, internal, w, h, 0, format, type, null);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
+    return { tex, target: gl.TEXTURE_2D };
+  };
+  const fbo = gl.createFramebuffer();
+  gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+  const attachments = [...Array(FRAME_ATTACHMENTS).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
+  const [color, position] = attachments.map((a) => make(gl.RGBA32F, gl.RGBA, gl.FLOAT, a));
+  make(gl.DEPTH_COMPONENT32F, gl.DEPTH_COMPONENT, gl.FLOAT, gl.DEPTH_ATTACHMENT);
+  gl.drawBuffers(attachments);
+  const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`the ${w}x${h} float render targets are incomplete (status 0x${status.toString(16)})`);
+  return { fbo, color, position };
+}
+
+/** render/executor.py _counts. */
+function counts(gl, plan) {
+  const g = plan.geometry;
+  let count = plan.count;
+  if (count == null) {
+    if (g.indices) count = g.indices.data.length;
+    else if (g.vertices != null) count = g.vertices;
+    else count = Math.min(...Object.values(g.attributes).filter((a) => !a.perInstance).map((a) => a.array.shape[0]));
+  }
+  return { mode: gl[MODES[g.primitive]], count, first: plan.first || 0, instances: g.instances, indexed: !!g.indices };
+}
+
+/** The GLSL ES pair of a one-file shader: VERTEX_SHADER / FRAGMENT_SHADER defined after #version. */
+function sourcePair(text) {
+  const [version, ...rest] = text.split('\n');
+  const body = rest.join('\n');
+  return { vertex: `${version}\n#define VERTEX_SHADER\n${body}`, fragment: `${version}\n#define FRAGMENT_SHADER\n${body}` };
+}
+
+function flat(value) {
+  if (value && value.data && value.shape) return Array.from(value.data, Number);
+  if (Array.isArray(value)) return value.flatMap(flat);
+  return [typeof value === 'boolean' ? Number(value) : value];
+}
+
+/** gl/uniforms.py set_uniforms: unused names skipped, lists cut to the array's length. */
+function setUniform(gl, linked, name, value) {
+  const u = linked.uniforms.get(name);
+  if (!u) return;
+  const T = gl;
+  if (Array.isArray(value) && u.size === 1 && Array.isArray(value[0]) && ![T.FLOAT_MAT3, T.FLOAT_MAT4].includes(u.type)) value = value[0];
+  const v = flat(value);
+  const n = { [T.FLOAT_MAT4]: 16, [T.FLOAT_MAT3]: 9, [T.FLOAT_VEC2]: 2, [T.FLOAT_VEC3]: 3, [T.FLOAT_VEC4]: 4,
+    [T.INT_VEC2]: 2, [T.INT_VEC3]: 3, [T.INT_VEC4]: 4, [T.BOOL_VEC2]: 2, [T.BOOL_VEC3]: 3, [T.BOOL_VEC4]: 4 }[u.type] || 1;
+  const data = v.slice(0, n * u.size);
+  switch (u.type) {
+    case T.FLOAT: return gl.uniform1fv(u.location, data);
+    case T.FLOAT_VEC2: return gl.uniform2fv(u.location, data);
+    case T.FLOAT_VEC3: return gl.uniform3fv(u.location, data);
+    case T.FLOAT_VEC4: return gl.uniform4fv(u.location, data);
+    case T.FLOAT_MAT3: return gl.uniformMatrix3fv(u.location, true, data);
+    case T.FLOAT_MAT4: return gl.uniformMatrix4fv(u.location, true, data);
+    case T.UNSIGNED_INT: return gl.uniform1uiv(u.location, data);
+    case T.INT_VEC2: case T.BOOL_VEC2: return gl.uniform2iv(u.location, data);
+    case T.INT_VEC3: case T.BOOL_VEC3: return gl.uniform3iv(u.location, data);
+    case T.INT_VEC4: case T.BOOL_VEC4: return gl.uniform4iv(u.location, data);
+    default: return gl.uniform1iv(u.location, data); // int, bool, samplers
+  }
+}
