@@ -164,8 +164,9 @@ export class Executor {
     const gl = this.gl;
     const out = {};
     const units = new Map();
-    for (const [name, t] of Object.entries(textures)) {
-      const made = t.tex ? t : this.texture(t);
+    // uploaded first: an upload binds its texture to the active unit
+    const uploaded = Object.entries(textures).map(([name, t]) => [name, t.tex ? t : this.texture(t)]);
+    for (const [name, made] of uploaded) {
       if (!units.has(made)) {
         units.set(made, units.size);
         gl.activeTexture(gl.TEXTURE0 + units.get(made));

@@ -362,8 +362,8 @@ var Executor = class {
     const gl = this.gl;
     const out = {};
     const units = /* @__PURE__ */ new Map();
-    for (const [name, t] of Object.entries(textures)) {
-      const made = t.tex ? t : this.texture(t);
+    const uploaded = Object.entries(textures).map(([name, t]) => [name, t.tex ? t : this.texture(t)]);
+    for (const [name, made] of uploaded) {
       if (!units.has(made)) {
         units.set(made, units.size);
         gl.activeTexture(gl.TEXTURE0 + units.get(made));
