@@ -1,0 +1,137 @@
+"""The viewer page in headless Chromium (SwiftShader's WebGL2) against `reliefkit render`:
+the same picture for every kind the page draws, at three views; a drag orbits; what it
+cannot draw, a broken file and a shader that does not compile show a message in the page
+that also reaches the server's log."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from browser import canvas_rgba, chromium, messages, open_page, served, state
+from helpers import sample
+
+from reliefkit import save
+from reliefkit.io.gltf.glb import glb_bytes, read_glb
+from reliefkit.render import render
+from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
+from reliefkit.scene.views import framing_bounds, orbit_bounds, parse_view
+from reliefkit.viewer.site import Input, load_inputs, site_files
+
+SIZE = (128, 128)
+VIEWS = ("30,25", "-100,10", "160,50")
+#: kinds whose default plans the page draws, and where their scene comes from
+DRAWN = {"mesh": "demo:vehicle", "billboard-cloud": ("billboard", "billboard-cloud"),
+         "octahedral-impostor": ("impostor", "octahedral-impostor")}
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with chromium() as b:
+        yield b
+
+
+@pytest.fixture(scope="module")
+def specs(tmp_path_factory):
+    """Each drawn kind as an input spec: the demo mesh, the techniques' samples as .rk."""
+    folder = tmp_path_factory.mktemp("inputs")
+    out = {}
+    for kind, source in DRAWN.items():
+        if isinstance(source, str):
+            out[kind] = source
+            continue
+        made = sample(*source)
+        out[kind] = str(folder / f"{kind}.rk")
+        save(out[kind], made() if callable(made) else made)
+    return out
+
+
+def rendered(spec: str, view: str) -> np.ndarray:
+    """What `reliefkit render SPEC --view VIEW --size 128x128` writes, as RGBA8."""
+    from reliefkit.io.inputs import load_input
+
+    obj = load_input(spec)
+    camera = orbit_bounds(framing_bounds(obj), *parse_view(view), SIZE)
+    light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
+    return render(obj, camera, light=light).rgba8()
+
+
+def agreement(page: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
+    """Mask IoU, and the fraction of pixels both cover whose channels are within 4/255."""
+    a, b = page[..., 3] > 0, reference[..., 3] > 0
+    iou = (a & b).sum() / max((a | b).sum(), 1)
+    both = a & b
+    diff = np.abs(page[..., :3].astype(int) - reference[..., :3].astype(int)).max(-1)[both]
+    return float(iou), float((diff <= 4).mean()) if diff.size else 0.0
+
+
+def url(base: str, view: str) -> str:
+    return f"{base}?view={view}&size={SIZE[0]}x{SIZE[1]}"
+
+
+@pytest.mark.parametrize("kind", list(DRAWN))
+def test_the_page_draws_what_render_draws(gl, browser, specs, kind):
+    files = site_files(load_inputs([specs[kind]]))
+    with served(files) as (base, log):
+        for view in VIEWS:
+            page = open_page(browser, url(base, view))
+            seen = state(page)
+            assert seen["ready"] and seen["errors"] == [], seen
+            iou, within = agreement(canvas_rgba(page), rendered(specs[kind], view))
+            print(f"{kind} {view}: mask IoU {iou:.4f}, {within:.2%} within 4/255")
+            assert iou >= 0.99 and within >= 0.99, (kind, view, iou, within)
+            page.close()
+        assert log == []
+
+
+def test_a_drag_orbits(gl, browser, specs):
+    with served(site_files(load_inputs([specs["mesh"]]))) as (base, _):
+        page = open_page(browser, url(base, "30,25"))
+        before, first = canvas_rgba(page), state(page)
+        box = page.locator("canvas").bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.mouse.move(x, y)
+        page.mouse.down()
+        page.mouse.move(x + 60, y + 20, steps=4)
+        page.mouse.up()
+        page.wait_for_function(f"window.reliefkit.frames > {first['frames']}")
+        az, el, _ = state(page)["view"]
+        assert az < 30 and el > 25
+        assert (canvas_rgba(page) != before).any()
+
+
+def test_what_the_page_cannot_draw_yet_is_said(gl, browser, tmp_path):
+    made = sample("relief", "relief")
+    save(tmp_path / "relief.rk", made() if callable(made) else made)
+    with served(site_files(load_inputs([str(tmp_path / "relief.rk")]))) as (base, log):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert shown and all("not supported by the viewer yet" in line for line in shown)
+    assert any("not supported by the viewer yet" in line for line in log)
+
+
+def test_a_broken_file_shows_its_message(gl, browser):
+    files = site_files([Input("broken.glb", "mesh", b"this is no GLB file at all",
+                              [[0, 0, 0], [1, 1, 1]])])
+    with served(files) as (base, log):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert shown == ["broken.glb: broken.glb is not a GLB file"]
+    assert log == ["page: broken.glb: broken.glb is not a GLB file"]
+
+
+def test_a_shader_that_does_not_compile_shows_its_message(gl, browser, specs, tmp_path):
+    (good,) = load_inputs([specs["mesh"]])
+    (tmp_path / "good.glb").write_bytes(good.glb)
+    glb = read_glb(tmp_path / "good.glb")
+    for node in glb.document["nodes"]:
+        for ext in node.get("extensions", {}).values():
+            for program in ext["draw"]["programs"]:
+                version, rest = program["fragment"].split("\n", 1)
+                program["fragment"] = f"{version}\n#error forced by the test\n{rest}"
+    broken = Input("forced.glb", "mesh", glb_bytes(glb.document, glb.binary), good.bounds)
+    with served(site_files([broken])) as (base, log):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert len(shown) == 1 and "fragment shader of core:mesh.glsl does not compile" in shown[0]
+    assert "forced by the test" in shown[0]
+    assert log == ["page: " + " ".join(shown[0].split())]
