@@ -9,7 +9,7 @@ import subprocess
 import sys
 import urllib.request
 
-from browser import chromium, open_page, state
+from browser import canvas_rgba, chromium, open_page, state
 from helpers import assert_one_line_error, run_cli
 
 TIMEOUT_S = 300
@@ -56,12 +56,7 @@ def test_export_html_opens_from_a_static_server(gl, tmp_path):
         with chromium() as browser:
             page = open_page(browser, f"http://127.0.0.1:{port}/?view=30,25&size=64x64")
             seen = state(page)
-            covered = page.evaluate("""() => {
-                const c = document.createElement('canvas'); c.width = 64; c.height = 64;
-                const g = c.getContext('2d');
-                g.drawImage(document.querySelector('canvas'), 0, 0);
-                return g.getImageData(0, 0, 64, 64).data.filter((v, i) => i % 4 == 3 && v > 0).length;
-            }""")
+            covered = int((canvas_rgba(page)[..., 3] > 0).sum())
     finally:
         server.kill()
         server.wait()
