@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from browser import canvas_rgba, chromium, messages, open_page, served, state
 from helpers import sample
+from mesh_scenes import sampler_mesh
 
 from reliefkit import save
 from reliefkit.io.gltf.glb import glb_bytes, read_glb
@@ -19,8 +20,10 @@ from reliefkit.viewer.site import Input, load_inputs, site_files
 
 SIZE = (128, 128)
 VIEWS = ("30,25", "-100,10", "160,50")
-#: kinds whose default plans the page draws, and where their scene comes from
-DRAWN = {"mesh": "demo:vehicle", "billboard-cloud": ("billboard", "billboard-cloud"),
+#: kinds whose default plans the page draws, and where their scene comes from: a demo
+#: asset, a technique's sample, or a mesh of the test's own (saved as a mesh .rk)
+DRAWN = {"mesh": "demo:vehicle", "mesh-materials": sampler_mesh,
+         "billboard-cloud": ("billboard", "billboard-cloud"),
          "octahedral-impostor": ("impostor", "octahedral-impostor")}
 
 
@@ -39,7 +42,7 @@ def specs(tmp_path_factory):
         if isinstance(source, str):
             out[kind] = source
             continue
-        made = sample(*source)
+        made = source if callable(source) else sample(*source)
         out[kind] = str(folder / f"{kind}.rk")
         save(out[kind], made() if callable(made) else made)
     return out

@@ -81,8 +81,8 @@ export function cameraUniforms(camera) {
   const view = multiply(camera.view, translation(origin));
   const toEye = sub(camera.eye, camera.target);
   return {
-    u_view: view, u_proj: camera.proj,
-    u_inv_view_proj: invert(multiply(camera.proj, view)),
+    u_view: matrix(view), u_proj: matrix(camera.proj),
+    u_inv_view_proj: matrix(invert(multiply(camera.proj, view))),
     u_eye: sub(camera.eye, origin), u_orthographic: false,
     u_view_dir: scale(toEye, 1 / norm(toEye)), u_viewport: camera.size,
   };
@@ -97,6 +97,11 @@ export function modelOffset(camera, origin) {
 export function lightUniforms(light, az, el) {
   const [a, e] = [rad(az), rad(el)];
   return { ...light.uniforms, u_light_dir: [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)] };
+}
+
+/** A row-major 4x4 as a plan's (4, 4) array: uniforms transpose it, as gl/uniforms.py does. */
+function matrix(rows) {
+  return { shape: [4, 4], dtype: 'float64', data: rows };
 }
 
 function identity() {

@@ -243,11 +243,14 @@ function flat(value) {
   return [typeof value === 'boolean' ? Number(value) : value];
 }
 
-/** gl/uniforms.py set_uniforms: unused names skipped, lists cut to the array's length. */
+/** gl/uniforms.py set_uniforms: unused names skipped, lists cut to the array's length; a
+ *  matrix given as an (n, n) array is row-major (numpy's), as a flat tuple column-major
+ *  (what moderngl hands GL as it is). */
 function setUniform(gl, linked, name, value) {
   const u = linked.uniforms.get(name);
   if (!u) return;
   const T = gl;
+  const rowMajor = !!(value && value.shape && value.shape.length === 2);
   if (Array.isArray(value) && u.size === 1 && Array.isArray(value[0]) && ![T.FLOAT_MAT3, T.FLOAT_MAT4].includes(u.type)) value = value[0];
   const v = flat(value);
   const n = { [T.FLOAT_MAT4]: 16, [T.FLOAT_MAT3]: 9, [T.FLOAT_VEC2]: 2, [T.FLOAT_VEC3]: 3, [T.FLOAT_VEC4]: 4,
@@ -258,8 +261,8 @@ function setUniform(gl, linked, name, value) {
     case T.FLOAT_VEC2: return gl.uniform2fv(u.location, data);
     case T.FLOAT_VEC3: return gl.uniform3fv(u.location, data);
     case T.FLOAT_VEC4: return gl.uniform4fv(u.location, data);
-    case T.FLOAT_MAT3: return gl.uniformMatrix3fv(u.location, true, data);
-    case T.FLOAT_MAT4: return gl.uniformMatrix4fv(u.location, true, data);
+    case T.FLOAT_MAT3: return gl.uniformMatrix3fv(u.location, rowMajor, data);
+    case T.FLOAT_MAT4: return gl.uniformMatrix4fv(u.location, rowMajor, data);
     case T.UNSIGNED_INT: return gl.uniform1uiv(u.location, data);
     case T.INT_VEC2: case T.BOOL_VEC2: return gl.uniform2iv(u.location, data);
     case T.INT_VEC3: case T.BOOL_VEC3: return gl.uniform3iv(u.location, data);

@@ -65,9 +65,9 @@ function cameraUniforms(camera) {
   const view = multiply(camera.view, translation(origin));
   const toEye = sub(camera.eye, camera.target);
   return {
-    u_view: view,
-    u_proj: camera.proj,
-    u_inv_view_proj: invert(multiply(camera.proj, view)),
+    u_view: matrix(view),
+    u_proj: matrix(camera.proj),
+    u_inv_view_proj: matrix(invert(multiply(camera.proj, view))),
     u_eye: sub(camera.eye, origin),
     u_orthographic: false,
     u_view_dir: scale(toEye, 1 / norm(toEye)),
@@ -80,6 +80,9 @@ function modelOffset(camera, origin) {
 function lightUniforms(light, az, el) {
   const [a, e] = [rad(az), rad(el)];
   return { ...light.uniforms, u_light_dir: [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)] };
+}
+function matrix(rows) {
+  return { shape: [4, 4], dtype: "float64", data: rows };
 }
 function identity() {
   return [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
@@ -439,6 +442,7 @@ function setUniform(gl, linked, name, value) {
   const u = linked.uniforms.get(name);
   if (!u) return;
   const T = gl;
+  const rowMajor = !!(value && value.shape && value.shape.length === 2);
   if (Array.isArray(value) && u.size === 1 && Array.isArray(value[0]) && ![T.FLOAT_MAT3, T.FLOAT_MAT4].includes(u.type)) value = value[0];
   const v = flat(value);
   const n = {
@@ -465,9 +469,9 @@ function setUniform(gl, linked, name, value) {
     case T.FLOAT_VEC4:
       return gl.uniform4fv(u.location, data);
     case T.FLOAT_MAT3:
-      return gl.uniformMatrix3fv(u.location, true, data);
+      return gl.uniformMatrix3fv(u.location, rowMajor, data);
     case T.FLOAT_MAT4:
-      return gl.uniformMatrix4fv(u.location, true, data);
+      return gl.uniformMatrix4fv(u.location, rowMajor, data);
     case T.UNSIGNED_INT:
       return gl.uniform1uiv(u.location, data);
     case T.INT_VEC2:
