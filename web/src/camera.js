@@ -72,12 +72,15 @@ export function orbitBounds(bounds, az, el, dist, size, frame) {
   const target = [0, 1, 2].map((i) => (bounds[0][i] + bounds[1][i]) / 2);
   const [a, e] = [rad(az), rad(el)];
   const eye = [0, 1, 2].map((i) => target[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
-  return { eye, target, size, near, far, view: lookAt(eye, target), proj: perspective(frame.fov, w / h, near, far), distance: dist };
+  return {
+    eye, target, up: [0, 1, 0], fov_deg: frame.fov, size, near, far, ortho_height: null, origin: target,
+    view: lookAt(eye, target), proj: perspective(frame.fov, w / h, near, far), distance: dist,
+  };
 }
 
 /** gl/uniforms.py camera_uniforms. */
 export function cameraUniforms(camera) {
-  const origin = camera.target;
+  const origin = camera.origin;
   const view = multiply(camera.view, translation(origin));
   const toEye = sub(camera.eye, camera.target);
   return {
@@ -90,13 +93,15 @@ export function cameraUniforms(camera) {
 
 /** gl/uniforms.py model_offset: a plan's origin relative to the camera's. */
 export function modelOffset(camera, origin) {
-  return { u_model_offset: sub(origin || [0, 0, 0], camera.target) };
+  return { u_model_offset: sub(origin || [0, 0, 0], camera.origin) };
 }
 
-/** The light's uniforms (scene/light.py DirectionalLight.uniforms) from its angles. */
-export function lightUniforms(light, az, el) {
+/** The light from its angles: its unit ``direction`` (towards the light) and its uniforms
+ *  (scene/light.py DirectionalLight.uniforms; ``fields`` holds the others from Python). */
+export function lightFrom(fields, az, el) {
   const [a, e] = [rad(az), rad(el)];
-  return { ...light.uniforms, u_light_dir: [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)] };
+  const direction = [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)];
+  return { direction, uniforms: { ...fields.uniforms, u_light_dir: direction } };
 }
 
 /** A row-major 4x4 as a plan's (4, 4) array: uniforms transpose it, as gl/uniforms.py does. */

@@ -5,7 +5,7 @@
 // `reliefkit render` writes (present.glsl).
 
 import { cameraUniforms, modelOffset } from './camera.js';
-import { programKey } from './plans.js';
+import { programKey, withView } from './plans.js';
 import { uploadTexture } from './textures.js';
 import PRESENT from './present.glsl';
 
@@ -25,12 +25,14 @@ export function createContext(canvas) {
 }
 
 export class Executor {
-  constructor(gl, draw, name) {
+  /** ``hooks``: the view hooks' ports by the Python function's "module:name" (web/src/hooks/). */
+  constructor(gl, draw, name, hooks = {}) {
     this.gl = gl;
     this.name = name;
+    this.hooks = hooks;
     this.sources = new Map(draw.programs.map((p) => [programKey(p.program, p.defines), p]));
     this.programs = new Map();
-    this.buffers = new Map();
+    this.buffers = new Map(); // geometry key -> {attribute name or 'indices': {buffer, source}}
     this.vaos = new Map();
     this.textures = new Map();
     this.depthClamp = gl.getExtension('EXT_depth_clamp');
@@ -39,9 +41,11 @@ export class Executor {
 
   /** Plans this executor draws as they are; throws `Unsupported` for the others. */
   check(plan) {
-    if (plan.perView) throw new Unsupported(`${plan.name}: its view hook ${plan.perView.function} is not supported by the viewer yet`);
+    if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
     if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
-    if (plan.renderPass !== 'opaque') throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
+    const encoded = Object.values(plan.textures).find((t) => t.encoded);
+    if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
+    if (plan.render_pass !== 'opaque') throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
     if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
   }
 
@@ -79,15 +83,20 @@ export class Executor {
     return { prog, uniforms, name };
   }
 
-  buffer(array, target) {
-    if (!this.buffers.has(array)) {
-      const gl = this.gl;
-      const buf = gl.createBuffer();
-      gl.bindBuffer(target, buf);
-      gl.bufferData(target, array.data, gl.STATIC_DRAW);
-      this.buffers.set(array, buf);
+  /** The buffer of a geometry's attribute (or 'indices') holding ``array``: written when the
+   *  array is not the one it holds (a view hook's new array; render/executor.py _write). */
+  buffer(geometry, name, array, target) {
+    const gl = this.gl;
+    if (!this.buffers.has(geometry.key)) this.buffers.set(geometry.key, {});
+    const made = this.buffers.get(geometry.key);
+    if (!made[name]) made[name] = { buffer: gl.createBuffer(), source: null };
+    const entry = made[name];
+    if (entry.source !== array) {
+      gl.bindBuffer(target, entry.buffer);
+      gl.bufferData(target, array.dtype === 'uint32' || target === gl.ARRAY_BUFFER ? array.data : new Uint32Array(array.data), gl.DYNAMIC_DRAW);
+      entry.source = array;
     }
-    return this.buffers.get(array);
+    return entry.buffer;
   }
 
   vertexArray(linked, geometry) {
@@ -101,14 +110,14 @@ export class Executor {
         if (loc < 0) continue;
         const { shape, dtype } = attr.array;
         const comps = shape.length === 2 ? shape[1] : 1;
-        gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer(attr.array, gl.ARRAY_BUFFER));
+        gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer(geometry, name, attr.array, gl.ARRAY_BUFFER));
         gl.enableVertexAttribArray(loc);
         if (dtype === 'int32') gl.vertexAttribIPointer(loc, comps, gl.INT, 0, 0);
         else if (dtype === 'float32') gl.vertexAttribPointer(loc, comps, gl.FLOAT, false, 0, 0);
         else throw new Error(`${geometry.key}: vertex array ${name} is ${dtype}, not float32 or int32`);
-        gl.vertexAttribDivisor(loc, attr.perInstance ? 1 : 0);
+        gl.vertexAttribDivisor(loc, attr.per_instance ? 1 : 0);
       }
-      if (geometry.indices) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer(geometry.indices, gl.ELEMENT_ARRAY_BUFFER));
+      if (geometry.indices) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer(geometry, 'indices', geometry.indices, gl.ELEMENT_ARRAY_BUFFER));
       gl.bindVertexArray(null);
       this.vaos.set(key, vao);
     }
@@ -140,13 +149,30 @@ export class Executor {
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
 
-  draw(plan, camera, light) {
+  /** ``plan`` as seen from ``camera`` (its hook's update applied), its new arrays written into
+   *  the geometry's buffers (render/executor.py Executor.view). */
+  view(plan, camera, light) {
+    if (!plan.per_view) return plan;
+    const hook = this.hooks[plan.per_view.function];
+    const viewed = withView(plan, hook(plan, camera, light, plan.per_view.data) || {});
     const gl = this.gl;
+    for (const [name, attr] of Object.entries(viewed.geometry.attributes)) this.buffer(plan.geometry, name, attr.array, gl.ARRAY_BUFFER);
+    if (viewed.geometry.indices) {
+      gl.bindVertexArray(null); // an element buffer binds to the bound vertex array
+      this.buffer(plan.geometry, 'indices', viewed.geometry.indices, gl.ELEMENT_ARRAY_BUFFER);
+    }
+    return viewed;
+  }
+
+  draw(source, camera, light) {
+    const gl = this.gl;
+    const plan = this.view(source, camera, light);
+    if (plan.count === 0) return; // switched off from this view
     const linked = this.program(plan.program);
     const vao = this.vertexArray(linked, plan.geometry);
     gl.useProgram(linked.prog);
     const samplers = this.bindTextures(plan.textures);
-    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light, ...plan.uniforms, ...samplers };
+    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light.uniforms, ...plan.uniforms, ...samplers };
     for (const [name, value] of Object.entries(values)) setUniform(gl, linked, name, value);
     this.setRaster(plan.raster);
     gl.bindVertexArray(vao);
@@ -225,7 +251,7 @@ function counts(gl, plan) {
   if (count == null) {
     if (g.indices) count = g.indices.data.length;
     else if (g.vertices != null) count = g.vertices;
-    else count = Math.min(...Object.values(g.attributes).filter((a) => !a.perInstance).map((a) => a.array.shape[0]));
+    else count = Math.min(...Object.values(g.attributes).filter((a) => !a.per_instance).map((a) => a.array.shape[0]));
   }
   return { mode: gl[MODES[g.primitive]], count, first: plan.first || 0, instances: g.instances, indexed: !!g.indices };
 }

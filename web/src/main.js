@@ -4,12 +4,15 @@
 // window.reliefkit.ready turns true after the first complete frame; errors show in the page
 // and are posted to the server's log.
 
-import { lightUniforms, orbitBounds, parseSize, parseView } from './camera.js';
+import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
 import { createContext, createTargets, Executor, Unsupported } from './executor.js';
 import { drawOf, parseGlb, readArrays } from './glb.js';
 import { decodePlans } from './plans.js';
 
 const state = window.reliefkit = { ready: false, errors: [], frames: 0 };
+// The view hooks' ports by Python function ("module:name"): web/src/hooks/index.js's HOOKS
+// once merged; until then a plan with a hook is reported as not drawn yet.
+const HOOKS = {};
 
 function report(message) {
   state.errors.push(message);
@@ -46,7 +49,7 @@ async function openInput(input, size) {
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
     const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name);
+    const executor = new Executor(gl, draw, input.name, HOOKS);
     const drawn = [];
     for (const plan of plans) {
       try {
@@ -76,15 +79,20 @@ async function main() {
   let [az, el, dist] = parseView(params.get('view') || frame.default_view);
   const size = parseSize(params.get('size') || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get('light') || manifest.light.angles);
-  const light = lightUniforms(manifest.light, lightAz, lightEl);
+  const light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds = union(manifest.inputs.map((i) => i.bounds));
   const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size)))).filter(Boolean);
 
+  const readout = document.getElementById('stats');
   const render = () => {
+    const start = performance.now();
     const camera = orbitBounds(bounds, az, el, dist, size, frame);
     dist = camera.distance;
     for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
     for (const p of panels) p.executor.gl.finish();
+    state.frameMs = performance.now() - start; // the CPU's clock around the draws and gl.finish
+    readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
+      + `frame ${state.frameMs.toFixed(1)} ms`;
     state.view = [az, el, dist];
     state.frames += 1;
     state.ready = true;

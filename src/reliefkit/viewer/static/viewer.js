@@ -58,10 +58,23 @@ function orbitBounds(bounds, az, el, dist, size, frame) {
   const target = [0, 1, 2].map((i) => (bounds[0][i] + bounds[1][i]) / 2);
   const [a, e] = [rad(az), rad(el)];
   const eye = [0, 1, 2].map((i) => target[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
-  return { eye, target, size, near, far, view: lookAt(eye, target), proj: perspective(frame.fov, w / h, near, far), distance: dist };
+  return {
+    eye,
+    target,
+    up: [0, 1, 0],
+    fov_deg: frame.fov,
+    size,
+    near,
+    far,
+    ortho_height: null,
+    origin: target,
+    view: lookAt(eye, target),
+    proj: perspective(frame.fov, w / h, near, far),
+    distance: dist
+  };
 }
 function cameraUniforms(camera) {
-  const origin = camera.target;
+  const origin = camera.origin;
   const view = multiply(camera.view, translation(origin));
   const toEye = sub(camera.eye, camera.target);
   return {
@@ -75,11 +88,12 @@ function cameraUniforms(camera) {
   };
 }
 function modelOffset(camera, origin) {
-  return { u_model_offset: sub(origin || [0, 0, 0], camera.target) };
+  return { u_model_offset: sub(origin || [0, 0, 0], camera.origin) };
 }
-function lightUniforms(light, az, el) {
+function lightFrom(fields, az, el) {
   const [a, e] = [rad(az), rad(el)];
-  return { ...light.uniforms, u_light_dir: [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)] };
+  const direction = [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)];
+  return { direction, uniforms: { ...fields.uniforms, u_light_dir: direction } };
 }
 function matrix(rows) {
   return { shape: [4, 4], dtype: "float64", data: rows };
@@ -133,7 +147,7 @@ function decodePlans(draw, arrays) {
     const { attributes, ...rest } = g;
     const attrs = Object.fromEntries(Object.entries(attributes).map(([name, a]) => {
       const [array, perInstance] = decode(a, arrays);
-      return [name, { array, perInstance }];
+      return [name, { array, per_instance: perInstance }];
     }));
     geometries[key] = { key, attributes: attrs, ...decodeFields(rest, arrays) };
   }
@@ -150,11 +164,11 @@ function decodePlans(draw, arrays) {
       textures: Object.fromEntries(Object.entries(entry.textures).map(([s, k]) => [s, textures[k]])),
       uniforms: decode(entry.uniforms, arrays),
       raster: decode(entry.raster, arrays),
-      renderPass: entry.render_pass,
+      render_pass: entry.render_pass,
       origin: decode(entry.origin, arrays),
       first: entry.first,
       count: entry.count,
-      perView: hook && { function: hook[0], data: hook[1] },
+      per_view: hook && { function: hook[0], data: hook[1] },
       multipass: multipass && { kind: multipass[0], programs: multipass[1], params: multipass[2] }
     };
   });
@@ -162,6 +176,30 @@ function decodePlans(draw, arrays) {
 function programKey(name, defines) {
   const sorted = Object.keys(defines || {}).sort().map((k) => [k, defines[k]]);
   return `${name} ${JSON.stringify(sorted)}`;
+}
+function withView(plan, update) {
+  let geometry = plan.geometry;
+  const { attributes = {}, indices, vertices, instances } = update;
+  if (Object.keys(attributes).length || indices != null || vertices != null || instances != null) {
+    geometry = {
+      ...geometry,
+      attributes: Object.fromEntries(Object.entries(geometry.attributes).map(
+        ([name, attr]) => [name, { ...attr, array: attributes[name] || attr.array }]
+      )),
+      indices: indices != null ? indices : geometry.indices,
+      vertices: vertices != null ? vertices : geometry.vertices,
+      instances: instances != null ? instances : geometry.instances
+    };
+  }
+  const params = update.params && Object.keys(update.params).length ? update.params : null;
+  return {
+    ...plan,
+    geometry,
+    raster: update.cull != null ? { ...plan.raster, cull: update.cull } : plan.raster,
+    count: update.count != null ? update.count : plan.count,
+    multipass: params ? { ...plan.multipass, params: { ...plan.multipass.params, ...params } } : plan.multipass,
+    uniforms: { ...plan.uniforms, ...update.uniforms || {} }
+  };
 }
 
 // web/src/textures.js
@@ -235,9 +273,11 @@ function createContext(canvas) {
   return gl;
 }
 var Executor = class {
-  constructor(gl, draw, name) {
+  /** ``hooks``: the view hooks' ports by the Python function's "module:name" (web/src/hooks/). */
+  constructor(gl, draw, name, hooks = {}) {
     this.gl = gl;
     this.name = name;
+    this.hooks = hooks;
     this.sources = new Map(draw.programs.map((p) => [programKey(p.program, p.defines), p]));
     this.programs = /* @__PURE__ */ new Map();
     this.buffers = /* @__PURE__ */ new Map();
@@ -248,9 +288,11 @@ var Executor = class {
   }
   /** Plans this executor draws as they are; throws `Unsupported` for the others. */
   check(plan) {
-    if (plan.perView) throw new Unsupported(`${plan.name}: its view hook ${plan.perView.function} is not supported by the viewer yet`);
+    if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
     if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
-    if (plan.renderPass !== "opaque") throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
+    const encoded = Object.values(plan.textures).find((t) => t.encoded);
+    if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
+    if (plan.render_pass !== "opaque") throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
     if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
   }
   program(program) {
@@ -285,15 +327,20 @@ var Executor = class {
     }
     return { prog, uniforms, name };
   }
-  buffer(array, target) {
-    if (!this.buffers.has(array)) {
-      const gl = this.gl;
-      const buf = gl.createBuffer();
-      gl.bindBuffer(target, buf);
-      gl.bufferData(target, array.data, gl.STATIC_DRAW);
-      this.buffers.set(array, buf);
+  /** The buffer of a geometry's attribute (or 'indices') holding ``array``: written when the
+   *  array is not the one it holds (a view hook's new array; render/executor.py _write). */
+  buffer(geometry, name, array, target) {
+    const gl = this.gl;
+    if (!this.buffers.has(geometry.key)) this.buffers.set(geometry.key, {});
+    const made = this.buffers.get(geometry.key);
+    if (!made[name]) made[name] = { buffer: gl.createBuffer(), source: null };
+    const entry = made[name];
+    if (entry.source !== array) {
+      gl.bindBuffer(target, entry.buffer);
+      gl.bufferData(target, array.dtype === "uint32" || target === gl.ARRAY_BUFFER ? array.data : new Uint32Array(array.data), gl.DYNAMIC_DRAW);
+      entry.source = array;
     }
-    return this.buffers.get(array);
+    return entry.buffer;
   }
   vertexArray(linked, geometry) {
     const gl = this.gl;
@@ -306,14 +353,14 @@ var Executor = class {
         if (loc < 0) continue;
         const { shape, dtype } = attr.array;
         const comps = shape.length === 2 ? shape[1] : 1;
-        gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer(attr.array, gl.ARRAY_BUFFER));
+        gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer(geometry, name, attr.array, gl.ARRAY_BUFFER));
         gl.enableVertexAttribArray(loc);
         if (dtype === "int32") gl.vertexAttribIPointer(loc, comps, gl.INT, 0, 0);
         else if (dtype === "float32") gl.vertexAttribPointer(loc, comps, gl.FLOAT, false, 0, 0);
         else throw new Error(`${geometry.key}: vertex array ${name} is ${dtype}, not float32 or int32`);
-        gl.vertexAttribDivisor(loc, attr.perInstance ? 1 : 0);
+        gl.vertexAttribDivisor(loc, attr.per_instance ? 1 : 0);
       }
-      if (geometry.indices) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer(geometry.indices, gl.ELEMENT_ARRAY_BUFFER));
+      if (geometry.indices) gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.buffer(geometry, "indices", geometry.indices, gl.ELEMENT_ARRAY_BUFFER));
       gl.bindVertexArray(null);
       this.vaos.set(key, vao);
     }
@@ -342,13 +389,29 @@ var Executor = class {
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
-  draw(plan, camera, light) {
+  /** ``plan`` as seen from ``camera`` (its hook's update applied), its new arrays written into
+   *  the geometry's buffers (render/executor.py Executor.view). */
+  view(plan, camera, light) {
+    if (!plan.per_view) return plan;
+    const hook = this.hooks[plan.per_view.function];
+    const viewed = withView(plan, hook(plan, camera, light, plan.per_view.data) || {});
     const gl = this.gl;
+    for (const [name, attr] of Object.entries(viewed.geometry.attributes)) this.buffer(plan.geometry, name, attr.array, gl.ARRAY_BUFFER);
+    if (viewed.geometry.indices) {
+      gl.bindVertexArray(null);
+      this.buffer(plan.geometry, "indices", viewed.geometry.indices, gl.ELEMENT_ARRAY_BUFFER);
+    }
+    return viewed;
+  }
+  draw(source, camera, light) {
+    const gl = this.gl;
+    const plan = this.view(source, camera, light);
+    if (plan.count === 0) return;
     const linked = this.program(plan.program);
     const vao = this.vertexArray(linked, plan.geometry);
     gl.useProgram(linked.prog);
     const samplers = this.bindTextures(plan.textures);
-    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light, ...plan.uniforms, ...samplers };
+    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light.uniforms, ...plan.uniforms, ...samplers };
     for (const [name, value] of Object.entries(values)) setUniform(gl, linked, name, value);
     this.setRaster(plan.raster);
     gl.bindVertexArray(vao);
@@ -420,7 +483,7 @@ function counts(gl, plan) {
   if (count == null) {
     if (g.indices) count = g.indices.data.length;
     else if (g.vertices != null) count = g.vertices;
-    else count = Math.min(...Object.values(g.attributes).filter((a) => !a.perInstance).map((a) => a.array.shape[0]));
+    else count = Math.min(...Object.values(g.attributes).filter((a) => !a.per_instance).map((a) => a.array.shape[0]));
   }
   return { mode: gl[MODES[g.primitive]], count, first: plan.first || 0, instances: g.instances, indexed: !!g.indices };
 }
@@ -605,6 +668,7 @@ function readBitmap(gl, bitmap) {
 
 // web/src/main.js
 var state = window.reliefkit = { ready: false, errors: [], frames: 0 };
+var HOOKS = {};
 function report(message) {
   state.errors.push(message);
   const box = document.getElementById("messages");
@@ -637,7 +701,7 @@ async function openInput(input, size) {
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
     const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name);
+    const executor = new Executor(gl, draw, input.name, HOOKS);
     const drawn = [];
     for (const plan of plans) {
       try {
@@ -665,14 +729,18 @@ async function main() {
   let [az, el, dist] = parseView(params.get("view") || frame.default_view);
   const size = parseSize(params.get("size") || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get("light") || manifest.light.angles);
-  const light = lightUniforms(manifest.light, lightAz, lightEl);
+  const light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds = union(manifest.inputs.map((i) => i.bounds));
   const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size)))).filter(Boolean);
+  const readout = document.getElementById("stats");
   const render = () => {
+    const start = performance.now();
     const camera = orbitBounds(bounds, az, el, dist, size, frame);
     dist = camera.distance;
     for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
     for (const p of panels) p.executor.gl.finish();
+    state.frameMs = performance.now() - start;
+    readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms`;
     state.view = [az, el, dist];
     state.frames += 1;
     state.ready = true;
