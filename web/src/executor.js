@@ -149,6 +149,14 @@ export class Executor {
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
 
+  /** Wait until the frame is drawn: a one-pixel read back (Chromium's gl.finish() returns
+   *  before the GPU process has drawn). */
+  finish() {
+    const gl = this.gl;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+  }
+
   /** ``plan`` as seen from ``camera`` (its hook's update applied), its new arrays written into
    *  the geometry's buffers (render/executor.py Executor.view). */
   view(plan, camera, light) {

@@ -89,8 +89,8 @@ async function main() {
     const camera = orbitBounds(bounds, az, el, dist, size, frame);
     dist = camera.distance;
     for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
-    for (const p of panels) p.executor.gl.finish();
-    state.frameMs = performance.now() - start; // the CPU's clock around the draws and gl.finish
+    for (const p of panels) p.executor.finish();
+    state.frameMs = performance.now() - start; // the CPU's clock around the draws and a read back
     readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
       + `frame ${state.frameMs.toFixed(1)} ms`;
     state.view = [az, el, dist];

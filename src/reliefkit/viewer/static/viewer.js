@@ -389,6 +389,13 @@ var Executor = class {
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
+  /** Wait until the frame is drawn: a one-pixel read back (Chromium's gl.finish() returns
+   *  before the GPU process has drawn). */
+  finish() {
+    const gl = this.gl;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+  }
   /** ``plan`` as seen from ``camera`` (its hook's update applied), its new arrays written into
    *  the geometry's buffers (render/executor.py Executor.view). */
   view(plan, camera, light) {
@@ -738,7 +745,7 @@ async function main() {
     const camera = orbitBounds(bounds, az, el, dist, size, frame);
     dist = camera.distance;
     for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
-    for (const p of panels) p.executor.gl.finish();
+    for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start;
     readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms`;
     state.view = [az, el, dist];
