@@ -5,6 +5,7 @@ line."""
 from __future__ import annotations
 
 import signal
+import socket
 import subprocess
 import sys
 import urllib.request
@@ -68,3 +69,9 @@ def test_bad_inputs_are_one_line():
     assert_one_line_error(run_cli("view", "no-such-file.obj", "--no-browser"), "no-such-file")
     assert_one_line_error(run_cli("view", "demo:cup", "--port", "70000"), "--port")
     assert_one_line_error(run_cli("view"), "INPUT")
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert_one_line_error(run_cli("view", "demo:cup", "--no-browser", "--port", port),
+                              f"cannot serve on 127.0.0.1:{port}")

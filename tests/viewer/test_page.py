@@ -1,9 +1,12 @@
 """The viewer page in headless Chromium (SwiftShader's WebGL2) against `reliefkit render`:
-the same picture for every kind the page draws, at three views; a drag orbits; what it
+the same picture for every kind the page draws, at three views; a drag and the arrow keys
+orbit, and the URL follows; a bad view in the URL, what it
 cannot draw, a broken file and a shader that does not compile show a message in the page
 that also reaches the server's log."""
 
 from __future__ import annotations
+
+from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 import pytest
@@ -97,9 +100,23 @@ def test_a_drag_orbits(gl, browser, specs):
         page.mouse.move(x + 60, y + 20, steps=4)
         page.mouse.up()
         page.wait_for_function(f"window.reliefkit.frames > {first['frames']}")
-        az, el, _ = state(page)["view"]
+        az, el, dist = state(page)["view"]
         assert az < 30 and el > 25
         assert (canvas_rgba(page) != before).any()
+        query = parse_qs(urlsplit(page.url).query)  # the view stays in the URL
+        assert np.allclose([float(x) for x in query["view"][0].split(",")], [az, el, dist],
+                           atol=1e-3) and query["size"] == ["128x128"]
+        page.locator("canvas").press("ArrowUp")
+        page.wait_for_function(f"window.reliefkit.view[1] > {el}")
+
+
+def test_a_bad_view_in_the_url_is_said(gl, browser, specs):
+    with served(site_files(load_inputs([specs["mesh"]]))) as (base, log):
+        page = open_page(browser, f"{base}?view=30")
+        shown = messages(page)
+    assert shown == ["error: view must be AZ,EL or AZ,EL,DIST with |EL| < 90 (e.g. 30,25,2.6), "
+                     "got '30'"]
+    assert log == ["page: " + shown[0]]
 
 
 def test_what_the_page_cannot_draw_yet_is_said(gl, browser, tmp_path):

@@ -1,6 +1,7 @@
 // reliefkit's viewer page: every input of `reliefkit view` (inputs.json: its GLB, kind and
 // framing bounds) drawn side by side from one camera by the WebGL2 executor. The view is in
-// the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL); a drag orbits, the wheel zooms.
+// the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL, kept up to date); a drag (mouse or touch)
+// or the arrow keys orbit, the wheel or + and - zoom.
 // window.reliefkit.ready turns true after the first complete frame; errors show in the page
 // and are posted to the server's log.
 
@@ -94,6 +95,8 @@ async function main() {
     readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
       + `frame ${state.frameMs.toFixed(1)} ms`;
     state.view = [az, el, dist];
+    params.set('view', `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
+    history.replaceState(null, '', `?${params}`); // the view stays in the URL
     state.frames += 1;
     state.ready = true;
   };
@@ -110,6 +113,17 @@ async function main() {
       if (!p.canvas.hasPointerCapture(e.pointerId)) return;
       az -= e.movementX * 0.4;
       el = Math.max(-89, Math.min(89, el + e.movementY * 0.4));
+      redraw();
+    });
+    p.canvas.tabIndex = 0; // arrows orbit, + and - zoom
+    p.canvas.addEventListener('keydown', (e) => {
+      const step = { ArrowLeft: [5, 0, 1], ArrowRight: [-5, 0, 1], ArrowUp: [0, 5, 1], ArrowDown: [0, -5, 1],
+        '+': [0, 0, 1 / 1.1], '=': [0, 0, 1 / 1.1], '-': [0, 0, 1.1] }[e.key];
+      if (!step) return;
+      e.preventDefault();
+      az += step[0];
+      el = Math.max(-89, Math.min(89, el + step[1]));
+      dist = Math.max(0.01, Math.min(1e4, dist * step[2]));
       redraw();
     });
     p.canvas.addEventListener('wheel', (e) => {

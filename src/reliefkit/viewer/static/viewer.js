@@ -749,6 +749,8 @@ async function main() {
     state.frameMs = performance.now() - start;
     readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms`;
     state.view = [az, el, dist];
+    params.set("view", `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
+    history.replaceState(null, "", `?${params}`);
     state.frames += 1;
     state.ready = true;
   };
@@ -768,6 +770,24 @@ async function main() {
       if (!p.canvas.hasPointerCapture(e.pointerId)) return;
       az -= e.movementX * 0.4;
       el = Math.max(-89, Math.min(89, el + e.movementY * 0.4));
+      redraw();
+    });
+    p.canvas.tabIndex = 0;
+    p.canvas.addEventListener("keydown", (e) => {
+      const step = {
+        ArrowLeft: [5, 0, 1],
+        ArrowRight: [-5, 0, 1],
+        ArrowUp: [0, 5, 1],
+        ArrowDown: [0, -5, 1],
+        "+": [0, 0, 1 / 1.1],
+        "=": [0, 0, 1 / 1.1],
+        "-": [0, 0, 1.1]
+      }[e.key];
+      if (!step) return;
+      e.preventDefault();
+      az += step[0];
+      el = Math.max(-89, Math.min(89, el + step[1]));
+      dist = Math.max(0.01, Math.min(1e4, dist * step[2]));
       redraw();
     });
     p.canvas.addEventListener("wheel", (e) => {
