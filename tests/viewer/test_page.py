@@ -1,6 +1,6 @@
 """The viewer page in headless Chromium (SwiftShader's WebGL2) against `reliefkit render`:
 the same picture for every kind the page draws, at three views; a drag and the arrow keys
-orbit, and the URL follows; a bad view in the URL, what it
+orbit, and the URL follows; several inputs share one camera; a bad view in the URL, what it
 cannot draw, a broken file and a shader that does not compile show a message in the page
 that also reaches the server's log."""
 
@@ -51,12 +51,14 @@ def specs(tmp_path_factory):
     return out
 
 
-def rendered(spec: str, view: str) -> np.ndarray:
-    """What `reliefkit render SPEC --view VIEW --size 128x128` writes, as RGBA8."""
+def rendered(spec: str, view: str, bounds=None) -> np.ndarray:
+    """What `reliefkit render SPEC --view VIEW --size 128x128` writes, as RGBA8 (framed by
+    ``bounds`` instead of the input's own)."""
     from reliefkit.io.inputs import load_input
 
     obj = load_input(spec)
-    camera = orbit_bounds(framing_bounds(obj), *parse_view(view), SIZE)
+    box = framing_bounds(obj) if bounds is None else bounds
+    camera = orbit_bounds(box, *parse_view(view), SIZE)
     light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
     return render(obj, camera, light=light).rgba8()
 
@@ -87,6 +89,20 @@ def test_the_page_draws_what_render_draws(gl, browser, specs, kind):
             assert iou >= 0.99 and within >= 0.99, (kind, view, iou, within)
             page.close()
         assert log == []
+
+
+def test_several_inputs_side_by_side_share_one_camera(gl, browser, specs):
+    from reliefkit.io.inputs import load_input
+
+    both = [specs["mesh-materials"], specs["mesh"]]
+    boxes = np.array([framing_bounds(load_input(spec)) for spec in both])
+    union = np.stack([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+    with served(site_files(load_inputs(both))) as (base, _):
+        page = open_page(browser, url(base, "-100,10"))
+        assert state(page)["errors"] == []
+        for index, spec in enumerate(both):
+            iou, within = agreement(canvas_rgba(page, index), rendered(spec, "-100,10", union))
+            assert iou >= 0.99 and within >= 0.99, (spec, iou, within)
 
 
 def test_a_drag_orbits(gl, browser, specs):
