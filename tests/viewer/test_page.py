@@ -6,6 +6,7 @@ that also reaches the server's log."""
 
 from __future__ import annotations
 
+import struct
 from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
@@ -145,14 +146,24 @@ def test_what_the_page_cannot_draw_yet_is_said(gl, browser, tmp_path):
     assert any("not supported by the viewer yet" in line for line in log)
 
 
-def test_a_broken_file_shows_its_message(gl, browser):
-    files = site_files([Input("broken.glb", "mesh", b"this is no GLB file at all",
-                              [[0, 0, 0], [1, 1, 1]])])
+def _glb_of_json(text: bytes) -> bytes:
+    body = text + b" " * (-len(text) % 4)
+    return struct.pack("<III", 0x46546C67, 2, 20 + len(body)) + \
+        struct.pack("<II", len(body), 0x4E4F534A) + body
+
+
+@pytest.mark.parametrize("data, message", [
+    (b"this is no GLB file at all", "broken.glb is not a GLB file"),
+    (_glb_of_json(b'{"asset": '), "broken.glb: its JSON chunk does not parse"),
+    (_glb_of_json(b'{"asset": {"version": "2.0"}}'),
+     "broken.glb: no RELIEFKIT_ extension (not exported by reliefkit)")])
+def test_a_broken_file_shows_its_message(gl, browser, data, message):
+    files = site_files([Input("broken.glb", "mesh", data, [[0, 0, 0], [1, 1, 1]])])
     with served(files) as (base, log):
         page = open_page(browser, base)
         shown = messages(page)
-    assert shown == ["broken.glb: broken.glb is not a GLB file"]
-    assert log == ["page: broken.glb: broken.glb is not a GLB file"]
+    assert len(shown) == 1 and shown[0].startswith(f"broken.glb: {message}"), shown
+    assert log == ["page: " + " ".join(shown[0].split())]
 
 
 def test_a_shader_that_does_not_compile_shows_its_message(gl, browser, specs, tmp_path):

@@ -47,6 +47,7 @@ async function openInput(input, size) {
   document.getElementById('panels').appendChild(panel);
   try {
     const gl = createContext(canvas);
+    canvas.addEventListener('webglcontextlost', () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
     const plans = decodePlans(draw, await readArrays(gl, glb, draw));

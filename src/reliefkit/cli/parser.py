@@ -14,7 +14,7 @@ from ..core.technique import bakers, techniques
 from ..export.gltf import DEFAULT_FALLBACK_TRIANGLES
 from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
-from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW
+from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW
 from ..shootout.sizing import candidates as shootout_candidates
 from .commands import (
     cmd_bake,
@@ -129,7 +129,7 @@ def _add_view_args(p: _Parser) -> None:
                    "distance that fits the sphere in view)")
     p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
                    help="image size in pixels (default: %(default)s)")
-    add_flag(p, "--fov", dash_value=True, type=float, default=40.0, metavar="DEG",
+    add_flag(p, "--fov", dash_value=True, type=float, default=DEFAULT_FOV, metavar="DEG",
               help="vertical field of view in degrees, within [0.1, 179] (default: "
                    "%(default)g)")
     add_flag(p, "--light", dash_value=True, metavar="AZ,EL",

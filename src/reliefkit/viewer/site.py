@@ -19,10 +19,9 @@ from ..export.gltf import export_bytes
 from ..io.atomic import atomic_path, written_together
 from ..io.inputs import kind_of, load_input
 from ..scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
-from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW, FIT_MARGIN, framing_bounds
+from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW, FIT_MARGIN, framing_bounds
 
 PAGE_FILES = ("index.html", "viewer.js")
-FOV_DEG = 40.0  # `reliefkit render`'s default --fov
 
 
 @dataclass(frozen=True)
@@ -59,7 +58,7 @@ def manifest(inputs: list[Input]) -> dict:
                         "bounds": i.bounds} for k, i in enumerate(inputs)],
             "camera": {"default_view": f"{az:g},{el:g}",
                        "default_size": f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}",
-                       "fov": FOV_DEG, "fit_margin": FIT_MARGIN},
+                       "fov": DEFAULT_FOV, "fit_margin": FIT_MARGIN},
             "light": {"angles": ",".join(f"{a:g}" for a in DEFAULT_LIGHT_ANGLES),
                       "uniforms": light}}
 

@@ -591,12 +591,19 @@ function parseGlb(buffer, name) {
     const type = data.getUint32(at + 4, true);
     if (at + 8 + length > buffer.byteLength) throw new Error(`${name}: a chunk runs past the end`);
     const body = buffer.slice(at + 8, at + 8 + length);
-    if (type === JSON_CHUNK) json = JSON.parse(new TextDecoder().decode(body));
+    if (type === JSON_CHUNK) json = parseJson(body, name);
     else if (type === BIN_CHUNK) bin = body;
     at += 8 + length;
   }
   if (json === null) throw new Error(`${name}: no JSON chunk`);
   return { json, bin, name };
+}
+function parseJson(bytes, name) {
+  try {
+    return JSON.parse(new TextDecoder("utf-8", { fatal: true }).decode(bytes));
+  } catch (e) {
+    throw new Error(`${name}: its JSON chunk does not parse (${e.message})`);
+  }
 }
 function drawOf(glb) {
   for (const node of glb.json.nodes || []) {
@@ -637,12 +644,26 @@ function viewBytes(glb, index, length, name) {
 async function pngValues(gl, glb, index, shape) {
   const image = (glb.json.images || [])[index];
   if (!image) throw new Error(`${glb.name}: image ${index} is missing`);
-  const view = glb.json.bufferViews[image.bufferView];
+  const view = (glb.json.bufferViews || [])[image.bufferView];
+  if (!view || (view.byteOffset || 0) + view.byteLength > glb.bin.byteLength) {
+    throw new Error(`${glb.name}: image ${index}'s bufferView lies outside the file (truncated or forged)`);
+  }
   const bytes = glb.bin.slice(view.byteOffset || 0, (view.byteOffset || 0) + view.byteLength);
-  const bitmap = await createImageBitmap(
-    new Blob([bytes], { type: "image/png" }),
-    { premultiplyAlpha: "none", colorSpaceConversion: "none" }
-  );
+  let bitmap;
+  try {
+    bitmap = await createImageBitmap(
+      new Blob([bytes], { type: "image/png" }),
+      { premultiplyAlpha: "none", colorSpaceConversion: "none" }
+    );
+  } catch {
+    throw new Error(`${glb.name}: image ${index} is not a PNG this browser decodes`);
+  }
+  const rows = shape.length === 2 ? shape[0] : shape.slice(0, -2).reduce((a, b) => a * b, 1);
+  const width = shape.length === 2 ? shape[1] : shape[shape.length - 2];
+  if (bitmap.width !== width || bitmap.height !== rows) {
+    bitmap.close();
+    throw new Error(`${glb.name}: image ${index} is ${bitmap.width}x${bitmap.height}, its array needs ${width}x${rows}`);
+  }
   const rgba = readBitmap(gl, bitmap);
   const channels = shape.length === 2 ? 1 : shape[shape.length - 1];
   if (channels === 4) return rgba;
@@ -705,6 +726,7 @@ async function openInput(input, size) {
   document.getElementById("panels").appendChild(panel);
   try {
     const gl = createContext(canvas);
+    canvas.addEventListener("webglcontextlost", () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
     const plans = decodePlans(draw, await readArrays(gl, glb, draw));
