@@ -125,6 +125,9 @@ def test_a_drag_orbits(gl, browser, specs):
                            atol=1e-3) and query["size"] == ["128x128"]
         page.locator("canvas").press("ArrowUp")
         page.wait_for_function(f"window.reliefkit.view[1] > {el}")
+        if page.evaluate("!!document.querySelector('canvas').getContext('webgl2')"
+                         ".getExtension('EXT_disjoint_timer_query_webgl2')"):
+            page.wait_for_function("window.reliefkit.gpuMs > 0")  # the readout's GPU time
 
 
 def test_a_bad_view_in_the_url_is_said(gl, browser, specs):

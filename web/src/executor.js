@@ -36,6 +36,9 @@ export class Executor {
     this.vaos = new Map();
     this.textures = new Map();
     this.depthClamp = gl.getExtension('EXT_depth_clamp');
+    this.timer = gl.getExtension('EXT_disjoint_timer_query_webgl2'); // GPU time, where the browser has it
+    this.query = null;
+    this.gpuMs = null;
     this.present = this.link('present.glsl', sourcePair(PRESENT));
   }
 
@@ -138,7 +141,13 @@ export class Executor {
     gl.depthMask(true);
     for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
     gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    const timing = this.timer && !this.query;
+    if (timing) {
+      this.query = gl.createQuery();
+      gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
+    }
     for (const plan of plans) this.draw(plan, camera, light);
+    if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     this.setRaster({ depth_test: false, cull: 'none', blend: 'none', depth_write: false });
@@ -147,6 +156,18 @@ export class Executor {
     for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+
+  /** The GPU time of the latest timed frame's draws in ms (null until one is known): a timer
+   *  query's result becomes available only after the page has returned to the browser. */
+  gpuTime() {
+    const gl = this.gl;
+    if (this.query && gl.getQueryParameter(this.query, gl.QUERY_RESULT_AVAILABLE)) {
+      if (!gl.getParameter(this.timer.GPU_DISJOINT_EXT)) this.gpuMs = gl.getQueryParameter(this.query, gl.QUERY_RESULT) / 1e6;
+      gl.deleteQuery(this.query);
+      this.query = null;
+    }
+    return this.gpuMs;
   }
 
   /** Wait until the frame is drawn: a one-pixel read back (Chromium's gl.finish() returns

@@ -93,8 +93,14 @@ async function main() {
     for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start; // the CPU's clock around the draws and a read back
-    readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
-      + `frame ${state.frameMs.toFixed(1)} ms`;
+    const shown = () => {
+      const gpu = panels.map((p) => p.executor.gpuTime());
+      state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
+      readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
+        + `frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? '' : `, GPU ${state.gpuMs.toFixed(2)} ms`);
+    };
+    shown();
+    setTimeout(shown, 50); // the timer query's result, once the browser has it
     state.view = [az, el, dist];
     params.set('view', `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
     history.replaceState(null, '', `?${params}`); // the view stays in the URL

@@ -284,6 +284,9 @@ var Executor = class {
     this.vaos = /* @__PURE__ */ new Map();
     this.textures = /* @__PURE__ */ new Map();
     this.depthClamp = gl.getExtension("EXT_depth_clamp");
+    this.timer = gl.getExtension("EXT_disjoint_timer_query_webgl2");
+    this.query = null;
+    this.gpuMs = null;
     this.present = this.link("present.glsl", sourcePair(present_default));
   }
   /** Plans this executor draws as they are; throws `Unsupported` for the others. */
@@ -379,7 +382,13 @@ var Executor = class {
     gl.depthMask(true);
     for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
     gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    const timing = this.timer && !this.query;
+    if (timing) {
+      this.query = gl.createQuery();
+      gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
+    }
     for (const plan of plans) this.draw(plan, camera, light);
+    if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     this.setRaster({ depth_test: false, cull: "none", blend: "none", depth_write: false });
@@ -388,6 +397,17 @@ var Executor = class {
     for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+  /** The GPU time of the latest timed frame's draws in ms (null until one is known): a timer
+   *  query's result becomes available only after the page has returned to the browser. */
+  gpuTime() {
+    const gl = this.gl;
+    if (this.query && gl.getQueryParameter(this.query, gl.QUERY_RESULT_AVAILABLE)) {
+      if (!gl.getParameter(this.timer.GPU_DISJOINT_EXT)) this.gpuMs = gl.getQueryParameter(this.query, gl.QUERY_RESULT) / 1e6;
+      gl.deleteQuery(this.query);
+      this.query = null;
+    }
+    return this.gpuMs;
   }
   /** Wait until the frame is drawn: a one-pixel read back (Chromium's gl.finish() returns
    *  before the GPU process has drawn). */
@@ -769,7 +789,13 @@ async function main() {
     for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start;
-    readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms`;
+    const shown = () => {
+      const gpu = panels.map((p) => p.executor.gpuTime());
+      state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
+      readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? "" : `, GPU ${state.gpuMs.toFixed(2)} ms`);
+    };
+    shown();
+    setTimeout(shown, 50);
     state.view = [az, el, dist];
     params.set("view", `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
     history.replaceState(null, "", `?${params}`);
