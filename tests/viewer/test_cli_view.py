@@ -69,6 +69,8 @@ def test_bad_inputs_are_one_line():
     assert_one_line_error(run_cli("view", "no-such-file.obj", "--no-browser"), "no-such-file")
     assert_one_line_error(run_cli("view", "demo:cup", "--port", "70000"), "--port")
     assert_one_line_error(run_cli("view"), "INPUT")
+    assert_one_line_error(run_cli("view", "demo:cup", "--parallax-steps", "2"),
+                          "--parallax-steps applies to none of the inputs")
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()

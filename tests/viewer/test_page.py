@@ -20,7 +20,7 @@ from reliefkit.io.gltf.glb import glb_bytes, read_glb
 from reliefkit.render import render
 from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
 from reliefkit.scene.views import framing_bounds, orbit_bounds, parse_view
-from reliefkit.viewer.site import Input, load_inputs, site_files
+from reliefkit.viewer.site import Input, load_inputs, make_input, site_files
 
 SIZE = (128, 128)
 VIEWS = ("30,25", "-100,10", "160,50")
@@ -52,16 +52,16 @@ def specs(tmp_path_factory):
     return out
 
 
-def rendered(spec: str, view: str, bounds=None) -> np.ndarray:
-    """What `reliefkit render SPEC --view VIEW --size 128x128` writes, as RGBA8 (framed by
-    ``bounds`` instead of the input's own)."""
+def rendered(spec: str, view: str, bounds=None, **options) -> np.ndarray:
+    """What `reliefkit render SPEC --view VIEW --size 128x128 [OPTIONS]` writes, as RGBA8
+    (framed by ``bounds`` instead of the input's own)."""
     from reliefkit.io.inputs import load_input
 
     obj = load_input(spec)
     box = framing_bounds(obj) if bounds is None else bounds
     camera = orbit_bounds(box, *parse_view(view), SIZE)
     light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
-    return render(obj, camera, light=light).rgba8()
+    return render(obj, camera, light=light, **options).rgba8()
 
 
 def agreement(page: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
@@ -90,6 +90,20 @@ def test_the_page_draws_what_render_draws(gl, browser, specs, kind):
             assert iou >= 0.99 and within >= 0.99, (kind, view, iou, within)
             page.close()
         assert log == []
+
+
+def test_render_options_make_the_plans(gl, browser, specs):
+    from reliefkit.io.inputs import load_input
+
+    spec = specs["octahedral-impostor"]
+    options = {"parallax_steps": 0}  # the lookup where the ray crosses each frame's plane
+    with served(site_files([make_input(spec, load_input(spec), options)])) as (base, _):
+        page = open_page(browser, url(base, "-100,10"))
+        assert state(page)["errors"] == []
+        got = canvas_rgba(page)
+    iou, within = agreement(got, rendered(spec, "-100,10", **options))
+    assert iou >= 0.99 and within >= 0.99, (iou, within)
+    assert agreement(got, rendered(spec, "-100,10"))[1] < 0.99  # not the default's picture
 
 
 def test_several_inputs_side_by_side_share_one_camera(gl, browser, specs):
@@ -147,6 +161,19 @@ def test_what_the_page_cannot_draw_yet_is_said(gl, browser, tmp_path):
         shown = messages(page)
     assert shown and all("not supported by the viewer yet" in line for line in shown)
     assert any("not supported by the viewer yet" in line for line in log)
+
+
+def test_a_block_compressed_texture_is_said(gl, browser, tmp_path):
+    from reliefkit.compact.compact import CompressOptions, compress
+
+    made = sample("impostor", "octahedral-impostor")
+    save(tmp_path / "bc.rk", compress(made() if callable(made) else made,
+                                      CompressOptions(compress="bc")))
+    with served(site_files(load_inputs([str(tmp_path / "bc.rk")]))) as (base, _):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert len(shown) == 1 and "is block-compressed, which the viewer does not draw yet" \
+        in shown[0], shown
 
 
 def _glb_of_json(text: bytes) -> bytes:

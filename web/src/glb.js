@@ -59,20 +59,22 @@ export function drawOf(glb) {
   throw new Error(`${glb.name}: no RELIEFKIT_ extension (not exported by reliefkit)`);
 }
 
-/** Every named array of ``draw.arrays`` as {dtype, shape, data}; PNG images are decoded
- *  through ``gl`` so their bytes stay exact (no premultiplying, no colour conversion). */
+/** Every named array of ``draw.arrays`` as {dtype, shape, data} (plus ``encoding`` for a
+ *  texture stored as its blocks); PNG images are decoded through ``gl`` so their bytes stay
+ *  exact (no premultiplying, no colour conversion). */
 export async function readArrays(gl, glb, draw) {
   const out = {};
   for (const [name, ref] of Object.entries(draw.arrays)) {
     const Typed = TYPED[ref.dtype];
     if (!Typed || !Array.isArray(ref.shape)) throw new Error(`${glb.name}: array ${name} has no known dtype`);
-    if (ref.encoding) throw new Error(`${glb.name}: array ${name} is block-compressed, which the viewer does not draw yet`);
     const count = ref.shape.reduce((a, b) => a * b, 1);
     let data;
     if ('image' in ref) data = await pngValues(gl, glb, ref.image, ref.shape);
     else if ('bufferView' in ref) data = new Typed(viewBytes(glb, ref.bufferView, count * Typed.BYTES_PER_ELEMENT, name));
     else data = new Typed(count);
-    out[name] = { dtype: ref.dtype, shape: ref.shape, data };
+    // an encoded array is its stored blocks with the record that decodes them (docs/gltf.md)
+    out[name] = ref.encoding ? { dtype: ref.dtype, shape: ref.shape, data, encoding: ref.encoding }
+      : { dtype: ref.dtype, shape: ref.shape, data };
   }
   return out;
 }

@@ -11,7 +11,7 @@ const FORMATS = { // dtype -> [internal formats by channel count, format by chan
 const TARGETS = { '2d': 'TEXTURE_2D', '3d': 'TEXTURE_3D', '2d_array': 'TEXTURE_2D_ARRAY' };
 
 export function uploadTexture(gl, t) {
-  if (t.encoded) throw new Error(`${t.what}: block-compressed textures are not drawn by the viewer yet`);
+  if (t.encoded || t.array.encoding) throw new Error(`${t.what}: block-compressed textures are not drawn by the viewer yet`);
   const target = gl[TARGETS[t.target]];
   const levels = t.levels || [t.array];
   const { shape, dtype } = levels[0];

@@ -550,8 +550,19 @@ def cmd_view(args) -> int:
         raise UsageError(f"--port must be within 0..65535, got {args.port}")
     for spec in args.inputs:
         _check_not_empty(spec)
+    objects = [load_input(spec) for spec in args.inputs]
+    given = given_options(args)
+    declared = [{opt.name for opt in render_options(obj)} for obj in objects]
+    unused = sorted(set(given) - set().union(*declared))
+    if unused:
+        flags = ", ".join("--" + name.replace("_", "-") for name in unused)
+        raise UsageError(f"{flags} applies to none of the inputs")
     with waiting("exporting the inputs"):
-        files = view_site.site_files(view_site.load_inputs(args.inputs))
+        inputs = [view_site.make_input(spec, obj, applicable(
+            {k: v for k, v in given.items() if k in names}, render_options(obj),
+            what_it_is(spec, obj))) for spec, obj, names in zip(args.inputs, objects, declared,
+                                                                 strict=True)]
+        files = view_site.site_files(inputs)
     if args.export_html:
         paths = view_site.export_html(files, args.export_html)
         print(f"wrote {len(paths)} files into {args.export_html} (index.html: serve the folder, "

@@ -189,9 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
                    help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
                         "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
-    add_options(p, [("mesh", spec.option_list) for spec in core_drawables()]
-                 + [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
-                    for spec in t.drawables], "render options")
+    _add_render_options(p, core_drawables)
     p.set_defaults(run=cmd_render)
 
     p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",
@@ -260,7 +258,8 @@ def build_parser() -> argparse.ArgumentParser:
                  "Serve a page on 127.0.0.1 that draws each input's draw plans with the "
                  "GLSL ES sources of reliefkit's shaders in WebGL2, side by side from one "
                  "camera (?view=AZ,EL,DIST&size=WxH in its URL; drag to orbit, wheel to "
-                 "zoom); Ctrl-C stops it. docs/viewer.md.")
+                 "zoom), their plans made with the render options given (each to the "
+                 "inputs that declare it); Ctrl-C stops it. docs/viewer.md.")
     p.add_argument("inputs", nargs="+", metavar="INPUT",
                    help=".rk file, a .glb reliefkit wrote, a mesh file or demo:NAME")
     p.add_argument("--port", type=int, default=0, metavar="N",
@@ -269,6 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--export-html", metavar="DIR",
                    help="write the page, its bundle and the GLB files into DIR (viewable from "
                         "any static web server) instead of serving")
+    _add_render_options(p, core_drawables)
     p.set_defaults(run=cmd_view)
 
     names = suite_names()
@@ -298,6 +298,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
     p.set_defaults(run=cmd_demo)
     return parser
+
+
+def _add_render_options(p, core_drawables) -> None:
+    """Every drawable's render options as flags, each owner named in its help."""
+    add_options(p, [("mesh", spec.option_list) for spec in core_drawables()]
+                + [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
+                   for spec in t.drawables], "render options")
 
 
 def _add_bake_args(p: argparse.ArgumentParser, table: dict,

@@ -60,12 +60,13 @@ def fallback_of(rep, triangles: int) -> RenderMesh:
 def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
                         fallback_triangles: int = DEFAULT_FALLBACK_TRIANGLES,
                         embed_shaders: bool = False, source_hash: str | None = None,
-                        name: str | None = None) -> int:
+                        name: str | None = None, options: dict | None = None) -> int:
     """Add ``rep``'s node (extension, extras, the fallback as its child) to the builder's
-    document; the node's index."""
+    document; the node's index. ``options``: render options its draw plans are made with."""
     codec, arrays, params = rk.prepare(rep)
     extension = representation_extension(builder, codec, arrays, params)
-    extension["draw"] = draw_extension(builder, rep, embed_shaders=embed_shaders)
+    extension["draw"] = draw_extension(builder, rep, embed_shaders=embed_shaders,
+                                       options=options)
     ext_name = extension_name(codec.kind)
     report = rep.bake_report() if hasattr(rep, "bake_report") else []
     node = {"name": name or codec.kind, "extensions": {ext_name: extension},
@@ -128,9 +129,11 @@ def export(rep, path, *, fallback: bool = True,
     return write_document(path, builder, [root])
 
 
-def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False) -> bytes:
-    """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves)."""
+def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False,
+                 options: dict | None = None) -> bytes:
+    """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves),
+    its draw plans made with the render ``options`` it declares."""
     builder = _generated(GlbBuilder())
     _one_scene(builder, [representation_node(builder, rep, fallback=fallback,
-                                             embed_shaders=embed_shaders)])
+                                             embed_shaders=embed_shaders, options=options)])
     return builder.glb()

@@ -36,17 +36,19 @@ class Input:
 
 def load_inputs(specs) -> list[Input]:
     """Each input (``.rk``, a reliefkit ``.glb``, a mesh file, ``demo:NAME``) loaded and
-    exported in memory with its draw plans' GLSL ES sources (no fallback mesh: the page
-    draws the plans)."""
+    made an `Input` with its render defaults."""
     if not specs:
         raise UsageError("view needs at least one input")
-    out = []
-    for spec in specs:
-        obj = load_input(spec)
-        out.append(Input(str(spec), kind_of(obj), export_bytes(obj, fallback=False,
-                                                               embed_shaders=True),
-                         framing_bounds(obj).tolist()))
-    return out
+    return [make_input(spec, load_input(spec)) for spec in specs]
+
+
+def make_input(spec: str, obj, options: dict | None = None) -> Input:
+    """``obj`` (loaded from ``spec``) exported in memory with its draw plans, made with the
+    render ``options`` it declares (checked by the caller), and their GLSL ES sources; no
+    fallback mesh: the page draws the plans."""
+    return Input(str(spec), kind_of(obj), export_bytes(obj, fallback=False, embed_shaders=True,
+                                                       options=options),
+                 framing_bounds(obj).tolist())
 
 
 def manifest(inputs: list[Input]) -> dict:

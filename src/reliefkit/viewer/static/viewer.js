@@ -212,7 +212,7 @@ var FORMATS = {
 };
 var TARGETS = { "2d": "TEXTURE_2D", "3d": "TEXTURE_3D", "2d_array": "TEXTURE_2D_ARRAY" };
 function uploadTexture(gl, t) {
-  if (t.encoded) throw new Error(`${t.what}: block-compressed textures are not drawn by the viewer yet`);
+  if (t.encoded || t.array.encoding) throw new Error(`${t.what}: block-compressed textures are not drawn by the viewer yet`);
   const target = gl[TARGETS[t.target]];
   const levels = t.levels || [t.array];
   const { shape, dtype } = levels[0];
@@ -293,7 +293,7 @@ var Executor = class {
   check(plan) {
     if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
     if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
-    const encoded = Object.values(plan.textures).find((t) => t.encoded);
+    const encoded = Object.values(plan.textures).find((t) => t.encoded || (t.levels || [t.array]).some((a) => a.encoding));
     if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
     if (plan.render_pass !== "opaque") throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
     if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
@@ -643,13 +643,12 @@ async function readArrays(gl, glb, draw) {
   for (const [name, ref] of Object.entries(draw.arrays)) {
     const Typed = TYPED[ref.dtype];
     if (!Typed || !Array.isArray(ref.shape)) throw new Error(`${glb.name}: array ${name} has no known dtype`);
-    if (ref.encoding) throw new Error(`${glb.name}: array ${name} is block-compressed, which the viewer does not draw yet`);
     const count = ref.shape.reduce((a, b) => a * b, 1);
     let data;
     if ("image" in ref) data = await pngValues(gl, glb, ref.image, ref.shape);
     else if ("bufferView" in ref) data = new Typed(viewBytes(glb, ref.bufferView, count * Typed.BYTES_PER_ELEMENT, name));
     else data = new Typed(count);
-    out[name] = { dtype: ref.dtype, shape: ref.shape, data };
+    out[name] = ref.encoding ? { dtype: ref.dtype, shape: ref.shape, data, encoding: ref.encoding } : { dtype: ref.dtype, shape: ref.shape, data };
   }
   return out;
 }
