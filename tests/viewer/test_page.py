@@ -92,18 +92,31 @@ def test_the_page_draws_what_render_draws(gl, browser, specs, kind):
         assert log == []
 
 
-def test_render_options_make_the_plans(gl, browser, specs):
+@pytest.mark.parametrize("kind, options", [
+    ("octahedral-impostor", {"parallax_steps": 0}),  # each frame looked up on its plane
+    ("mesh", {"shadows": True}),                      # the shadow-map multi-pass kind
+    ("octahedral-impostor", {"shadows": True})])
+def test_render_options_make_the_plans(gl, browser, specs, kind, options):
     from reliefkit.io.inputs import load_input
 
-    spec = specs["octahedral-impostor"]
-    options = {"parallax_steps": 0}  # the lookup where the ray crosses each frame's plane
+    spec = specs[kind]
     with served(site_files([make_input(spec, load_input(spec), options)])) as (base, _):
-        page = open_page(browser, url(base, "-100,10"))
-        assert state(page)["errors"] == []
-        got = canvas_rgba(page)
-    iou, within = agreement(got, rendered(spec, "-100,10", **options))
-    assert iou >= 0.99 and within >= 0.99, (iou, within)
-    assert agreement(got, rendered(spec, "-100,10"))[1] < 0.99  # not the default's picture
+        for view in VIEWS:
+            page = open_page(browser, url(base, view))
+            assert state(page)["errors"] == []
+            got = canvas_rgba(page)
+            iou, within = agreement(got, rendered(spec, view, **options))
+            print(f"{kind} {options} {view}: mask IoU {iou:.4f}, {within:.2%} within 4/255")
+            assert iou >= 0.99 and within >= 0.99, (view, iou, within)
+            page.close()
+    # nearer the options' picture than the defaults'
+    assert _mean_difference(got, rendered(spec, view, **options)) < \
+        _mean_difference(got, rendered(spec, view))
+
+
+def _mean_difference(page: np.ndarray, reference: np.ndarray) -> float:
+    both = (page[..., 3] > 0) & (reference[..., 3] > 0)
+    return float(np.abs(page[..., :3].astype(int) - reference[..., :3].astype(int))[both].mean())
 
 
 def test_several_inputs_side_by_side_share_one_camera(gl, browser, specs):

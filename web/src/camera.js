@@ -55,6 +55,30 @@ export function perspective(fovDeg, aspect, near, far) {
   return p;
 }
 
+export function orthographic(halfHeight, aspect, near, far) {
+  const p = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+  p[0] = 1 / (halfHeight * aspect);
+  p[5] = 1 / halfHeight;
+  p[10] = -2 / (far - near);
+  p[11] = -(far + near) / (far - near);
+  return p;
+}
+
+/** The light's orthographic camera over ``bounds`` (render/shadows.py light_camera). */
+export function lightCamera(bounds, direction, size) {
+  const [lo, hi] = bounds;
+  const centre = [0, 1, 2].map((i) => (lo[i] + hi[i]) / 2);
+  const radius = norm(sub(hi, lo)) / 2 || 1;
+  const towards = scale(direction, 1 / norm(direction));
+  const up = Math.abs(towards[1]) > 0.99 ? [1, 0, 0] : [0, 1, 0];
+  const eye = centre.map((c, i) => c + 2 * radius * towards[i]);
+  const [near, far] = [0.5 * radius, 3.5 * radius];
+  return {
+    eye, target: centre, up, fov_deg: 40, size: [size, size], near, far, ortho_height: radius, origin: centre,
+    view: lookAt(eye, centre, up), proj: orthographic(radius, 1, near, far),
+  };
+}
+
 /** The camera orbiting ``bounds``' centre (scene.views.orbit_bounds); ``frame`` holds the
  *  page's copies of the Python constants (fov, fit margin). */
 export function orbitBounds(bounds, az, el, dist, size, frame) {
@@ -86,7 +110,7 @@ export function cameraUniforms(camera) {
   return {
     u_view: matrix(view), u_proj: matrix(camera.proj),
     u_inv_view_proj: matrix(invert(multiply(camera.proj, view))),
-    u_eye: sub(camera.eye, origin), u_orthographic: false,
+    u_eye: sub(camera.eye, origin), u_orthographic: camera.ortho_height != null,
     u_view_dir: scale(toEye, 1 / norm(toEye)), u_viewport: camera.size,
   };
 }
@@ -105,7 +129,7 @@ export function lightFrom(fields, az, el) {
 }
 
 /** A row-major 4x4 as a plan's (4, 4) array: uniforms transpose it, as gl/uniforms.py does. */
-function matrix(rows) {
+export function matrix(rows) {
   return { shape: [4, 4], dtype: 'float64', data: rows };
 }
 
@@ -113,7 +137,7 @@ function identity() {
   return [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
 }
 
-function translation(t) {
+export function translation(t) {
   const m = identity();
   [m[3], m[7], m[11]] = t;
   return m;

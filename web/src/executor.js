@@ -6,12 +6,17 @@
 
 import { cameraUniforms, modelOffset } from './camera.js';
 import { programKey, withView } from './plans.js';
+import { drawShadowMapped } from './shadow_map.js';
 import { uploadTexture } from './textures.js';
 import PRESENT from './present.glsl';
 
 const FRAME_ATTACHMENTS = 3;
 const MODES = { triangles: 'TRIANGLES', points: 'POINTS', lines: 'LINES', triangle_strip: 'TRIANGLE_STRIP' };
 const BLEND = { under: ['ONE_MINUS_DST_ALPHA', 'ONE'], add: ['ONE', 'ONE'] };
+
+/** Multi-pass kinds (render/executor.py MULTIPASS): ``kind(executor, viewed plan, camera,
+ *  light, outer)``, where ``outer()`` binds the frame's target again after a pass of its own. */
+const MULTIPASS = { 'shadow-map': drawShadowMapped };
 
 /** A plan this executor cannot draw yet, named in a user's words. */
 export class Unsupported extends Error {}
@@ -35,6 +40,8 @@ export class Executor {
     this.buffers = new Map(); // geometry key -> {attribute name or 'indices': {buffer, source}}
     this.vaos = new Map();
     this.textures = new Map();
+    this.groups = new Map(); // geometry key -> its multi-pass plans (a shadow map's casters)
+    this.cache = new Map();  // a multi-pass kind's per-light products
     this.depthClamp = gl.getExtension('EXT_depth_clamp');
     this.timer = gl.getExtension('EXT_disjoint_timer_query_webgl2'); // GPU time, where the browser has it
     this.query = null;
@@ -42,10 +49,21 @@ export class Executor {
     this.present = this.link('present.glsl', sourcePair(PRESENT));
   }
 
-  /** Plans this executor draws as they are; throws `Unsupported` for the others. */
+  /** Take ``plan`` to draw (its programs compiled); throws `Unsupported` for one it cannot
+   *  draw yet, or an Error (a shader that does not compile). */
+  add(plan) {
+    this.check(plan);
+    this.program(plan.program);
+    if (plan.multipass) {
+      for (const role of Object.values(plan.multipass.programs)) this.program({ name: role[0], defines: role[1] });
+      if (!this.groups.has(plan.geometry.key)) this.groups.set(plan.geometry.key, []);
+      this.groups.get(plan.geometry.key).push(plan);
+    }
+  }
+
   check(plan) {
     if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
-    if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
+    if (plan.multipass && !MULTIPASS[plan.multipass.kind]) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
     const encoded = Object.values(plan.textures).find((t) => t.encoded || (t.levels || [t.array]).some((a) => a.encoding));
     if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
     if (plan.render_pass !== 'opaque') throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
@@ -141,12 +159,16 @@ export class Executor {
     gl.depthMask(true);
     for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
     gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    const outer = () => {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
+      gl.viewport(0, 0, w, h);
+    };
     const timing = this.timer && !this.query;
     if (timing) {
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }
-    for (const plan of plans) this.draw(plan, camera, light);
+    for (const plan of plans) this.draw(plan, camera, light, outer);
     if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
@@ -193,17 +215,25 @@ export class Executor {
     return viewed;
   }
 
-  draw(source, camera, light) {
-    const gl = this.gl;
+  /** Draw ``source`` from ``camera``: its view, then one draw or its multi-pass kind. */
+  draw(source, camera, light, outer) {
     const plan = this.view(source, camera, light);
     if (plan.count === 0) return; // switched off from this view
-    const linked = this.program(plan.program);
+    if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer);
+    else this.drawViewed(plan, camera, light);
+  }
+
+  /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
+   *  ``raster``, ``uniforms`` and ``textures`` replace or add to the plan's. */
+  drawViewed(plan, camera, light, { program, raster, uniforms = {}, textures = {} } = {}) {
+    const gl = this.gl;
+    const linked = this.program(program ? { name: program[0], defines: program[1] } : plan.program);
     const vao = this.vertexArray(linked, plan.geometry);
     gl.useProgram(linked.prog);
-    const samplers = this.bindTextures(plan.textures);
-    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light.uniforms, ...plan.uniforms, ...samplers };
+    const samplers = this.bindTextures({ ...plan.textures, ...textures });
+    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light.uniforms, ...plan.uniforms, ...uniforms, ...samplers };
     for (const [name, value] of Object.entries(values)) setUniform(gl, linked, name, value);
-    this.setRaster(plan.raster);
+    this.setRaster(raster || plan.raster);
     gl.bindVertexArray(vao);
     const { mode, count, first, instances, indexed } = counts(gl, plan);
     if (indexed && instances != null) gl.drawElementsInstanced(mode, count, gl.UNSIGNED_INT, first * 4, instances);

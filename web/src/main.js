@@ -55,8 +55,7 @@ async function openInput(input, size) {
     const drawn = [];
     for (const plan of plans) {
       try {
-        executor.check(plan);
-        executor.program(plan.program);
+        executor.add(plan);
         drawn.push(plan);
       } catch (e) {
         if (!(e instanceof Unsupported)) throw e;

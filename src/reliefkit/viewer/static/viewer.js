@@ -43,6 +43,36 @@ function perspective(fovDeg, aspect, near, far) {
   p[14] = -1;
   return p;
 }
+function orthographic(halfHeight, aspect, near, far) {
+  const p = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+  p[0] = 1 / (halfHeight * aspect);
+  p[5] = 1 / halfHeight;
+  p[10] = -2 / (far - near);
+  p[11] = -(far + near) / (far - near);
+  return p;
+}
+function lightCamera(bounds, direction, size) {
+  const [lo, hi] = bounds;
+  const centre = [0, 1, 2].map((i) => (lo[i] + hi[i]) / 2);
+  const radius = norm(sub(hi, lo)) / 2 || 1;
+  const towards = scale(direction, 1 / norm(direction));
+  const up = Math.abs(towards[1]) > 0.99 ? [1, 0, 0] : [0, 1, 0];
+  const eye = centre.map((c, i) => c + 2 * radius * towards[i]);
+  const [near, far] = [0.5 * radius, 3.5 * radius];
+  return {
+    eye,
+    target: centre,
+    up,
+    fov_deg: 40,
+    size: [size, size],
+    near,
+    far,
+    ortho_height: radius,
+    origin: centre,
+    view: lookAt(eye, centre, up),
+    proj: orthographic(radius, 1, near, far)
+  };
+}
 function orbitBounds(bounds, az, el, dist, size, frame) {
   const [w, h] = size;
   if (dist === null) {
@@ -82,7 +112,7 @@ function cameraUniforms(camera) {
     u_proj: matrix(camera.proj),
     u_inv_view_proj: matrix(invert(multiply(camera.proj, view))),
     u_eye: sub(camera.eye, origin),
-    u_orthographic: false,
+    u_orthographic: camera.ortho_height != null,
     u_view_dir: scale(toEye, 1 / norm(toEye)),
     u_viewport: camera.size
   };
@@ -202,6 +232,58 @@ function withView(plan, update) {
   };
 }
 
+// web/src/shadow_map.js
+function drawShadowMapped(executor, plan, camera, light, outer) {
+  const [uniforms, textures] = shadowInputs(executor, plan, light, outer);
+  executor.drawViewed(plan, camera, light, { uniforms, textures });
+}
+function shadowInputs(executor, plan, light, outer) {
+  const params = plan.multipass.params;
+  const key = `shadow-map ${plan.geometry.key} ${light.direction.join(",")}`;
+  if (!executor.cache.has(key)) {
+    const gl = executor.gl;
+    const size = Number(params.size);
+    const bounds = nested(params.bounds);
+    const cam = lightCamera(bounds, light.direction, size);
+    const depth = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, depth);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.DEPTH_COMPONENT32F, size, size, 0, gl.DEPTH_COMPONENT, gl.FLOAT, null);
+    const fbo = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.TEXTURE_2D, depth, 0);
+    gl.drawBuffers([gl.NONE]);
+    gl.viewport(0, 0, size, size);
+    gl.depthMask(true);
+    gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    const raster = { depth_test: true, depth_write: true, cull: params.cull || "none", blend: "none" };
+    for (const caster of executor.groups.get(plan.geometry.key) || [plan]) {
+      const viewed = params.caster_hooks === false ? caster : executor.view(caster, cam, light);
+      executor.drawViewed(viewed, cam, light, { program: caster.multipass.programs.caster, raster });
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.deleteFramebuffer(fbo);
+    outer();
+    gl.bindTexture(gl.TEXTURE_2D, depth);
+    const compare = (params.sampler || "compare") === "compare";
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_COMPARE_MODE, compare ? gl.COMPARE_REF_TO_TEXTURE : gl.NONE);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_COMPARE_FUNC, gl.LEQUAL);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, compare ? gl.LINEAR : gl.NEAREST);
+    for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
+    const texel = 2 * cam.ortho_height / size;
+    const uniforms = {
+      u_light_matrix: matrix(multiply(multiply(cam.proj, cam.view), translation(plan.origin || [0, 0, 0]))),
+      u_shadow_texel: texel,
+      u_shadow_bias: "bias" in params ? Number(params.bias) : texel / (cam.far - cam.near)
+    };
+    executor.cache.set(key, [uniforms, { u_shadow_map: { tex: depth, target: gl.TEXTURE_2D } }]);
+  }
+  return executor.cache.get(key);
+}
+function nested(box) {
+  if (box && box.data) return [Array.from(box.data.slice(0, 3), Number), Array.from(box.data.slice(3, 6), Number)];
+  return box;
+}
+
 // web/src/textures.js
 var FORMATS = {
   // dtype -> [internal formats by channel count, format by channel count, type]
@@ -263,6 +345,7 @@ var present_default = "#version 300 es\n// The picture `reliefkit render` writes
 var FRAME_ATTACHMENTS = 3;
 var MODES = { triangles: "TRIANGLES", points: "POINTS", lines: "LINES", triangle_strip: "TRIANGLE_STRIP" };
 var BLEND = { under: ["ONE_MINUS_DST_ALPHA", "ONE"], add: ["ONE", "ONE"] };
+var MULTIPASS = { "shadow-map": drawShadowMapped };
 var Unsupported = class extends Error {
 };
 function createContext(canvas) {
@@ -283,16 +366,28 @@ var Executor = class {
     this.buffers = /* @__PURE__ */ new Map();
     this.vaos = /* @__PURE__ */ new Map();
     this.textures = /* @__PURE__ */ new Map();
+    this.groups = /* @__PURE__ */ new Map();
+    this.cache = /* @__PURE__ */ new Map();
     this.depthClamp = gl.getExtension("EXT_depth_clamp");
     this.timer = gl.getExtension("EXT_disjoint_timer_query_webgl2");
     this.query = null;
     this.gpuMs = null;
     this.present = this.link("present.glsl", sourcePair(present_default));
   }
-  /** Plans this executor draws as they are; throws `Unsupported` for the others. */
+  /** Take ``plan`` to draw (its programs compiled); throws `Unsupported` for one it cannot
+   *  draw yet, or an Error (a shader that does not compile). */
+  add(plan) {
+    this.check(plan);
+    this.program(plan.program);
+    if (plan.multipass) {
+      for (const role of Object.values(plan.multipass.programs)) this.program({ name: role[0], defines: role[1] });
+      if (!this.groups.has(plan.geometry.key)) this.groups.set(plan.geometry.key, []);
+      this.groups.get(plan.geometry.key).push(plan);
+    }
+  }
   check(plan) {
     if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
-    if (plan.multipass) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
+    if (plan.multipass && !MULTIPASS[plan.multipass.kind]) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
     const encoded = Object.values(plan.textures).find((t) => t.encoded || (t.levels || [t.array]).some((a) => a.encoding));
     if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
     if (plan.render_pass !== "opaque") throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
@@ -382,12 +477,16 @@ var Executor = class {
     gl.depthMask(true);
     for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
     gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    const outer = () => {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
+      gl.viewport(0, 0, w, h);
+    };
     const timing = this.timer && !this.query;
     if (timing) {
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }
-    for (const plan of plans) this.draw(plan, camera, light);
+    for (const plan of plans) this.draw(plan, camera, light, outer);
     if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
@@ -430,17 +529,24 @@ var Executor = class {
     }
     return viewed;
   }
-  draw(source, camera, light) {
-    const gl = this.gl;
+  /** Draw ``source`` from ``camera``: its view, then one draw or its multi-pass kind. */
+  draw(source, camera, light, outer) {
     const plan = this.view(source, camera, light);
     if (plan.count === 0) return;
-    const linked = this.program(plan.program);
+    if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer);
+    else this.drawViewed(plan, camera, light);
+  }
+  /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
+   *  ``raster``, ``uniforms`` and ``textures`` replace or add to the plan's. */
+  drawViewed(plan, camera, light, { program, raster, uniforms = {}, textures = {} } = {}) {
+    const gl = this.gl;
+    const linked = this.program(program ? { name: program[0], defines: program[1] } : plan.program);
     const vao = this.vertexArray(linked, plan.geometry);
     gl.useProgram(linked.prog);
-    const samplers = this.bindTextures(plan.textures);
-    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light.uniforms, ...plan.uniforms, ...samplers };
+    const samplers = this.bindTextures({ ...plan.textures, ...textures });
+    const values = { ...cameraUniforms(camera), ...modelOffset(camera, plan.origin), ...light.uniforms, ...plan.uniforms, ...uniforms, ...samplers };
     for (const [name, value] of Object.entries(values)) setUniform(gl, linked, name, value);
-    this.setRaster(plan.raster);
+    this.setRaster(raster || plan.raster);
     gl.bindVertexArray(vao);
     const { mode, count, first, instances, indexed } = counts(gl, plan);
     if (indexed && instances != null) gl.drawElementsInstanced(mode, count, gl.UNSIGNED_INT, first * 4, instances);
@@ -753,8 +859,7 @@ async function openInput(input, size) {
     const drawn = [];
     for (const plan of plans) {
       try {
-        executor.check(plan);
-        executor.program(plan.program);
+        executor.add(plan);
         drawn.push(plan);
       } catch (e) {
         if (!(e instanceof Unsupported)) throw e;
