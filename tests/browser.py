@@ -19,9 +19,12 @@ import numpy as np
 import pytest
 
 CHROMIUM = "/usr/bin/chromium"
-# SwiftShader's WebGL2 through ANGLE, headless, on a closed network (ecosystem notes)
-FLAGS = ["--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-         "--disable-background-networking", "--disable-component-update"]
+# headless, on a closed network (ecosystem notes), with WebGL2 through ANGLE on SwiftShader
+# or on Mesa's llvmpipe (what `reliefkit render` draws with here; blocklisted without the flag)
+FLAGS = ["--headless=new", "--no-sandbox", "--disable-background-networking",
+         "--disable-component-update"]
+BACKENDS = {"swiftshader": ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"],
+            "mesa": ["--use-angle=gl-egl", "--ignore-gpu-blocklist"]}
 READY_TIMEOUT_MS = 120_000
 
 
@@ -32,17 +35,29 @@ def unavailable(reason: str):
 
 
 @contextmanager
-def chromium():
-    """A headless Chromium (Playwright's Browser)."""
+def playwright():
+    """Playwright's sync API, once per test module (it runs one instance at a time)."""
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:
         unavailable("playwright is not installed (pip install playwright)")
+    with sync_playwright() as p:
+        yield p
+
+
+def launch(p, backend: str = "swiftshader"):
+    """A headless Chromium (Playwright's Browser) drawing WebGL2 with ``backend``."""
     path = shutil.which("chromium") or (CHROMIUM if os.path.exists(CHROMIUM) else None)
     if path is None:
         unavailable("chromium is not installed (apt-get install chromium)")
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=path, args=FLAGS)
+    return p.chromium.launch(executable_path=path, args=FLAGS + BACKENDS[backend])
+
+
+@contextmanager
+def chromium(backend: str = "swiftshader"):
+    """A headless Chromium of its own, closed at the end."""
+    with playwright() as p:
+        browser = launch(p, backend)
         try:
             yield browser
         finally:
