@@ -116,7 +116,8 @@ def test_the_page_draws_what_render_draws(gl, browser, specs, kind):
     # an opaque shell on SwiftShader: IoU 0.998-0.999 but 98.5-99.4% within 4/255, isolated
     # pixels where its 3D textures' filtering decides the first dense sample differently;
     # on Mesa's llvmpipe (what render draws with) every pixel is within 1/255
-    ("shell-volume", {"composite": "opaque"}, "mesa")])
+    ("shell-volume", {"composite": "opaque"}, "mesa"),
+    ("shell-volume", {"composite": "opaque", "shadows": True}, "mesa")])  # depth sampler, culled
 def test_render_options_make_the_plans(gl, browser, mesa_browser, specs, kind, options,
                                        backend):
     from reliefkit.io.inputs import load_input
