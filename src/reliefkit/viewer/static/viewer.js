@@ -590,7 +590,13 @@ var Executor = class {
     } else gl.disable(gl.BLEND);
   }
 };
+var MAX_TARGET_BYTES = 1 << 30;
 function createTargets(gl, [w, h]) {
+  const side = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+  const bytes = w * h * (FRAME_ATTACHMENTS * 16 + 4);
+  if (w > side || h > side || bytes > MAX_TARGET_BYTES) {
+    throw new Error(`a ${w}x${h} frame needs ${Math.ceil(bytes / 2 ** 20)} MiB of float render targets (limits: ${side} texels a side, ${MAX_TARGET_BYTES / 2 ** 20} MiB): ask for a smaller size`);
+  }
   const make = (internal, format, type, attachment) => {
     const tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, tex);
