@@ -544,25 +544,16 @@ def cmd_demo(args) -> int:
 
 
 
-
 def cmd_view(args) -> int:
     if not 0 <= args.port <= 65535:
         raise UsageError(f"--port must be within 0..65535, got {args.port}")
     for spec in args.inputs:
         _check_not_empty(spec)
     objects = [load_input(spec) for spec in args.inputs]
-    given = given_options(args)
-    declared = [{opt.name for opt in render_options(obj)} for obj in objects]
-    unused = sorted(set(given) - set().union(*declared))
-    if unused:
-        flags = ", ".join("--" + name.replace("_", "-") for name in unused)
-        raise UsageError(f"{flags} applies to none of the inputs")
+    routed = _routed_options(given_options(args), args.inputs, objects)
     with waiting("exporting the inputs"):
-        inputs = [view_site.make_input(spec, obj, applicable(
-            {k: v for k, v in given.items() if k in names}, render_options(obj),
-            what_it_is(spec, obj))) for spec, obj, names in zip(args.inputs, objects, declared,
-                                                                 strict=True)]
-        files = view_site.site_files(inputs)
+        files = view_site.site_files([view_site.make_input(spec, obj, options) for spec, obj,
+                                      options in zip(args.inputs, objects, routed, strict=True)])
     if args.export_html:
         paths = view_site.export_html(files, args.export_html)
         print(f"wrote {len(paths)} files into {args.export_html} (index.html: serve the folder, "
@@ -570,3 +561,16 @@ def cmd_view(args) -> int:
         return 0
     view_server.serve(files, args.port, open_browser=not args.no_browser)
     return 0
+
+
+def _routed_options(given: dict, specs, objects) -> list[dict]:
+    """The render options each input gets: those of ``given`` it declares, checked; one that
+    no input declares is an error (as `render` routes them to several drawables)."""
+    declared = [{opt.name for opt in render_options(obj)} for obj in objects]
+    unused = sorted(set(given) - set().union(*declared))
+    if unused:
+        flags = ", ".join("--" + name.replace("_", "-") for name in unused)
+        raise UsageError(f"{flags} applies to none of the inputs")
+    return [applicable({k: v for k, v in given.items() if k in names}, render_options(obj),
+                       what_it_is(spec, obj))
+            for spec, obj, names in zip(specs, objects, declared, strict=True)]
