@@ -185,12 +185,12 @@ def test_a_bad_view_in_the_url_is_said(gl, browser, specs):
     with served(site_files(load_inputs([specs["mesh"]]))) as (base, log):
         page = open_page(browser, f"{base}?view=30")
         shown = messages(page)
-        huge = open_page(browser, f"{base}?size=5000x5000")  # 5000² x 52 bytes of targets
+        huge = open_page(browser, f"{base}?size=5000x5000")  # 5000² x 132 bytes of targets
         refused = messages(huge)
     assert shown == ["error: view must be AZ,EL or AZ,EL,DIST with |EL| < 90 (e.g. 30,25,2.6), "
                      "got '30'"]
     assert log[0] == "page: " + shown[0]
-    assert len(refused) == 1 and "a 5000x5000 frame needs 1240 MiB" in refused[0], refused
+    assert len(refused) == 1 and "a 5000x5000 frame needs 3148 MiB" in refused[0], refused
 
 
 def test_what_the_page_cannot_draw_yet_is_said(gl, browser, tmp_path):

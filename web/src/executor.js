@@ -6,8 +6,9 @@
 
 import { cameraUniforms, modelOffset } from './camera.js';
 import { programKey, withView } from './plans.js';
-import { drawShadowMapped } from './shadow_map.js';
+import { drawShadowMapped, shadowInputs } from './shadow_map.js';
 import { uploadTexture } from './textures.js';
+import COPY_DEPTH from './copy_depth.glsl';
 import PRESENT from './present.glsl';
 
 const FRAME_ATTACHMENTS = 3;
@@ -16,7 +17,8 @@ const BLEND = { under: ['ONE_MINUS_DST_ALPHA', 'ONE'], add: ['ONE', 'ONE'] };
 
 /** Multi-pass kinds (render/executor.py MULTIPASS): ``kind(executor, viewed plan, camera,
  *  light, outer)``, where ``outer()`` binds the frame's target again after a pass of its own. */
-const MULTIPASS = { 'shadow-map': drawShadowMapped };
+const MULTIPASS = { 'shadow-map': drawShadowMapped, 'opaque-depth': drawWithOpaqueDepth };
+const FRONT_OPACITY_UNIT = 15; // gl/targets.py: drawables use the low units
 
 /** A plan this executor cannot draw yet, named in a user's words. */
 export class Unsupported extends Error {}
@@ -47,6 +49,7 @@ export class Executor {
     this.query = null;
     this.gpuMs = null;
     this.present = this.link('present.glsl', sourcePair(PRESENT));
+    this.copyDepth = this.link('copy_depth.glsl', sourcePair(COPY_DEPTH));
   }
 
   /** Take ``plan`` to draw (its programs compiled); throws `Unsupported` for one it cannot
@@ -66,7 +69,6 @@ export class Executor {
     if (plan.multipass && !MULTIPASS[plan.multipass.kind]) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
     const encoded = Object.values(plan.textures).find((t) => t.encoded || (t.levels || [t.array]).some((a) => a.encoding));
     if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
-    if (plan.render_pass !== 'opaque') throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
     if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
   }
 
@@ -150,31 +152,42 @@ export class Executor {
     return this.textures.get(t);
   }
 
-  /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas. */
+  /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas: the
+   *  opaque pass, then the transparent plans front to back (gl/targets.py draw_passes). */
   frame(plans, camera, light, targets) {
     const gl = this.gl;
     const [w, h] = camera.size;
-    gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
-    gl.viewport(0, 0, w, h);
-    gl.depthMask(true);
-    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
-    gl.clearBufferfv(gl.DEPTH, 0, [1]);
-    const outer = () => {
-      gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
+    const pass = (fbo) => () => {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
       gl.viewport(0, 0, w, h);
     };
+    const opaque = pass(targets.fbo);
+    const transparent = pass(targets.transparentFbo);
     const timing = this.timer && !this.query;
     if (timing) {
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }
-    for (const plan of plans) this.draw(plan, camera, light, outer);
+    opaque();
+    gl.depthMask(true);
+    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    for (const plan of plans.filter((p) => p.render_pass === 'opaque')) this.draw(plan, camera, light, opaque);
+    transparent();
+    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    // one drawable per canvas: nothing is in front of it (u_front_opacity stays zero)
+    const front = { u_front_opacity: FRONT_OPACITY_UNIT };
+    gl.activeTexture(gl.TEXTURE0 + FRONT_OPACITY_UNIT);
+    gl.bindTexture(gl.TEXTURE_2D, targets.frontOpacity.tex);
+    for (const plan of plans.filter((p) => p.render_pass === 'transparent')) {
+      this.draw(plan, camera, light, transparent, { uniforms: front, targets });
+    }
     if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     this.setRaster({ depth_test: false, cull: 'none', blend: 'none', depth_write: false });
     gl.useProgram(this.present.prog);
-    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position });
+    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position, u_transparent: targets.transparent });
     for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
@@ -215,12 +228,23 @@ export class Executor {
     return viewed;
   }
 
-  /** Draw ``source`` from ``camera``: its view, then one draw or its multi-pass kind. */
-  draw(source, camera, light, outer) {
+  /** Draw ``source`` from ``camera``: its view, then one draw or its multi-pass kind;
+   *  ``extra`` (uniforms, the frame's targets) goes to both. */
+  draw(source, camera, light, outer, extra = {}) {
     const plan = this.view(source, camera, light);
     if (plan.count === 0) return; // switched off from this view
-    if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer);
-    else this.drawViewed(plan, camera, light);
+    if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer, extra);
+    else this.drawViewed(plan, camera, light, extra);
+  }
+
+  /** A full-screen triangle drawn with ``linked`` and ``textures`` (a pass of a kind). */
+  drawFullScreen(linked, textures) {
+    const gl = this.gl;
+    this.setRaster({ depth_test: false, cull: 'none', blend: 'none', depth_write: false });
+    gl.useProgram(linked.prog);
+    for (const [name, value] of Object.entries(this.bindTextures(textures))) setUniform(gl, linked, name, value);
+    gl.bindVertexArray(null);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
 
   /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
@@ -286,7 +310,8 @@ const MAX_TARGET_BYTES = 1 << 30; // the float AOV targets of one canvas
 /** The AOV targets of a WxH frame (gl/targets.py render_target), sizes checked first. */
 export function createTargets(gl, [w, h]) {
   const side = gl.getParameter(gl.MAX_TEXTURE_SIZE);
-  const bytes = w * h * (FRAME_ATTACHMENTS * 16 + 4);
+  // RGBA32F: both passes' attachments, the depth copy and the front opacity; float depth
+  const bytes = w * h * ((2 * FRAME_ATTACHMENTS + 2) * 16 + 4);
   if (w > side || h > side || bytes > MAX_TARGET_BYTES) {
     throw new Error(`a ${w}x${h} frame needs ${Math.ceil(bytes / 2 ** 20)} MiB of float render targets `
       + `(limits: ${side} texels a side, ${MAX_TARGET_BYTES / 2 ** 20} MiB): ask for a smaller size`);
@@ -299,16 +324,58 @@ export function createTargets(gl, [w, h]) {
     gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
     return { tex, target: gl.TEXTURE_2D };
   };
-  const fbo = gl.createFramebuffer();
-  gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
   const attachments = [...Array(FRAME_ATTACHMENTS).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
-  const [color, position] = attachments.map((a) => make(gl.RGBA32F, gl.RGBA, gl.FLOAT, a));
-  make(gl.DEPTH_COMPONENT32F, gl.DEPTH_COMPONENT, gl.FLOAT, gl.DEPTH_ATTACHMENT);
-  gl.drawBuffers(attachments);
-  const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+  const framebuffer = (colors, depth) => {
+    const fbo = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+    const made = colors.map((a) => make(gl.RGBA32F, gl.RGBA, gl.FLOAT, a));
+    if (depth) gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.TEXTURE_2D, depth.tex, 0);
+    gl.drawBuffers(colors);
+    const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`the ${w}x${h} float render targets are incomplete (status 0x${status.toString(16)})`);
+    return [fbo, made];
+  };
+  const depth = (() => {
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.DEPTH_COMPONENT32F, w, h, 0, gl.DEPTH_COMPONENT, gl.FLOAT, null);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+    return { tex, target: gl.TEXTURE_2D };
+  })();
+  const [fbo, [color, position]] = framebuffer(attachments, depth);
+  // the transparent pass shares the opaque depth (tested, never written)
+  const [transparentFbo, [transparent]] = framebuffer(attachments, depth);
+  const [depthCopyFbo, [depthCopy]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
+  const [frontFbo, [frontOpacity]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, frontFbo);
+  gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-  if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`the ${w}x${h} float render targets are incomplete (status 0x${status.toString(16)})`);
-  return { fbo, color, position };
+  return { fbo, color, position, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h] };
+}
+
+/** The "opaque-depth" kind (render/multipass/opaque_depth.py): a transparent plan drawn once,
+ *  sampling a copy of the opaque depth (``u_opaque_depth``; ``u_clip_opaque``: whether any
+ *  opaque surface was drawn), lit by the light's shadow map when its params ask for one. */
+function drawWithOpaqueDepth(executor, plan, camera, light, outer, extra) {
+  const [uniforms, textures] = opaqueDepthInputs(executor, plan, light, outer, extra.targets);
+  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
+}
+
+function opaqueDepthInputs(executor, plan, light, outer, targets) {
+  const gl = executor.gl;
+  const [w, h] = targets.size;
+  let [uniforms, textures] = [{}, {}];
+  if (plan.multipass.params.shadow_map) {
+    [uniforms, textures] = shadowInputs(executor, plan, light, outer, plan.multipass.params.shadow_map);
+  }
+  gl.bindFramebuffer(gl.FRAMEBUFFER, targets.depthCopyFbo);
+  gl.viewport(0, 0, w, h);
+  executor.drawFullScreen(executor.copyDepth, { u_depth: targets.depth });
+  const depth = new Float32Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, depth);
+  outer();
+  return [{ ...uniforms, u_clip_opaque: depth.some((z) => z < 1) }, { ...textures, u_opaque_depth: targets.depthCopy }];
 }
 
 /** render/executor.py _counts. */

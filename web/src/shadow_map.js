@@ -6,13 +6,14 @@
 import { lightCamera, matrix, multiply, translation } from './camera.js';
 
 /** Draw ``plan`` shadow-mapped; ``outer`` rebinds the frame's target after the depth pass. */
-export function drawShadowMapped(executor, plan, camera, light, outer) {
+export function drawShadowMapped(executor, plan, camera, light, outer, extra = {}) {
   const [uniforms, textures] = shadowInputs(executor, plan, light, outer);
-  executor.drawViewed(plan, camera, light, { uniforms, textures });
+  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
 }
 
-function shadowInputs(executor, plan, light, outer) {
-  const params = plan.multipass.params;
+/** The uniforms and the texture (``u_shadow_map``) of ``light``'s shadow map for ``plan``'s
+ *  group, drawn on first use with ``params`` (the Python module's; other kinds pass theirs). */
+export function shadowInputs(executor, plan, light, outer, params = plan.multipass.params) {
   const key = `shadow-map ${plan.geometry.key} ${light.direction.join(',')}`;
   if (!executor.cache.has(key)) {
     const gl = executor.gl;

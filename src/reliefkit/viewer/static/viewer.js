@@ -233,12 +233,11 @@ function withView(plan, update) {
 }
 
 // web/src/shadow_map.js
-function drawShadowMapped(executor, plan, camera, light, outer) {
+function drawShadowMapped(executor, plan, camera, light, outer, extra = {}) {
   const [uniforms, textures] = shadowInputs(executor, plan, light, outer);
-  executor.drawViewed(plan, camera, light, { uniforms, textures });
+  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
 }
-function shadowInputs(executor, plan, light, outer) {
-  const params = plan.multipass.params;
+function shadowInputs(executor, plan, light, outer, params = plan.multipass.params) {
   const key = `shadow-map ${plan.geometry.key} ${light.direction.join(",")}`;
   if (!executor.cache.has(key)) {
     const gl = executor.gl;
@@ -338,14 +337,18 @@ function uploadTexture(gl, t) {
   return { tex, target };
 }
 
+// web/src/copy_depth.glsl
+var copy_depth_default = "#version 300 es\n// The opaque pass's depth as a float colour (render/multipass/opaque_depth.py: a transparent\n// plan samples it while the depth attachment itself is being tested). VERTEX_SHADER /\n// FRAGMENT_SHADER pick the stage.\nprecision highp float;\n#ifdef VERTEX_SHADER\nvoid main() {  // one full-screen triangle\n    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n}\n#else\nuniform highp sampler2D u_depth;\nout vec4 f_out;\n\nvoid main() {\n    f_out = vec4(texelFetch(u_depth, ivec2(gl_FragCoord.xy), 0).r);\n}\n#endif\n";
+
 // web/src/present.glsl
-var present_default = "#version 300 es\n// The picture `reliefkit render` writes (render/frame.py Frame.rgba8, colorspace.to_rgba8):\n// where the opaque pass covered a pixel (position.w > 0.5), its linear colour sRGB-encoded\n// with straight alpha; elsewhere transparent. VERTEX_SHADER / FRAGMENT_SHADER pick the stage.\nprecision highp float;\n#ifdef VERTEX_SHADER\nvoid main() {  // one full-screen triangle\n    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n}\n#else\nuniform sampler2D u_color;\nuniform sampler2D u_position;\nout vec4 f_out;\n\nvec3 srgb_encode(vec3 x) {\n    x = clamp(x, 0.0, 1.0);\n    return mix(1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, 12.92 * x, lessThanEqual(x, vec3(0.0031308)));\n}\n\nvoid main() {\n    ivec2 p = ivec2(gl_FragCoord.xy);\n    vec4 color = texelFetch(u_color, p, 0);\n    bool covered = texelFetch(u_position, p, 0).w > 0.5;\n    f_out = covered ? vec4(srgb_encode(color.rgb), clamp(color.a, 0.0, 1.0)) : vec4(0.0);\n}\n#endif\n";
+var present_default = "#version 300 es\n// The picture `reliefkit render` writes (render/frame.py frame_from_passes, Frame.rgba8,\n// colorspace.to_rgba8): the opaque pass's colour where it covered a pixel (position.w > 0.5),\n// under the transparent pass's premultiplied colour, straight again and sRGB-encoded;\n// transparent where neither drew. VERTEX_SHADER / FRAGMENT_SHADER pick the stage.\nprecision highp float;\n#ifdef VERTEX_SHADER\nvoid main() {  // one full-screen triangle\n    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n}\n#else\nuniform sampler2D u_color;\nuniform sampler2D u_position;\nuniform sampler2D u_transparent;  // premultiplied, accumulated front to back\nout vec4 f_out;\n\nvec3 srgb_encode(vec3 x) {\n    x = clamp(x, 0.0, 1.0);\n    return mix(1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, 12.92 * x, lessThanEqual(x, vec3(0.0031308)));\n}\n\nvoid main() {\n    ivec2 p = ivec2(gl_FragCoord.xy);\n    bool covered = texelFetch(u_position, p, 0).w > 0.5;\n    vec4 opaque = covered ? texelFetch(u_color, p, 0) : vec4(0.0);\n    vec4 front = texelFetch(u_transparent, p, 0);\n    float alpha = front.a + (1.0 - front.a) * opaque.a;\n    vec3 rgb = front.rgb + (1.0 - front.a) * opaque.rgb * opaque.a;\n    vec3 straight = alpha > 0.0 ? rgb / alpha : vec3(0.0);\n    f_out = covered || front.a > 0.0 ? vec4(srgb_encode(straight), clamp(alpha, 0.0, 1.0))\n                                     : vec4(0.0);\n}\n#endif\n";
 
 // web/src/executor.js
 var FRAME_ATTACHMENTS = 3;
 var MODES = { triangles: "TRIANGLES", points: "POINTS", lines: "LINES", triangle_strip: "TRIANGLE_STRIP" };
 var BLEND = { under: ["ONE_MINUS_DST_ALPHA", "ONE"], add: ["ONE", "ONE"] };
-var MULTIPASS = { "shadow-map": drawShadowMapped };
+var MULTIPASS = { "shadow-map": drawShadowMapped, "opaque-depth": drawWithOpaqueDepth };
+var FRONT_OPACITY_UNIT = 15;
 var Unsupported = class extends Error {
 };
 function createContext(canvas) {
@@ -373,6 +376,7 @@ var Executor = class {
     this.query = null;
     this.gpuMs = null;
     this.present = this.link("present.glsl", sourcePair(present_default));
+    this.copyDepth = this.link("copy_depth.glsl", sourcePair(copy_depth_default));
   }
   /** Take ``plan`` to draw (its programs compiled); throws `Unsupported` for one it cannot
    *  draw yet, or an Error (a shader that does not compile). */
@@ -390,7 +394,6 @@ var Executor = class {
     if (plan.multipass && !MULTIPASS[plan.multipass.kind]) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
     const encoded = Object.values(plan.textures).find((t) => t.encoded || (t.levels || [t.array]).some((a) => a.encoding));
     if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
-    if (plan.render_pass !== "opaque") throw new Unsupported(`${plan.name}: the transparent pass is not supported by the viewer yet`);
     if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
   }
   program(program) {
@@ -468,31 +471,41 @@ var Executor = class {
     if (!this.textures.has(t)) this.textures.set(t, uploadTexture(this.gl, t));
     return this.textures.get(t);
   }
-  /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas. */
+  /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas: the
+   *  opaque pass, then the transparent plans front to back (gl/targets.py draw_passes). */
   frame(plans, camera, light, targets) {
     const gl = this.gl;
     const [w, h] = camera.size;
-    gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
-    gl.viewport(0, 0, w, h);
-    gl.depthMask(true);
-    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
-    gl.clearBufferfv(gl.DEPTH, 0, [1]);
-    const outer = () => {
-      gl.bindFramebuffer(gl.FRAMEBUFFER, targets.fbo);
+    const pass = (fbo) => () => {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
       gl.viewport(0, 0, w, h);
     };
+    const opaque = pass(targets.fbo);
+    const transparent = pass(targets.transparentFbo);
     const timing = this.timer && !this.query;
     if (timing) {
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }
-    for (const plan of plans) this.draw(plan, camera, light, outer);
+    opaque();
+    gl.depthMask(true);
+    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    for (const plan of plans.filter((p) => p.render_pass === "opaque")) this.draw(plan, camera, light, opaque);
+    transparent();
+    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    const front = { u_front_opacity: FRONT_OPACITY_UNIT };
+    gl.activeTexture(gl.TEXTURE0 + FRONT_OPACITY_UNIT);
+    gl.bindTexture(gl.TEXTURE_2D, targets.frontOpacity.tex);
+    for (const plan of plans.filter((p) => p.render_pass === "transparent")) {
+      this.draw(plan, camera, light, transparent, { uniforms: front, targets });
+    }
     if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     this.setRaster({ depth_test: false, cull: "none", blend: "none", depth_write: false });
     gl.useProgram(this.present.prog);
-    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position });
+    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position, u_transparent: targets.transparent });
     for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
@@ -529,12 +542,22 @@ var Executor = class {
     }
     return viewed;
   }
-  /** Draw ``source`` from ``camera``: its view, then one draw or its multi-pass kind. */
-  draw(source, camera, light, outer) {
+  /** Draw ``source`` from ``camera``: its view, then one draw or its multi-pass kind;
+   *  ``extra`` (uniforms, the frame's targets) goes to both. */
+  draw(source, camera, light, outer, extra = {}) {
     const plan = this.view(source, camera, light);
     if (plan.count === 0) return;
-    if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer);
-    else this.drawViewed(plan, camera, light);
+    if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer, extra);
+    else this.drawViewed(plan, camera, light, extra);
+  }
+  /** A full-screen triangle drawn with ``linked`` and ``textures`` (a pass of a kind). */
+  drawFullScreen(linked, textures) {
+    const gl = this.gl;
+    this.setRaster({ depth_test: false, cull: "none", blend: "none", depth_write: false });
+    gl.useProgram(linked.prog);
+    for (const [name, value] of Object.entries(this.bindTextures(textures))) setUniform(gl, linked, name, value);
+    gl.bindVertexArray(null);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
   /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
    *  ``raster``, ``uniforms`` and ``textures`` replace or add to the plan's. */
@@ -593,7 +616,7 @@ var Executor = class {
 var MAX_TARGET_BYTES = 1 << 30;
 function createTargets(gl, [w, h]) {
   const side = gl.getParameter(gl.MAX_TEXTURE_SIZE);
-  const bytes = w * h * (FRAME_ATTACHMENTS * 16 + 4);
+  const bytes = w * h * ((2 * FRAME_ATTACHMENTS + 2) * 16 + 4);
   if (w > side || h > side || bytes > MAX_TARGET_BYTES) {
     throw new Error(`a ${w}x${h} frame needs ${Math.ceil(bytes / 2 ** 20)} MiB of float render targets (limits: ${side} texels a side, ${MAX_TARGET_BYTES / 2 ** 20} MiB): ask for a smaller size`);
   }
@@ -605,16 +628,52 @@ function createTargets(gl, [w, h]) {
     gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
     return { tex, target: gl.TEXTURE_2D };
   };
-  const fbo = gl.createFramebuffer();
-  gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
   const attachments = [...Array(FRAME_ATTACHMENTS).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
-  const [color, position] = attachments.map((a) => make(gl.RGBA32F, gl.RGBA, gl.FLOAT, a));
-  make(gl.DEPTH_COMPONENT32F, gl.DEPTH_COMPONENT, gl.FLOAT, gl.DEPTH_ATTACHMENT);
-  gl.drawBuffers(attachments);
-  const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+  const framebuffer = (colors, depth2) => {
+    const fbo2 = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo2);
+    const made = colors.map((a) => make(gl.RGBA32F, gl.RGBA, gl.FLOAT, a));
+    if (depth2) gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.TEXTURE_2D, depth2.tex, 0);
+    gl.drawBuffers(colors);
+    const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`the ${w}x${h} float render targets are incomplete (status 0x${status.toString(16)})`);
+    return [fbo2, made];
+  };
+  const depth = (() => {
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.DEPTH_COMPONENT32F, w, h, 0, gl.DEPTH_COMPONENT, gl.FLOAT, null);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+    return { tex, target: gl.TEXTURE_2D };
+  })();
+  const [fbo, [color, position]] = framebuffer(attachments, depth);
+  const [transparentFbo, [transparent]] = framebuffer(attachments, depth);
+  const [depthCopyFbo, [depthCopy]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
+  const [frontFbo, [frontOpacity]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, frontFbo);
+  gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-  if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`the ${w}x${h} float render targets are incomplete (status 0x${status.toString(16)})`);
-  return { fbo, color, position };
+  return { fbo, color, position, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h] };
+}
+function drawWithOpaqueDepth(executor, plan, camera, light, outer, extra) {
+  const [uniforms, textures] = opaqueDepthInputs(executor, plan, light, outer, extra.targets);
+  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
+}
+function opaqueDepthInputs(executor, plan, light, outer, targets) {
+  const gl = executor.gl;
+  const [w, h] = targets.size;
+  let [uniforms, textures] = [{}, {}];
+  if (plan.multipass.params.shadow_map) {
+    [uniforms, textures] = shadowInputs(executor, plan, light, outer, plan.multipass.params.shadow_map);
+  }
+  gl.bindFramebuffer(gl.FRAMEBUFFER, targets.depthCopyFbo);
+  gl.viewport(0, 0, w, h);
+  executor.drawFullScreen(executor.copyDepth, { u_depth: targets.depth });
+  const depth = new Float32Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, depth);
+  outer();
+  return [{ ...uniforms, u_clip_opaque: depth.some((z) => z < 1) }, { ...textures, u_opaque_depth: targets.depthCopy }];
 }
 function counts(gl, plan) {
   const g = plan.geometry;
