@@ -1,8 +1,9 @@
 """The page's executor on the plans of the kinds whose view hooks it has no port of yet: each
 plan seen from a camera in Python (`DrawPlan.with_view`: the hook applied), exported without
 its hook and drawn by the page from the same camera, against `reliefkit render` there (the
-transparent shell: its sorted tetrahedra through the transparent pass and the opaque-depth
-kind). What is left for these kinds is the hooks' JavaScript ports (web/src/hooks/)."""
+transparent shell: its sorted tetrahedra through the transparent pass, drawn by the
+opaque-depth kind or, by default, the half-opacity search, whose colour is the same). What
+is left for these kinds is the hooks' JavaScript ports (web/src/hooks/)."""
 
 from __future__ import annotations
 
@@ -26,14 +27,16 @@ VIEWS = ("30,25", "-100,10", "160,50")
 HOOKED = {"relief": ("relief", "relief"), "relief-object": ("relief", "relief-object"),
           "dmbbc": ("billboard", "dmbbc"), "depth-object": ("slicing", "depth-object"),
           "visual-hull": ("slicing", "visual-hull"), "displacement": ("slicing", "displacement"),
-          "shell-volume": ("shellvolume", "shell-volume")}
-#: render options a kind is drawn with here: the transparent shell with the "opaque-depth"
-#: kind (the half-opacity search is not ported yet)
-OPTIONS = {"shell-volume": {"half_opacity": False}}
+          "shell-volume": ("shellvolume", "shell-volume"),
+          "shell-volume --no-half-opacity": ("shellvolume", "shell-volume")}
+#: render options a kind is drawn with here besides its defaults (the transparent shell's
+#: default multi-pass kind is the half-opacity search)
+OPTIONS = {"shell-volume --no-half-opacity": {"half_opacity": False}}
 #: on SwiftShader the displacement map's slices (IoU 0.999-1.0, 98.8-99.0% within 4/255) and
 #: the shell's 3D textures (0.999, 98.0-99.1%) fall short, as the opaque shell does; on Mesa's
 #: llvmpipe (what render draws with) every pixel agrees
-BACKEND = {"displacement": "mesa", "shell-volume": "mesa"}
+BACKEND = {"displacement": "mesa", "shell-volume": "mesa",
+           "shell-volume --no-half-opacity": "mesa"}
 
 
 @pytest.fixture(scope="module")

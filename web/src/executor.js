@@ -17,7 +17,13 @@ const BLEND = { under: ['ONE_MINUS_DST_ALPHA', 'ONE'], add: ['ONE', 'ONE'] };
 
 /** Multi-pass kinds (render/executor.py MULTIPASS): ``kind(executor, viewed plan, camera,
  *  light, outer)``, where ``outer()`` binds the frame's target again after a pass of its own. */
-const MULTIPASS = { 'shadow-map': drawShadowMapped, 'opaque-depth': drawWithOpaqueDepth };
+const MULTIPASS = {
+  'shadow-map': drawShadowMapped,
+  'opaque-depth': drawWithOpaqueDepth,
+  // its extra passes only place the position and normal AOVs at the half-opacity point,
+  // which the page does not show: its colour and coverage are the opaque-depth kind's
+  'half-opacity-search': drawWithOpaqueDepth,
+};
 const FRONT_OPACITY_UNIT = 15; // gl/targets.py: drawables use the low units
 
 /** A plan this executor cannot draw yet, named in a user's words. */

@@ -347,7 +347,13 @@ var present_default = "#version 300 es\n// The picture `reliefkit render` writes
 var FRAME_ATTACHMENTS = 3;
 var MODES = { triangles: "TRIANGLES", points: "POINTS", lines: "LINES", triangle_strip: "TRIANGLE_STRIP" };
 var BLEND = { under: ["ONE_MINUS_DST_ALPHA", "ONE"], add: ["ONE", "ONE"] };
-var MULTIPASS = { "shadow-map": drawShadowMapped, "opaque-depth": drawWithOpaqueDepth };
+var MULTIPASS = {
+  "shadow-map": drawShadowMapped,
+  "opaque-depth": drawWithOpaqueDepth,
+  // its extra passes only place the position and normal AOVs at the half-opacity point,
+  // which the page does not show: its colour and coverage are the opaque-depth kind's
+  "half-opacity-search": drawWithOpaqueDepth
+};
 var FRONT_OPACITY_UNIT = 15;
 var Unsupported = class extends Error {
 };
