@@ -6,7 +6,9 @@
 
 import { cameraUniforms, modelOffset } from './camera.js';
 import { programKey, withView } from './plans.js';
-import { drawShadowMapped, shadowInputs } from './shadow_map.js';
+import { drawDepthPeeled } from './depth_peel.js';
+import { drawWithOpaqueDepth } from './opaque_depth.js';
+import { drawShadowMapped } from './shadow_map.js';
 import { uploadTexture } from './textures.js';
 import COPY_DEPTH from './copy_depth.glsl';
 import PRESENT from './present.glsl';
@@ -23,6 +25,7 @@ const MULTIPASS = {
   // its extra passes only place the position and normal AOVs at the half-opacity point,
   // which the page does not show: its colour and coverage are the opaque-depth kind's
   'half-opacity-search': drawWithOpaqueDepth,
+  'depth-peel': drawDepthPeeled,
 };
 const FRONT_OPACITY_UNIT = 15; // gl/targets.py: drawables use the low units
 
@@ -243,10 +246,11 @@ export class Executor {
     else this.drawViewed(plan, camera, light, extra);
   }
 
-  /** A full-screen triangle drawn with ``linked`` and ``textures`` (a pass of a kind). */
-  drawFullScreen(linked, textures) {
+  /** A full-screen triangle drawn with ``linked`` and ``textures`` under ``raster`` (a pass
+   *  of a multi-pass kind). */
+  drawFullScreen(linked, textures, raster = { depth_test: false, cull: 'none', blend: 'none', depth_write: false }) {
     const gl = this.gl;
-    this.setRaster({ depth_test: false, cull: 'none', blend: 'none', depth_write: false });
+    this.setRaster(raster);
     gl.useProgram(linked.prog);
     for (const [name, value] of Object.entries(this.bindTextures(textures))) setUniform(gl, linked, name, value);
     gl.bindVertexArray(null);
@@ -358,30 +362,6 @@ export function createTargets(gl, [w, h]) {
   gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   return { fbo, color, position, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h] };
-}
-
-/** The "opaque-depth" kind (render/multipass/opaque_depth.py): a transparent plan drawn once,
- *  sampling a copy of the opaque depth (``u_opaque_depth``; ``u_clip_opaque``: whether any
- *  opaque surface was drawn), lit by the light's shadow map when its params ask for one. */
-function drawWithOpaqueDepth(executor, plan, camera, light, outer, extra) {
-  const [uniforms, textures] = opaqueDepthInputs(executor, plan, light, outer, extra.targets);
-  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
-}
-
-function opaqueDepthInputs(executor, plan, light, outer, targets) {
-  const gl = executor.gl;
-  const [w, h] = targets.size;
-  let [uniforms, textures] = [{}, {}];
-  if (plan.multipass.params.shadow_map) {
-    [uniforms, textures] = shadowInputs(executor, plan, light, outer, plan.multipass.params.shadow_map);
-  }
-  gl.bindFramebuffer(gl.FRAMEBUFFER, targets.depthCopyFbo);
-  gl.viewport(0, 0, w, h);
-  executor.drawFullScreen(executor.copyDepth, { u_depth: targets.depth });
-  const depth = new Float32Array(w * h * 4);
-  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, depth);
-  outer();
-  return [{ ...uniforms, u_clip_opaque: depth.some((z) => z < 1) }, { ...textures, u_opaque_depth: targets.depthCopy }];
 }
 
 /** render/executor.py _counts. */

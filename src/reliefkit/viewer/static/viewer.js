@@ -283,6 +283,93 @@ function nested(box) {
   return box;
 }
 
+// web/src/opaque_depth.js
+function drawWithOpaqueDepth(executor, plan, camera, light, outer, extra) {
+  const [uniforms, textures] = opaqueDepthInputs(executor, plan, light, outer, extra.targets);
+  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
+}
+function opaqueDepthInputs(executor, plan, light, outer, targets) {
+  const gl = executor.gl;
+  const [w, h] = targets.size;
+  let [uniforms, textures] = [{}, {}];
+  if (plan.multipass.params.shadow_map) {
+    [uniforms, textures] = shadowInputs(executor, plan, light, outer, plan.multipass.params.shadow_map);
+  }
+  gl.bindFramebuffer(gl.FRAMEBUFFER, targets.depthCopyFbo);
+  gl.viewport(0, 0, w, h);
+  executor.drawFullScreen(executor.copyDepth, { u_depth: targets.depth });
+  const depth = new Float32Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, depth);
+  outer();
+  return [{ ...uniforms, u_clip_opaque: depth.some((z) => z < 1) }, { ...textures, u_opaque_depth: targets.depthCopy }];
+}
+
+// web/src/depth_peel.js
+var BEYOND = 2;
+var COMPOSITE = { depth_test: false, depth_write: false, cull: "none", blend: "under" };
+function drawDepthPeeled(executor, plan, camera, light, outer, extra) {
+  const gl = executor.gl;
+  const [uniforms, textures] = opaqueDepthInputs(executor, plan, light, outer, extra.targets);
+  const [w, h] = extra.targets.size;
+  const peel = peelTargets(executor, w, h);
+  const raster = { ...plan.raster, depth_write: true, blend: "none" };
+  const layer = executor.program({ name: plan.multipass.programs.layer[0], defines: plan.multipass.programs.layer[1] });
+  gl.bindFramebuffer(gl.FRAMEBUFFER, peel.fbos[1]);
+  gl.clearBufferfv(gl.COLOR, 1, [-1, -1, -1, -1]);
+  const depth = new Float32Array(w * h * 4);
+  let layers = 0;
+  for (let k = 0; k < Number(plan.multipass.params.max_layers); k++) {
+    const [fbo, before] = [peel.fbos[k % 2], peel.peeled[(k + 1) % 2]];
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+    gl.viewport(0, 0, w, h);
+    gl.depthMask(true);
+    gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
+    gl.clearBufferfv(gl.COLOR, 1, [BEYOND, BEYOND, BEYOND, BEYOND]);
+    gl.clearBufferfv(gl.DEPTH, 0, [1]);
+    executor.drawViewed(plan, camera, light, {
+      uniforms: { ...extra.uniforms, ...uniforms },
+      textures: { ...textures, u_peel_depth: before },
+      raster
+    });
+    gl.readBuffer(gl.COLOR_ATTACHMENT1);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, depth);
+    gl.readBuffer(gl.COLOR_ATTACHMENT0);
+    if (!depth.some((z, i) => i % 4 === 0 && z !== BEYOND)) break;
+    layers += 1;
+    outer();
+    executor.drawFullScreen(layer, { u_layer: peel.color }, COMPOSITE);
+  }
+  outer();
+  return layers;
+}
+function peelTargets(executor, w, h) {
+  const key = `depth-peel ${w}x${h}`;
+  if (!executor.cache.has(key)) {
+    const gl = executor.gl;
+    const texture = (internal, format, type) => {
+      const tex = gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, tex);
+      gl.texImage2D(gl.TEXTURE_2D, 0, internal, w, h, 0, format, type, null);
+      for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+      return { tex, target: gl.TEXTURE_2D };
+    };
+    const color = texture(gl.RGBA32F, gl.RGBA, gl.FLOAT);
+    const peeled = [0, 1].map(() => texture(gl.RGBA32F, gl.RGBA, gl.FLOAT));
+    const depth = texture(gl.DEPTH_COMPONENT32F, gl.DEPTH_COMPONENT, gl.FLOAT);
+    const fbos = peeled.map((z) => {
+      const fbo = gl.createFramebuffer();
+      gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, color.tex, 0);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, z.tex, 0);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.TEXTURE_2D, depth.tex, 0);
+      gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
+      return fbo;
+    });
+    executor.cache.set(key, { color, peeled, fbos });
+  }
+  return executor.cache.get(key);
+}
+
 // web/src/textures.js
 var FORMATS = {
   // dtype -> [internal formats by channel count, format by channel count, type]
@@ -352,7 +439,8 @@ var MULTIPASS = {
   "opaque-depth": drawWithOpaqueDepth,
   // its extra passes only place the position and normal AOVs at the half-opacity point,
   // which the page does not show: its colour and coverage are the opaque-depth kind's
-  "half-opacity-search": drawWithOpaqueDepth
+  "half-opacity-search": drawWithOpaqueDepth,
+  "depth-peel": drawDepthPeeled
 };
 var FRONT_OPACITY_UNIT = 15;
 var Unsupported = class extends Error {
@@ -556,10 +644,11 @@ var Executor = class {
     if (plan.multipass) MULTIPASS[plan.multipass.kind](this, plan, camera, light, outer, extra);
     else this.drawViewed(plan, camera, light, extra);
   }
-  /** A full-screen triangle drawn with ``linked`` and ``textures`` (a pass of a kind). */
-  drawFullScreen(linked, textures) {
+  /** A full-screen triangle drawn with ``linked`` and ``textures`` under ``raster`` (a pass
+   *  of a multi-pass kind). */
+  drawFullScreen(linked, textures, raster = { depth_test: false, cull: "none", blend: "none", depth_write: false }) {
     const gl = this.gl;
-    this.setRaster({ depth_test: false, cull: "none", blend: "none", depth_write: false });
+    this.setRaster(raster);
     gl.useProgram(linked.prog);
     for (const [name, value] of Object.entries(this.bindTextures(textures))) setUniform(gl, linked, name, value);
     gl.bindVertexArray(null);
@@ -661,25 +750,6 @@ function createTargets(gl, [w, h]) {
   gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   return { fbo, color, position, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h] };
-}
-function drawWithOpaqueDepth(executor, plan, camera, light, outer, extra) {
-  const [uniforms, textures] = opaqueDepthInputs(executor, plan, light, outer, extra.targets);
-  executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
-}
-function opaqueDepthInputs(executor, plan, light, outer, targets) {
-  const gl = executor.gl;
-  const [w, h] = targets.size;
-  let [uniforms, textures] = [{}, {}];
-  if (plan.multipass.params.shadow_map) {
-    [uniforms, textures] = shadowInputs(executor, plan, light, outer, plan.multipass.params.shadow_map);
-  }
-  gl.bindFramebuffer(gl.FRAMEBUFFER, targets.depthCopyFbo);
-  gl.viewport(0, 0, w, h);
-  executor.drawFullScreen(executor.copyDepth, { u_depth: targets.depth });
-  const depth = new Float32Array(w * h * 4);
-  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, depth);
-  outer();
-  return [{ ...uniforms, u_clip_opaque: depth.some((z) => z < 1) }, { ...textures, u_opaque_depth: targets.depthCopy }];
 }
 function counts(gl, plan) {
   const g = plan.geometry;
