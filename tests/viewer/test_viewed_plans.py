@@ -29,16 +29,20 @@ HOOKED = {"relief": ("relief", "relief"), "relief-object": ("relief", "relief-ob
           "visual-hull": ("slicing", "visual-hull"), "displacement": ("slicing", "displacement"),
           "shell-volume": ("shellvolume", "shell-volume"),
           "shell-volume --no-half-opacity": ("shellvolume", "shell-volume"),
-          "shell-volume --sort peel": ("shellvolume", "shell-volume")}
+          "shell-volume --sort peel": ("shellvolume", "shell-volume"),
+          "depth-object --passes stencil": ("slicing", "depth-object")}
 #: render options a kind is drawn with here besides its defaults (the transparent shell's
 #: default multi-pass kind is the half-opacity search)
 OPTIONS = {"shell-volume --no-half-opacity": {"half_opacity": False},
-           "shell-volume --sort peel": {"sort": "peel"}}
-#: on SwiftShader the displacement map's slices (IoU 0.999-1.0, 98.8-99.0% within 4/255) and
-#: the shell's 3D textures (0.999, 98.0-99.1%) fall short, as the opaque shell does; on Mesa's
-#: llvmpipe (what render draws with) every pixel agrees
+           "shell-volume --sort peel": {"sort": "peel"},
+           "depth-object --passes stencil": {"passes": "stencil", "slicing": "screen"}}
+#: on SwiftShader the displacement map's slices (IoU 0.999-1.0, 98.8-99.0% within 4/255), the
+#: shell's 3D textures (0.999, 98.0-99.1%) and the depth object's screen slices counted in
+#: the stencil (0.997, 99.0%) fall short, as the opaque shell does; on Mesa's llvmpipe (what
+#: render draws with) every pixel agrees
 BACKEND = {"displacement": "mesa", "shell-volume": "mesa",
-           "shell-volume --no-half-opacity": "mesa", "shell-volume --sort peel": "mesa"}
+           "shell-volume --no-half-opacity": "mesa", "shell-volume --sort peel": "mesa",
+           "depth-object --passes stencil": "mesa"}
 
 
 @pytest.fixture(scope="module")

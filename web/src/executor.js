@@ -9,6 +9,7 @@ import { programKey, withView } from './plans.js';
 import { drawDepthPeeled } from './depth_peel.js';
 import { drawWithOpaqueDepth } from './opaque_depth.js';
 import { drawShadowMapped } from './shadow_map.js';
+import { drawStencilCounted } from './stencil_count.js';
 import { uploadTexture } from './textures.js';
 import COPY_DEPTH from './copy_depth.glsl';
 import PRESENT from './present.glsl';
@@ -26,6 +27,7 @@ const MULTIPASS = {
   // which the page does not show: its colour and coverage are the opaque-depth kind's
   'half-opacity-search': drawWithOpaqueDepth,
   'depth-peel': drawDepthPeeled,
+  'stencil-count': drawStencilCounted,
 };
 const FRONT_OPACITY_UNIT = 15; // gl/targets.py: drawables use the low units
 
