@@ -1,5 +1,6 @@
 """Shader loader: namespaces, includes with #line, define variants, compile errors naming file
-and line, a bounded per-context cache, GLSL ES portability and the wheel's package data."""
+and line, a bounded per-context cache, GLSL ES portability and the wheel's package data
+(the shaders and the viewer's page)."""
 
 import shutil
 import subprocess
@@ -163,11 +164,12 @@ def test_every_draw_path_program_compiles(gl, es):
             pytest.fail(f"{variant.file} {variant.defines} as {'ES' if es else 'core'}: {exc}")
 
 
-def test_wheel_contains_every_shader(tmp_path):
+def test_wheel_contains_every_shader_and_the_viewer_page(tmp_path):
     root = Path(__file__).resolve().parents[2]
     package = root / "src" / "reliefkit"
-    expected = {str(p.relative_to(package.parent)) for p in package.rglob("*.glsl")}
-    assert len(expected) >= 8
+    shaders = {str(p.relative_to(package.parent)) for p in package.rglob("*.glsl")}
+    page = {f"reliefkit/viewer/static/{name}" for name in ("index.html", "viewer.js")}
+    assert len(shaders) >= 8
     # from a copy: a build/ folder left in the checkout would ship files since deleted
     copy = tmp_path / "source"
     shutil.copytree(root / "src", copy / "src",
@@ -180,5 +182,6 @@ def test_wheel_contains_every_shader(tmp_path):
     assert out.returncode == 0, out.stderr[-2000:]
     (wheel,) = tmp_path.glob("reliefkit-*.whl")
     with zipfile.ZipFile(wheel) as zf:
-        shipped = {name for name in zf.namelist() if name.endswith(".glsl")}
-    assert shipped == expected
+        names = set(zf.namelist())
+    assert {name for name in names if name.endswith(".glsl")} == shaders
+    assert page <= names  # `reliefkit view` needs no Node: the bundle ships

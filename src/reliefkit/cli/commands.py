@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import shlex
 import sys
 from contextlib import closing
 from pathlib import Path
@@ -44,6 +45,8 @@ from ..scene.views import (
 )
 from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, shootout
 from ..units import format_bytes
+from ..viewer import server as view_server
+from ..viewer import site as view_site
 from .options import applicable, given_options
 
 MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
@@ -540,3 +543,34 @@ def cmd_demo(args) -> int:
     return 0
 
 
+
+def cmd_view(args) -> int:
+    if not 0 <= args.port <= 65535:
+        raise UsageError(f"--port must be within 0..65535, got {args.port}")
+    for spec in args.inputs:
+        _check_not_empty(spec)
+    objects = [load_input(spec) for spec in args.inputs]
+    routed = _routed_options(given_options(args), args.inputs, objects)
+    with waiting("exporting the inputs"):
+        files = view_site.site_files([view_site.make_input(spec, obj, options) for spec, obj,
+                                      options in zip(args.inputs, objects, routed, strict=True)])
+    if args.export_html:
+        paths = view_site.export_html(files, args.export_html)
+        print(f"wrote {len(paths)} files into {args.export_html} (index.html: serve the folder, "
+              "e.g. python -m http.server -d " + shlex.quote(args.export_html) + ")")
+        return 0
+    view_server.serve(files, args.port, open_browser=not args.no_browser)
+    return 0
+
+
+def _routed_options(given: dict, specs, objects) -> list[dict]:
+    """The render options each input gets: those of ``given`` it declares, checked; one that
+    no input declares is an error (as `render` routes them to several drawables)."""
+    declared = [{opt.name for opt in render_options(obj)} for obj in objects]
+    unused = sorted(set(given) - set().union(*declared))
+    if unused:
+        flags = ", ".join("--" + name.replace("_", "-") for name in unused)
+        raise UsageError(f"{flags} applies to none of the inputs")
+    return [applicable({k: v for k, v in given.items() if k in names}, render_options(obj),
+                       what_it_is(spec, obj))
+            for spec, obj, names in zip(specs, objects, declared, strict=True)]

@@ -14,7 +14,7 @@ from ..core.technique import bakers, techniques
 from ..export.gltf import DEFAULT_FALLBACK_TRIANGLES
 from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
-from ..scene.views import DEFAULT_SIZE, DEFAULT_VIEW
+from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW
 from ..shootout.sizing import candidates as shootout_candidates
 from .commands import (
     cmd_bake,
@@ -25,6 +25,7 @@ from .commands import (
     cmd_info,
     cmd_render,
     cmd_shootout,
+    cmd_view,
 )
 from .exits import EXIT_USAGE
 from .options import add_flag, add_options
@@ -46,6 +47,9 @@ CORE_EXAMPLES = {
                "reliefkit reads it back",
                "reliefkit export car.glb --lod relief-cube,billboard-cloud -o car-lod.glb",
                "reliefkit export tree.rk -o tree.gltf --embed-shaders"],
+    "view": ["reliefkit view tree.rk demo:tree                    in the browser, side by side",
+             "reliefkit view car.glb --no-browser --port 8000   print the URL only",
+             "reliefkit view tree.rk --export-html site/        a folder any static server shows"],
     "shootout": ["reliefkit shootout demo:tree --out out/shootout    what to ship at 64 and "
                  "256 px, 256 KB and 1 MB",
                  "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "
@@ -55,7 +59,7 @@ CORE_EXAMPLES = {
              "reliefkit info model.obj                          counts and bounds of a mesh "
              "(or an .rk)"],
 }
-ORDER = ("demo", "render", "bake", "compare", "export", "shootout", "bench", "info")
+ORDER = ("demo", "render", "bake", "compare", "export", "view", "shootout", "bench", "info")
 
 
 def _examples(command: str | None = None) -> list[str]:
@@ -125,7 +129,7 @@ def _add_view_args(p: _Parser) -> None:
                    "distance that fits the sphere in view)")
     p.add_argument("--size", default="x".join(map(str, DEFAULT_SIZE)), metavar="WxH",
                    help="image size in pixels (default: %(default)s)")
-    add_flag(p, "--fov", dash_value=True, type=float, default=40.0, metavar="DEG",
+    add_flag(p, "--fov", dash_value=True, type=float, default=DEFAULT_FOV, metavar="DEG",
               help="vertical field of view in degrees, within [0.1, 179] (default: "
                    "%(default)g)")
     add_flag(p, "--light", dash_value=True, metavar="AZ,EL",
@@ -185,9 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--msaa", type=int, default=1, choices=MSAA_CHOICES, metavar="N",
                    help="samples per pixel for the colour (1, 2, 4 or 8, up to the GPU's "
                         "GL_MAX_SAMPLES); the AOVs stay single-sample (default: %(default)s)")
-    add_options(p, [("mesh", spec.option_list) for spec in core_drawables()]
-                 + [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
-                    for spec in t.drawables], "render options")
+    _add_render_options(p, core_drawables)
     p.set_defaults(run=cmd_render)
 
     p = _command(sub, "bake", "bake a mesh or heightmap into an .rk representation",
@@ -252,6 +254,23 @@ def build_parser() -> argparse.ArgumentParser:
     add_options(p, [("compress", options_of(CompressOptions))], "compression (with --lod)")
     p.set_defaults(run=cmd_export)
 
+    p = _command(sub, "view", "look at representations in the browser, drawn by their shaders",
+                 "Serve a page on 127.0.0.1 that draws each input's draw plans with the "
+                 "GLSL ES sources of reliefkit's shaders in WebGL2, side by side from one "
+                 "camera (?view=AZ,EL,DIST&size=WxH in its URL; drag to orbit, wheel to "
+                 "zoom), their plans made with the render options given (each to the "
+                 "inputs that declare it); Ctrl-C stops it. docs/viewer.md.")
+    p.add_argument("inputs", nargs="+", metavar="INPUT",
+                   help=".rk file, a .glb reliefkit wrote, a mesh file or demo:NAME")
+    p.add_argument("--port", type=int, default=0, metavar="N",
+                   help="port on 127.0.0.1 (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="print the URL, open no browser")
+    p.add_argument("--export-html", metavar="DIR",
+                   help="write the page, its bundle and the GLB files into DIR (viewable from "
+                        "any static web server) instead of serving")
+    _add_render_options(p, core_drawables)
+    p.set_defaults(run=cmd_view)
+
     names = suite_names()
     p = _command(sub, "bench", "reproduce a paper's tables (speed, iterations, errors)",
                  "Benchmarks measured side by side in one run: "
@@ -279,6 +298,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--size", default="256x256", metavar="WxH", help="tile size")
     p.set_defaults(run=cmd_demo)
     return parser
+
+
+def _add_render_options(p, core_drawables) -> None:
+    """Every drawable's render options as flags, each owner named in its help."""
+    add_options(p, [("mesh", spec.option_list) for spec in core_drawables()]
+                + [(_drawn_kinds(t, spec), spec.option_list) for t in techniques()
+                   for spec in t.drawables], "render options")
 
 
 def _add_bake_args(p: argparse.ArgumentParser, table: dict,

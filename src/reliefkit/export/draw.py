@@ -28,9 +28,11 @@ __all__ = ["draw_extension", "read_plans"]
 _ACCESSOR_WIDTHS = (1, 2, 3, 4, 16)
 
 
-def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False) -> dict:
-    """The ``draw`` object of ``rep``'s extension (see the module)."""
-    (drawable,) = make_drawables([rep], {})
+def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False,
+                   options: dict | None = None) -> dict:
+    """The ``draw`` object of ``rep``'s extension (see the module): its plans with its
+    render defaults, or with ``options`` (render options it declares: `reliefkit view`)."""
+    (drawable,) = make_drawables([rep], dict(options or {}))
     document, arrays = to_json(drawable.plans)
     geometry, images = _geometry_arrays(document), _texture_arrays(document)
     refs = {}

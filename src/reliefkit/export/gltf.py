@@ -25,7 +25,7 @@ from ..io.gltf.representation import extension_name, representation_extension
 from ..scene.mesh import RenderMesh
 from .draw import draw_extension
 
-__all__ = ["export", "representation_node", "builder_for", "write_document",
+__all__ = ["export", "export_bytes", "representation_node", "builder_for", "write_document",
            "DEFAULT_FALLBACK_TRIANGLES", "GENERATOR"]
 
 DEFAULT_FALLBACK_TRIANGLES = 20_000
@@ -38,7 +38,10 @@ def builder_for(path) -> GlbBuilder:
     suffix = path.suffix.lower()
     if suffix not in (".glb", ".gltf"):
         raise UsageError(f"cannot export to {path}: name a .glb or .gltf file")
-    builder = gltf_builder(path) if suffix == ".gltf" else GlbBuilder()
+    return _generated(gltf_builder(path) if suffix == ".gltf" else GlbBuilder())
+
+
+def _generated(builder: GlbBuilder) -> GlbBuilder:
     builder.document["asset"]["generator"] = GENERATOR
     return builder
 
@@ -57,12 +60,13 @@ def fallback_of(rep, triangles: int) -> RenderMesh:
 def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
                         fallback_triangles: int = DEFAULT_FALLBACK_TRIANGLES,
                         embed_shaders: bool = False, source_hash: str | None = None,
-                        name: str | None = None) -> int:
+                        name: str | None = None, options: dict | None = None) -> int:
     """Add ``rep``'s node (extension, extras, the fallback as its child) to the builder's
-    document; the node's index."""
+    document; the node's index. ``options``: render options its draw plans are made with."""
     codec, arrays, params = rk.prepare(rep)
     extension = representation_extension(builder, codec, arrays, params)
-    extension["draw"] = draw_extension(builder, rep, embed_shaders=embed_shaders)
+    extension["draw"] = draw_extension(builder, rep, embed_shaders=embed_shaders,
+                                       options=options)
     ext_name = extension_name(codec.kind)
     report = rep.bake_report() if hasattr(rep, "bake_report") else []
     node = {"name": name or codec.kind, "extensions": {ext_name: extension},
@@ -85,10 +89,14 @@ def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
     return len(document["nodes"]) - 1
 
 
-def write_document(path, builder: GlbBuilder, roots: list[int]) -> Path:
-    """One scene of the ``roots`` nodes, written atomically as .glb or .gltf."""
+def _one_scene(builder: GlbBuilder, roots: list[int]) -> None:
     builder.document["scenes"] = [{"nodes": roots}]
     builder.document["scene"] = 0
+
+
+def write_document(path, builder: GlbBuilder, roots: list[int]) -> Path:
+    """One scene of the ``roots`` nodes, written atomically as .glb or .gltf."""
+    _one_scene(builder, roots)
     path = Path(path)
     if path.suffix.lower() == ".gltf":
         return write_gltf(path, builder)
@@ -119,3 +127,13 @@ def export(rep, path, *, fallback: bool = True,
     except FormatError as exc:
         raise FormatError(f"cannot export to {path}: {exc}") from None
     return write_document(path, builder, [root])
+
+
+def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False,
+                 options: dict | None = None) -> bytes:
+    """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves),
+    its draw plans made with the render ``options`` it declares."""
+    builder = _generated(GlbBuilder())
+    _one_scene(builder, [representation_node(builder, rep, fallback=fallback,
+                                             embed_shaders=embed_shaders, options=options)])
+    return builder.glb()

@@ -16,6 +16,7 @@ from .camera import Camera
 DEFAULT_VIEW = (30.0, 25.0, None)  # distance None: fit the bounding sphere in the view
 FIT_MARGIN = 1.05                  # the fitted sphere fills 1 / FIT_MARGIN of the view
 DEFAULT_SIZE = (512, 512)
+DEFAULT_FOV = 40.0                 # vertical field of view in degrees (--fov)
 DISTANCE_RANGE = (0.01, 1e4)       # --view DIST in bounding-sphere radii: near/far stay sane
 FOV_RANGE = (0.1, 179.0)           # --fov in degrees: the projection stays well conditioned
 
@@ -84,7 +85,7 @@ def bounds_radius(bounds) -> float:
     return r if r > 0 else 1.0
 
 
-def fit_distance(size, fov_deg: float = 40.0) -> float:
+def fit_distance(size, fov_deg: float = DEFAULT_FOV) -> float:
     """Distance in bounding-sphere radii at which the sphere fits the view (both directions)."""
     w, h = size
     half_v = np.radians(fov_deg) / 2
@@ -112,7 +113,7 @@ def source_box(value, name: str = "source_bounds") -> np.ndarray | None:
 
 
 def orbit_bounds(bounds, azimuth: float, elevation: float, distance: float | None = None,
-                 size=DEFAULT_SIZE, fov_deg: float = 40.0) -> Camera:
+                 size=DEFAULT_SIZE, fov_deg: float = DEFAULT_FOV) -> Camera:
     """Orbit the box centre at ``distance`` bounding-sphere radii (None: fit the view),
     near/far hugging the box."""
     b = np.asarray(bounds, dtype=np.float64)
@@ -146,7 +147,7 @@ def _shown(b: np.ndarray) -> str:
 
 
 def turntable(bounds, count: int, elevation: float, distance: float | None, size=DEFAULT_SIZE,
-              fov_deg: float = 40.0) -> list[Camera]:
+              fov_deg: float = DEFAULT_FOV) -> list[Camera]:
     """``count`` cameras evenly spaced in azimuth around the box."""
     if count < 1 or count > 3600:
         raise UsageError(f"--turntable needs between 1 and 3600 views, got {count}")

@@ -1,0 +1,73 @@
+"""Serving the viewer's site on 127.0.0.1 (only: nothing else can reach it) until Ctrl-C.
+
+Files are served from memory; the page POSTs the errors it shows to ``/log``, and they are
+printed as ``page: ...`` lines on the server's stderr, so a shader that does not compile in
+the user's browser shows where the command runs too.
+"""
+
+from __future__ import annotations
+
+import sys
+import webbrowser
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from urllib.parse import urlsplit
+
+from ..errors import UsageError
+
+HOST = "127.0.0.1"
+MAX_LOG_BYTES = 16 << 10  # one message the page posts
+_TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
+          ".json": "application/json", ".glb": "model/gltf-binary"}
+
+
+def make_server(files: dict[str, bytes], port: int = 0, log=None) -> ThreadingHTTPServer:
+    """A server of ``files`` on 127.0.0.1:``port`` (0: a free one), not yet serving."""
+    log = log or (lambda line: print(line, file=sys.stderr, flush=True))
+
+    class Handler(BaseHTTPRequestHandler):
+        def do_GET(self):  # noqa: N802 (http.server's name)
+            name = urlsplit(self.path).path.lstrip("/") or "index.html"
+            if name not in files:
+                self.send_error(404, f"no {name} here")
+                return
+            body = files[name]
+            self.send_response(200)
+            self.send_header("Content-Type", _TYPES.get(name[name.rfind("."):],
+                                                        "application/octet-stream"))
+            self.send_header("Content-Length", str(len(body)))
+            self.send_header("Cache-Control", "no-store")
+            self.end_headers()
+            self.wfile.write(body)
+
+        def do_POST(self):  # noqa: N802
+            length = int(self.headers.get("Content-Length") or 0)
+            if urlsplit(self.path).path != "/log" or not 0 <= length <= MAX_LOG_BYTES:
+                self.send_error(400, "POST /log with a message of at most 16 KiB")
+                return
+            text = self.rfile.read(length).decode("utf-8", "replace")
+            log("page: " + " ".join(text.split()))
+            self.send_response(204)
+            self.end_headers()
+
+        def log_message(self, *args):  # requests are not news; errors come through /log
+            pass
+
+    try:
+        return ThreadingHTTPServer((HOST, port), Handler)
+    except OSError as exc:
+        raise UsageError(f"cannot serve on {HOST}:{port}: {exc.strerror or exc}") from None
+
+
+def serve(files: dict[str, bytes], port: int = 0, *, open_browser: bool = True) -> None:
+    """Serve ``files`` until Ctrl-C, printing the URL (and opening it unless told not to)."""
+    server = make_server(files, port)
+    url = f"http://{HOST}:{server.server_address[1]}/"
+    print(f"serving {url} (Ctrl-C stops)", flush=True)
+    if open_browser:
+        webbrowser.open(url)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        print("stopped", flush=True)
+    finally:
+        server.server_close()

@@ -1,0 +1,92 @@
+"""The viewer's static site: the page (static/index.html), its bundle (static/viewer.js,
+built from web/src/ by web/build.mjs), one GLB per input, exported in memory with its
+shaders, and inputs.json, which names them with their kind and framing bounds and carries
+the camera's and the light's defaults the page shares with `reliefkit render`.
+
+Everything the page computes per view comes from these files, so the folder that
+`export_html` writes is viewable from any static web server.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from ..errors import UsageError
+from ..export.gltf import export_bytes
+from ..io.atomic import atomic_path, written_together
+from ..io.inputs import kind_of, load_input
+from ..scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
+from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW, FIT_MARGIN, framing_bounds
+
+PAGE_FILES = ("index.html", "viewer.js")
+
+
+@dataclass(frozen=True)
+class Input:
+    """One input as the page gets it."""
+
+    name: str
+    kind: str
+    glb: bytes
+    bounds: list
+
+
+def load_inputs(specs) -> list[Input]:
+    """Each input (``.rk``, a reliefkit ``.glb``, a mesh file, ``demo:NAME``) loaded and
+    made an `Input` with its render defaults."""
+    if not specs:
+        raise UsageError("view needs at least one input")
+    return [make_input(spec, load_input(spec)) for spec in specs]
+
+
+def make_input(spec: str, obj, options: dict | None = None) -> Input:
+    """``obj`` (loaded from ``spec``) exported in memory with its draw plans, made with the
+    render ``options`` it declares (checked by the caller), and their GLSL ES sources; no
+    fallback mesh: the page draws the plans."""
+    return Input(str(spec), kind_of(obj), export_bytes(obj, fallback=False, embed_shaders=True,
+                                                       options=options),
+                 framing_bounds(obj).tolist())
+
+
+def manifest(inputs: list[Input]) -> dict:
+    """inputs.json: the inputs and the defaults of `reliefkit render` the page uses."""
+    light = DirectionalLight().uniforms()
+    light.pop("u_light_dir")  # the page computes it from the angles (`--light`)
+    az, el, _ = DEFAULT_VIEW
+    return {"inputs": [{"name": i.name, "kind": i.kind, "file": _glb_name(k),
+                        "bounds": i.bounds} for k, i in enumerate(inputs)],
+            "camera": {"default_view": f"{az:g},{el:g}",
+                       "default_size": f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}",
+                       "fov": DEFAULT_FOV, "fit_margin": FIT_MARGIN},
+            "light": {"angles": ",".join(f"{a:g}" for a in DEFAULT_LIGHT_ANGLES),
+                      "uniforms": light}}
+
+
+def site_files(inputs: list[Input]) -> dict[str, bytes]:
+    """Every file of the site by its name."""
+    static = resources.files(__package__) / "static"
+    files = {name: (static / name).read_bytes() for name in PAGE_FILES}
+    files["inputs.json"] = json.dumps(manifest(inputs), indent=1).encode()
+    files.update({_glb_name(k): i.glb for k, i in enumerate(inputs)})
+    return files
+
+
+def export_html(files: dict[str, bytes], folder) -> list[Path]:
+    """Write the site into ``folder`` (created), all files or none; their paths."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"--export-html {folder}: exists and is not a folder")
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = [folder / name for name in files]
+    with written_together():
+        for path in paths:
+            with atomic_path(path) as tmp:
+                Path(tmp).write_bytes(files[path.name])
+    return paths
+
+
+def _glb_name(index: int) -> str:
+    return f"input-{index}.glb"

@@ -1,0 +1,257 @@
+"""The viewer page in headless Chromium (SwiftShader's WebGL2) against `reliefkit render`:
+the same picture for every kind the page draws, at three views; a drag and the arrow keys
+orbit, and the URL follows; several inputs share one camera; a bad view in the URL, what it
+cannot draw, a broken file and a shader that does not compile show a message in the page
+that also reaches the server's log."""
+
+from __future__ import annotations
+
+import struct
+from urllib.parse import parse_qs, urlsplit
+
+import numpy as np
+import pytest
+from browser import canvas_rgba, launch, messages, open_page, playwright, served, state
+from helpers import sample
+from mesh_scenes import sampler_mesh
+
+from reliefkit import save
+from reliefkit.io.gltf.glb import glb_bytes, read_glb
+from reliefkit.render import render
+from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
+from reliefkit.scene.views import framing_bounds, orbit_bounds, parse_view
+from reliefkit.viewer.site import Input, load_inputs, make_input, site_files
+
+SIZE = (128, 128)
+VIEWS = ("30,25", "-100,10", "160,50")
+#: the scenes: a demo asset, a technique's sample, or a mesh of the test's own (saved as a
+#: mesh .rk)
+SCENES = {"mesh": "demo:vehicle", "mesh-materials": sampler_mesh,
+          "billboard-cloud": ("billboard", "billboard-cloud"),
+          "octahedral-impostor": ("impostor", "octahedral-impostor"),
+          "shell-volume": ("shellvolume", "shell-volume")}
+#: kinds whose default plans the page draws
+DRAWN = ("mesh", "mesh-materials", "billboard-cloud", "octahedral-impostor")
+
+
+@pytest.fixture(scope="module")
+def pw():
+    with playwright() as p:
+        yield p
+
+
+@pytest.fixture(scope="module")
+def browser(pw):
+    b = launch(pw)
+    yield b
+    b.close()
+
+
+@pytest.fixture(scope="module")
+def mesa_browser(pw):
+    b = launch(pw, "mesa")
+    yield b
+    b.close()
+
+
+@pytest.fixture(scope="module")
+def specs(tmp_path_factory):
+    """Each scene as an input spec: the demo mesh, the techniques' samples as .rk."""
+    folder = tmp_path_factory.mktemp("inputs")
+    out = {}
+    for kind, source in SCENES.items():
+        if isinstance(source, str):
+            out[kind] = source
+            continue
+        made = source if callable(source) else sample(*source)
+        out[kind] = str(folder / f"{kind}.rk")
+        save(out[kind], made() if callable(made) else made)
+    return out
+
+
+def rendered(spec: str, view: str, bounds=None, **options) -> np.ndarray:
+    """What `reliefkit render SPEC --view VIEW --size 128x128 [OPTIONS]` writes, as RGBA8
+    (framed by ``bounds`` instead of the input's own)."""
+    from reliefkit.io.inputs import load_input
+
+    obj = load_input(spec)
+    box = framing_bounds(obj) if bounds is None else bounds
+    camera = orbit_bounds(box, *parse_view(view), SIZE)
+    light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
+    return render(obj, camera, light=light, **options).rgba8()
+
+
+def agreement(page: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
+    """Mask IoU, and the fraction of pixels both cover whose channels are within 4/255."""
+    a, b = page[..., 3] > 0, reference[..., 3] > 0
+    iou = (a & b).sum() / max((a | b).sum(), 1)
+    both = a & b
+    diff = np.abs(page[..., :3].astype(int) - reference[..., :3].astype(int)).max(-1)[both]
+    return float(iou), float((diff <= 4).mean()) if diff.size else 0.0
+
+
+def url(base: str, view: str) -> str:
+    return f"{base}?view={view}&size={SIZE[0]}x{SIZE[1]}"
+
+
+@pytest.mark.parametrize("kind", DRAWN)
+def test_the_page_draws_what_render_draws(gl, browser, specs, kind):
+    files = site_files(load_inputs([specs[kind]]))
+    with served(files) as (base, log):
+        for view in VIEWS:
+            page = open_page(browser, url(base, view))
+            seen = state(page)
+            assert seen["ready"] and seen["errors"] == [], seen
+            iou, within = agreement(canvas_rgba(page), rendered(specs[kind], view))
+            print(f"{kind} {view}: mask IoU {iou:.4f}, {within:.2%} within 4/255")
+            assert iou >= 0.99 and within >= 0.99, (kind, view, iou, within)
+            page.close()
+        assert log == []
+
+
+@pytest.mark.parametrize("kind, options, backend", [
+    ("octahedral-impostor", {"parallax_steps": 0}, "swiftshader"),  # frames on their planes
+    ("mesh", {"shadows": True}, "swiftshader"),                      # the shadow-map kind
+    ("octahedral-impostor", {"shadows": True}, "swiftshader"),
+    # an opaque shell on SwiftShader: IoU 0.998-0.999 but 98.5-99.4% within 4/255, isolated
+    # pixels where its 3D textures' filtering decides the first dense sample differently;
+    # on Mesa's llvmpipe (what render draws with) every pixel is within 1/255
+    ("shell-volume", {"composite": "opaque"}, "mesa"),
+    ("shell-volume", {"composite": "opaque", "shadows": True}, "mesa"),  # depth sampler, culled
+    ("shell-volume", {"sort": "peel"}, "mesa")])  # transparent, by depth peeling: no hook
+def test_render_options_make_the_plans(gl, browser, mesa_browser, specs, kind, options,
+                                       backend):
+    from reliefkit.io.inputs import load_input
+
+    spec = specs[kind]
+    browser = mesa_browser if backend == "mesa" else browser
+    with served(site_files([make_input(spec, load_input(spec), options)])) as (base, _):
+        for view in VIEWS:
+            page = open_page(browser, url(base, view))
+            assert state(page)["errors"] == []
+            got = canvas_rgba(page)
+            iou, within = agreement(got, rendered(spec, view, **options))
+            print(f"{kind} {options} {view}: mask IoU {iou:.4f}, {within:.2%} within 4/255")
+            assert iou >= 0.99 and within >= 0.99, (view, iou, within)
+            page.close()
+    # nearer the options' picture than the defaults' (depth peeling draws the default's:
+    # there the default's plans, with their view hook, would have been refused above)
+    optioned, default = rendered(spec, view, **options), rendered(spec, view)
+    if not np.array_equal(optioned, default):
+        assert _mean_difference(got, optioned) < _mean_difference(got, default)
+
+
+def _mean_difference(page: np.ndarray, reference: np.ndarray) -> float:
+    both = (page[..., 3] > 0) & (reference[..., 3] > 0)
+    return float(np.abs(page[..., :3].astype(int) - reference[..., :3].astype(int))[both].mean())
+
+
+def test_several_inputs_side_by_side_share_one_camera(gl, browser, specs):
+    from reliefkit.io.inputs import load_input
+
+    both = [specs["mesh-materials"], specs["mesh"]]
+    boxes = np.array([framing_bounds(load_input(spec)) for spec in both])
+    union = np.stack([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+    with served(site_files(load_inputs(both))) as (base, _):
+        page = open_page(browser, url(base, "-100,10"))
+        assert state(page)["errors"] == []
+        for index, spec in enumerate(both):
+            iou, within = agreement(canvas_rgba(page, index), rendered(spec, "-100,10", union))
+            assert iou >= 0.99 and within >= 0.99, (spec, iou, within)
+
+
+def test_a_drag_orbits(gl, browser, specs):
+    with served(site_files(load_inputs([specs["mesh"]]))) as (base, _):
+        page = open_page(browser, url(base, "30,25"))
+        before, first = canvas_rgba(page), state(page)
+        box = page.locator("canvas").bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.mouse.move(x, y)
+        page.mouse.down()
+        page.mouse.move(x + 60, y + 20, steps=4)
+        page.mouse.up()
+        page.wait_for_function(f"window.reliefkit.frames > {first['frames']}")
+        az, el, dist = state(page)["view"]
+        assert az < 30 and el > 25
+        assert (canvas_rgba(page) != before).any()
+        query = parse_qs(urlsplit(page.url).query)  # the view stays in the URL
+        assert np.allclose([float(x) for x in query["view"][0].split(",")], [az, el, dist],
+                           atol=1e-3) and query["size"] == ["128x128"]
+        page.locator("canvas").press("ArrowUp")
+        page.wait_for_function(f"window.reliefkit.view[1] > {el}")
+        if page.evaluate("!!document.querySelector('canvas').getContext('webgl2')"
+                         ".getExtension('EXT_disjoint_timer_query_webgl2')"):
+            page.wait_for_function("window.reliefkit.gpuMs > 0")  # the readout's GPU time
+
+
+def test_a_bad_view_in_the_url_is_said(gl, browser, specs):
+    with served(site_files(load_inputs([specs["mesh"]]))) as (base, log):
+        page = open_page(browser, f"{base}?view=30")
+        shown = messages(page)
+        huge = open_page(browser, f"{base}?size=5000x5000")  # 5000² x 132 bytes of targets
+        refused = messages(huge)
+    assert shown == ["error: view must be AZ,EL or AZ,EL,DIST with |EL| < 90 (e.g. 30,25,2.6), "
+                     "got '30'"]
+    assert log[0] == "page: " + shown[0]
+    assert len(refused) == 1 and "a 5000x5000 frame needs 3148 MiB" in refused[0], refused
+
+
+def test_what_the_page_cannot_draw_yet_is_said(gl, browser, tmp_path):
+    made = sample("relief", "relief")
+    save(tmp_path / "relief.rk", made() if callable(made) else made)
+    with served(site_files(load_inputs([str(tmp_path / "relief.rk")]))) as (base, log):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert shown and all("not supported by the viewer yet" in line for line in shown)
+    assert any("not supported by the viewer yet" in line for line in log)
+
+
+def test_a_block_compressed_texture_is_said(gl, browser, tmp_path):
+    from reliefkit.compact.compact import CompressOptions, compress
+
+    made = sample("impostor", "octahedral-impostor")
+    save(tmp_path / "bc.rk", compress(made() if callable(made) else made,
+                                      CompressOptions(compress="bc")))
+    with served(site_files(load_inputs([str(tmp_path / "bc.rk")]))) as (base, _):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert len(shown) == 1 and "is block-compressed, which the viewer does not draw yet" \
+        in shown[0], shown
+
+
+def _glb_of_json(text: bytes) -> bytes:
+    body = text + b" " * (-len(text) % 4)
+    return struct.pack("<III", 0x46546C67, 2, 20 + len(body)) + \
+        struct.pack("<II", len(body), 0x4E4F534A) + body
+
+
+@pytest.mark.parametrize("data, message", [
+    (b"this is no GLB file at all", "broken.glb is not a GLB file"),
+    (_glb_of_json(b'{"asset": '), "broken.glb: its JSON chunk does not parse"),
+    (_glb_of_json(b'{"asset": {"version": "2.0"}}'),
+     "broken.glb: no RELIEFKIT_ extension (not exported by reliefkit)")])
+def test_a_broken_file_shows_its_message(gl, browser, data, message):
+    files = site_files([Input("broken.glb", "mesh", data, [[0, 0, 0], [1, 1, 1]])])
+    with served(files) as (base, log):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert len(shown) == 1 and shown[0].startswith(f"broken.glb: {message}"), shown
+    assert log == ["page: " + " ".join(shown[0].split())]
+
+
+def test_a_shader_that_does_not_compile_shows_its_message(gl, browser, specs, tmp_path):
+    (good,) = load_inputs([specs["mesh"]])
+    (tmp_path / "good.glb").write_bytes(good.glb)
+    glb = read_glb(tmp_path / "good.glb")
+    for node in glb.document["nodes"]:
+        for ext in node.get("extensions", {}).values():
+            for program in ext["draw"]["programs"]:
+                version, rest = program["fragment"].split("\n", 1)
+                program["fragment"] = f"{version}\n#error forced by the test\n{rest}"
+    broken = Input("forced.glb", "mesh", glb_bytes(glb.document, glb.binary), good.bounds)
+    with served(site_files([broken])) as (base, log):
+        page = open_page(browser, base)
+        shown = messages(page)
+    assert len(shown) == 1 and "fragment shader of core:mesh.glsl does not compile" in shown[0]
+    assert "forced by the test" in shown[0]
+    assert log == ["page: " + " ".join(shown[0].split())]

@@ -1,0 +1,41 @@
+"""The viewer's site: every input's GLB carries, for every program its plans draw with, the
+GLSL ES sources reliefkit's shader loader builds (one source of truth with the OpenGL
+path); --export-html writes all of its files or none."""
+
+from __future__ import annotations
+
+import pytest
+
+from reliefkit.errors import UsageError
+from reliefkit.export.draw import read_plans
+from reliefkit.gl.shaders import stage_sources
+from reliefkit.io.gltf.glb import read_glb
+from reliefkit.viewer.site import export_html, load_inputs, site_files
+
+
+def test_each_input_carries_the_loaders_shader_sources(tmp_path):
+    (made,) = load_inputs(["demo:cup"])
+    (tmp_path / "cup.glb").write_bytes(made.glb)
+    glb = read_glb(tmp_path / "cup.glb")
+    (node,) = glb.document["nodes"]
+    (extension,) = node["extensions"].values()
+    draw = extension["draw"]
+    embedded = {(p["program"], tuple(sorted(p["defines"].items()))): p for p in draw["programs"]}
+    plans = read_plans(glb, draw)
+    assert plans
+    for plan in plans:
+        defines = dict(sorted(dict(plan.program.defines).items()))
+        sources = stage_sources(plan.program.name, defines, es=True)
+        program = embedded[(plan.program.name, tuple(defines.items()))]
+        assert program["vertex"] == sources["vertex_shader"]
+        assert program["fragment"] == sources["fragment_shader"]
+
+
+def test_export_html_refuses_a_file_in_the_way(tmp_path):
+    files = site_files(load_inputs(["demo:cup"]))
+    (tmp_path / "site").write_text("a file")
+    with pytest.raises(UsageError, match="not a folder"):
+        export_html(files, tmp_path / "site")
+    written = export_html(files, tmp_path / "out")
+    assert {p.name for p in written} == set(files)
+    assert all(p.read_bytes() == files[p.name] for p in written)
