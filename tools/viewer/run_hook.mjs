@@ -8,7 +8,7 @@
 
 import { createInterface } from "node:readline";
 import { ndarray, typedArrayOf } from "../../web/src/hooks/ndarray.js";
-import { decodePlans } from "../../web/src/hooks/plan.js";
+import { decodePlans } from "../../web/src/plans.js";
 import { HOOKS, viewUpdate } from "../../web/src/hooks/index.js";
 
 function fromWire(a) {

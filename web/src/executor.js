@@ -78,8 +78,6 @@ export class Executor {
   check(plan) {
     if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
     if (plan.multipass && !MULTIPASS[plan.multipass.kind]) throw new Unsupported(`${plan.name}: the multi-pass kind ${plan.multipass.kind} is not supported by the viewer yet`);
-    const encoded = Object.values(plan.textures).find((t) => t.encoded || (t.levels || [t.array]).some((a) => a.encoding));
-    if (encoded) throw new Unsupported(`${plan.name}: ${encoded.what} is block-compressed, which the viewer does not draw yet`);
     if (plan.raster.depth_clamp && !this.depthClamp) throw new Unsupported(`${plan.name}: needs depth clamping, which this browser lacks (EXT_depth_clamp)`);
   }
 

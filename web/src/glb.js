@@ -65,18 +65,24 @@ export function drawOf(glb) {
 export async function readArrays(gl, glb, draw) {
   const out = {};
   for (const [name, ref] of Object.entries(draw.arrays)) {
-    const Typed = TYPED[ref.dtype];
-    if (!Typed || !Array.isArray(ref.shape)) throw new Error(`${glb.name}: array ${name} has no known dtype`);
-    const count = ref.shape.reduce((a, b) => a * b, 1);
-    let data;
-    if ('image' in ref) data = await pngValues(gl, glb, ref.image, ref.shape);
-    else if ('bufferView' in ref) data = new Typed(viewBytes(glb, ref.bufferView, count * Typed.BYTES_PER_ELEMENT, name));
-    else data = new Typed(count);
-    // an encoded array is its stored blocks with the record that decodes them (docs/gltf.md)
-    out[name] = ref.encoding ? { dtype: ref.dtype, shape: ref.shape, data, encoding: ref.encoding }
-      : { dtype: ref.dtype, shape: ref.shape, data };
+    out[name] = await readArray(gl, glb, name, ref);
+    // an encoded texture's mip levels as the GPU gets them (re-encoded: docs/gltf.md)
+    if (ref.mipLevels) out[name].mipLevels = await Promise.all(ref.mipLevels.map((level, k) => readArray(gl, glb, `${name} level ${k + 1}`, level)));
   }
   return out;
+}
+
+async function readArray(gl, glb, name, ref) {
+  const Typed = TYPED[ref.dtype];
+  if (!Typed || !Array.isArray(ref.shape)) throw new Error(`${glb.name}: array ${name} has no known dtype`);
+  const count = ref.shape.reduce((a, b) => a * b, 1);
+  let data;
+  if ('image' in ref) data = await pngValues(gl, glb, ref.image, ref.shape);
+  else if ('bufferView' in ref) data = new Typed(viewBytes(glb, ref.bufferView, count * Typed.BYTES_PER_ELEMENT, name));
+  else data = new Typed(count);
+  // an encoded array is its stored blocks with the record that decodes them (docs/gltf.md)
+  return ref.encoding ? { dtype: ref.dtype, shape: ref.shape, data, encoding: ref.encoding }
+    : { dtype: ref.dtype, shape: ref.shape, data };
 }
 
 function viewBytes(glb, index, length, name) {

@@ -8,12 +8,10 @@
 import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
 import { createContext, createTargets, Executor, Unsupported } from './executor.js';
 import { drawOf, parseGlb, readArrays } from './glb.js';
+import { HOOKS } from './hooks/index.js';
 import { decodePlans } from './plans.js';
 
 const state = window.reliefkit = { ready: false, errors: [], frames: 0 };
-// The view hooks' ports by Python function ("module:name"): web/src/hooks/index.js's HOOKS
-// once merged; until then a plan with a hook is reported as not drawn yet.
-const HOOKS = {};
 
 function report(message) {
   state.errors.push(message);

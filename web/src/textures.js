@@ -10,8 +10,32 @@ const FORMATS = { // dtype -> [internal formats by channel count, format by chan
 };
 const TARGETS = { '2d': 'TEXTURE_2D', '3d': 'TEXTURE_3D', '2d_array': 'TEXTURE_2D_ARRAY' };
 
+import { decodeEncoded } from './textures/bc.js';
+
+/** An array as the page uploads it: a block-compressed or quantized one (``encoding``)
+ *  decoded to the values `reliefkit.compact.encodings.decoded` gives (the array the Python
+ *  executor uploads where its GL lacks the format; `<sampler>_decode` stays (1, 0)). */
+function decoded(a) {
+  return a.encoding ? decodeEncoded(a.encoding, a.data) : a;
+}
+
+/** An encoded texture's mip chain as the Python executor uploads it (its blocks' levels,
+ *  docs/gltf.md `mipLevels`), each decoded; null where it has none. */
+function decodedChain(a) {
+  if (!a.encoding || !a.encoding.mipmaps || !a.mipLevels) return null;
+  const { shape, layered } = a.encoding;
+  const first = layered ? 1 : 0;
+  return [decoded(a), ...a.mipLevels.map((level, k) => {
+    const size = shape.slice();
+    size[first] = Math.max(shape[first] >> (k + 1), 1);
+    size[first + 1] = Math.max(shape[first + 1] >> (k + 1), 1);
+    return decodeEncoded({ ...a.encoding, shape: size }, level.data);
+  })];
+}
+
 export function uploadTexture(gl, t) {
-  if (t.encoded || t.array.encoding) throw new Error(`${t.what}: block-compressed textures are not drawn by the viewer yet`);
+  const chain = decodedChain(t.array);
+  t = { ...t, array: decoded(t.array), levels: chain || (t.levels && t.levels.map(decoded)) };
   const target = gl[TARGETS[t.target]];
   const levels = t.levels || [t.array];
   const { shape, dtype } = levels[0];
@@ -39,7 +63,10 @@ export function uploadTexture(gl, t) {
   const integer = dtype === 'uint16';
   const nearest = t.filter === 'nearest' || integer;
   let minify = nearest ? gl.NEAREST : gl.LINEAR;
-  if (t.levels) {
+  if (chain) { // trilinear over the given chain, as the executor samples an encoded one
+    gl.texParameteri(target, gl.TEXTURE_MAX_LEVEL, chain.length - 1);
+    minify = gl.LINEAR_MIPMAP_LINEAR;
+  } else if (t.levels) {
     gl.texParameteri(target, gl.TEXTURE_MAX_LEVEL, t.levels.length - 1);
     minify = gl.NEAREST_MIPMAP_NEAREST;
   } else if (t.mipmaps && !nearest) {

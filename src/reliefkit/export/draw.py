@@ -2,8 +2,10 @@
 
 What `render.plan.to_json` makes of the plans a drawable draws with its default options:
 ``plans``, ``geometries`` and ``textures`` as that JSON, and ``arrays``, each named array as a
-typed reference (`io.gltf.arrays`; uint8 textures as PNG images), vertex attributes and
-indices also as glTF accessors
+typed reference (`io.gltf.arrays`; uint8 textures as PNG images; an encoded texture as its
+blocks, with ``mipLevels``: the blocks of the mip levels a GPU gets, each encoded from the
+half-size average of the decoded level 0, which no browser could encode), vertex attributes
+and indices also as glTF accessors
 (``"accessor": i``) so a viewer's loader reads them as it reads any geometry. With shaders
 embedded, ``programs`` holds the GLSL ES 3.00 sources that reliefkit's shader loader builds
 for every program and define set the plans use (one source of truth with the OpenGL path).
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compact.encodings import encoding_of
 from ..errors import FormatError
 from ..gl.shaders import stage_sources
 from ..io.gltf.arrays import array_of, declared, put_array
@@ -41,6 +44,9 @@ def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False,
         ref = put_array(builder, stored, png=name in images and encoding is None)
         if encoding is not None:  # a texture's decoded values: stored as its blocks
             ref["encoding"] = encoding
+            chain = encoding_of(array).levels[1:]  # the mip levels a GPU gets, re-encoded
+            if chain:
+                ref["mipLevels"] = [put_array(builder, level) for level in chain]
         if name in geometry and _accessor_able(array):
             ref["accessor"] = builder.add_array(array)
         refs[name] = ref
