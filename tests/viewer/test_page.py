@@ -138,7 +138,10 @@ def test_the_page_draws_what_render_draws(gl, browser, mesa_browser, specs, kind
     # on Mesa's llvmpipe (what render draws with) every pixel is within 1/255
     ("shell-volume", {"composite": "opaque"}, "mesa"),
     ("shell-volume", {"composite": "opaque", "shadows": True}, "mesa"),  # depth sampler, culled
-    ("shell-volume", {"sort": "peel"}, "mesa")])  # transparent, by depth peeling: no hook
+    ("shell-volume", {"sort": "peel"}, "mesa"),  # transparent, by depth peeling: no hook
+    ("shell-volume", {"half_opacity": False}, "mesa"),  # the opaque-depth multi-pass kind
+    # the depth object's screen slices counted in a stencil buffer
+    ("depth-object", {"passes": "stencil", "slicing": "screen"}, "mesa")])
 def test_render_options_make_the_plans(gl, browser, mesa_browser, specs, kind, options,
                                        backend):
     from reliefkit.io.inputs import load_input
@@ -154,8 +157,7 @@ def test_render_options_make_the_plans(gl, browser, mesa_browser, specs, kind, o
             print(f"{kind} {options} {view}: mask IoU {iou:.4f}, {within:.2%} within 4/255")
             assert iou >= 0.99 and within >= 0.99, (view, iou, within)
             page.close()
-    # nearer the options' picture than the defaults' (depth peeling draws the default's:
-    # there the default's plans, with their view hook, would have been refused above)
+    # nearer the options' picture than the defaults' (where the two differ)
     optioned, default = rendered(spec, view, **options), rendered(spec, view)
     if not np.array_equal(optioned, default):
         assert _mean_difference(got, optioned) < _mean_difference(got, default)
