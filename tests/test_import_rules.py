@@ -160,7 +160,9 @@ def test_only_the_executor_and_the_gl_layer_touch_gl(path):
                # reads the defines a program declares (allowed_defines), makes nothing
                PACKAGE / "render" / "instancing.py": "reliefkit.gl.shaders",
                # builds GLSL ES sources for the glTF extension (stage_sources), makes nothing
-               PACKAGE / "export" / "draw.py": "reliefkit.gl.shaders"}.get(path)
+               PACKAGE / "export" / "draw.py": "reliefkit.gl.shaders",
+               # ... and the viewer page's own two programs
+               PACKAGE / "viewer" / "site.py": "reliefkit.gl.shaders"}.get(path)
     used = {m for m in uses_gl(path) if not (allowed and m.startswith(allowed))}
     assert not used, f"{path.name} uses {sorted(used)}"
 

@@ -12,7 +12,6 @@ await esbuild.build({
   bundle: true,
   format: 'esm',
   target: 'es2022',
-  loader: { '.glsl': 'text' },
   legalComments: 'none',
   logLevel: 'warning',
 });

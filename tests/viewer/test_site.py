@@ -31,6 +31,22 @@ def test_each_input_carries_the_loaders_shader_sources(tmp_path):
         assert program["fragment"] == sources["fragment_shader"]
 
 
+def test_the_page_has_no_glsl_of_its_own():
+    """Its own two programs (the picture, the depth copy) come from the shader loader in
+    inputs.json; the bundle holds no shader source."""
+    import json
+
+    files = site_files(load_inputs(["demo:cup"]))
+    programs = json.loads(files["inputs.json"])["programs"]
+    assert set(programs) == {"present", "copy_depth"}
+    for program in programs.values():
+        sources = stage_sources(program["name"], es=True)
+        assert program["vertex"] == sources["vertex_shader"]
+        assert program["fragment"] == sources["fragment_shader"]
+    bundle = files["viewer.js"].decode()
+    assert "#version" not in bundle and "gl_FragCoord" not in bundle
+
+
 def test_export_html_refuses_a_file_in_the_way(tmp_path):
     files = site_files(load_inputs(["demo:cup"]))
     (tmp_path / "site").write_text("a file")

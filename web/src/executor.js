@@ -2,7 +2,7 @@
 // the export embedded), geometry and textures are made once; a frame draws the opaque plans
 // into the AOV targets that gl/targets.py makes (colour, position + coverage, normal; a float
 // depth texture) with the uniforms the Python executor sets, then presents the picture
-// `reliefkit render` writes (present.glsl).
+// `reliefkit render` writes (shaders/viewer/present.glsl, served in inputs.json).
 
 import { cameraUniforms, modelOffset } from './camera.js';
 import { programKey, withView } from './plans.js';
@@ -11,8 +11,6 @@ import { drawWithOpaqueDepth } from './opaque_depth.js';
 import { drawShadowMapped } from './shadow_map.js';
 import { drawStencilCounted } from './stencil_count.js';
 import { uploadTexture } from './textures.js';
-import COPY_DEPTH from './copy_depth.glsl';
-import PRESENT from './present.glsl';
 
 const FRAME_ATTACHMENTS = 3;
 const MODES = { triangles: 'TRIANGLES', points: 'POINTS', lines: 'LINES', triangle_strip: 'TRIANGLE_STRIP' };
@@ -43,8 +41,9 @@ export function createContext(canvas) {
 }
 
 export class Executor {
-  /** ``hooks``: the view hooks' ports by the Python function's "module:name" (web/src/hooks/). */
-  constructor(gl, draw, name, hooks = {}) {
+  /** ``hooks``: the view hooks' ports by the Python function's "module:name" (web/src/hooks/);
+   *  ``programs``: the page's own programs (inputs.json: present, copy_depth). */
+  constructor(gl, draw, name, hooks, programs) {
     this.gl = gl;
     this.name = name;
     this.hooks = hooks;
@@ -59,8 +58,9 @@ export class Executor {
     this.timer = gl.getExtension('EXT_disjoint_timer_query_webgl2'); // GPU time, where the browser has it
     this.query = null;
     this.gpuMs = null;
-    this.present = this.link('present.glsl', sourcePair(PRESENT));
-    this.copyDepth = this.link('copy_depth.glsl', sourcePair(COPY_DEPTH));
+    // the page's own programs, built by reliefkit's shader loader (inputs.json `programs`)
+    this.present = this.link(programs.present.name, programs.present);
+    this.copyDepth = this.link(programs.copy_depth.name, programs.copy_depth);
   }
 
   /** Take ``plan`` to draw (its programs compiled); throws `Unsupported` for one it cannot
@@ -374,13 +374,6 @@ function counts(gl, plan) {
     else count = Math.min(...Object.values(g.attributes).filter((a) => !a.per_instance).map((a) => a.array.shape[0]));
   }
   return { mode: gl[MODES[g.primitive]], count, first: plan.first || 0, instances: g.instances, indexed: !!g.indices };
-}
-
-/** The GLSL ES pair of a one-file shader: VERTEX_SHADER / FRAGMENT_SHADER defined after #version. */
-function sourcePair(text) {
-  const [version, ...rest] = text.split('\n');
-  const body = rest.join('\n');
-  return { vertex: `${version}\n#define VERTEX_SHADER\n${body}`, fragment: `${version}\n#define FRAGMENT_SHADER\n${body}` };
 }
 
 function flat(value) {

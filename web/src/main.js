@@ -33,7 +33,7 @@ async function fetchOk(url) {
 }
 
 /** One input's panel: its canvas, executor, plans and targets, or its error. */
-async function openInput(input, size) {
+async function openInput(input, size, programs) {
   const panel = document.createElement('figure');
   const canvas = document.createElement('canvas');
   [canvas.width, canvas.height] = size;
@@ -49,7 +49,7 @@ async function openInput(input, size) {
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
     const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name, HOOKS);
+    const executor = new Executor(gl, draw, input.name, HOOKS, programs);
     const drawn = [];
     for (const plan of plans) {
       try {
@@ -80,7 +80,7 @@ async function main() {
   const [lightAz, lightEl] = parseView(params.get('light') || manifest.light.angles);
   const light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds = union(manifest.inputs.map((i) => i.bounds));
-  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size)))).filter(Boolean);
+  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
 
   const readout = document.getElementById('stats');
   const render = () => {

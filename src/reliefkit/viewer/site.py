@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..export.gltf import export_bytes
+from ..gl.shaders import stage_sources
 from ..io.atomic import atomic_path, written_together
 from ..io.inputs import kind_of, load_input
 from ..scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
@@ -51,8 +52,24 @@ def make_input(spec: str, obj, options: dict | None = None) -> Input:
                  framing_bounds(obj).tolist())
 
 
+#: The page's own programs (the picture it shows, the opaque depth it copies), in the core
+#: shader namespace: built as GLSL ES by the shader loader like every plan's program.
+PAGE_PROGRAMS = {"present": "core:viewer/present.glsl", "copy_depth": "core:viewer/copy_depth.glsl"}
+
+
+def page_programs() -> dict:
+    """Each of `PAGE_PROGRAMS` as its GLSL ES vertex and fragment sources."""
+    out = {}
+    for key, name in PAGE_PROGRAMS.items():
+        sources = stage_sources(name, es=True)
+        out[key] = {"name": name, "vertex": sources["vertex_shader"],
+                    "fragment": sources["fragment_shader"]}
+    return out
+
+
 def manifest(inputs: list[Input]) -> dict:
-    """inputs.json: the inputs and the defaults of `reliefkit render` the page uses."""
+    """inputs.json: the inputs, the page's own programs and the defaults of `reliefkit render`
+    the page uses."""
     light = DirectionalLight().uniforms()
     light.pop("u_light_dir")  # the page computes it from the angles (`--light`)
     az, el, _ = DEFAULT_VIEW
@@ -62,7 +79,8 @@ def manifest(inputs: list[Input]) -> dict:
                        "default_size": f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}",
                        "fov": DEFAULT_FOV, "fit_margin": FIT_MARGIN},
             "light": {"angles": ",".join(f"{a:g}" for a in DEFAULT_LIGHT_ANGLES),
-                      "uniforms": light}}
+                      "uniforms": light},
+            "programs": page_programs()}
 
 
 def site_files(inputs: list[Input]) -> dict[str, bytes]:

@@ -1158,12 +1158,6 @@ function uploadTexture(gl, t) {
   return { tex, target };
 }
 
-// web/src/copy_depth.glsl
-var copy_depth_default = "#version 300 es\n// The opaque pass's depth as a float colour (render/multipass/opaque_depth.py: a transparent\n// plan samples it while the depth attachment itself is being tested). VERTEX_SHADER /\n// FRAGMENT_SHADER pick the stage.\nprecision highp float;\n#ifdef VERTEX_SHADER\nvoid main() {  // one full-screen triangle\n    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n}\n#else\nuniform highp sampler2D u_depth;\nout vec4 f_out;\n\nvoid main() {\n    f_out = vec4(texelFetch(u_depth, ivec2(gl_FragCoord.xy), 0).r);\n}\n#endif\n";
-
-// web/src/present.glsl
-var present_default = "#version 300 es\n// The picture `reliefkit render` writes (render/frame.py frame_from_passes, Frame.rgba8,\n// colorspace.to_rgba8): the opaque pass's colour where it covered a pixel (position.w > 0.5),\n// under the transparent pass's premultiplied colour, straight again and sRGB-encoded;\n// transparent where neither drew. VERTEX_SHADER / FRAGMENT_SHADER pick the stage.\nprecision highp float;\n#ifdef VERTEX_SHADER\nvoid main() {  // one full-screen triangle\n    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n}\n#else\nuniform sampler2D u_color;\nuniform sampler2D u_position;\nuniform sampler2D u_transparent;  // premultiplied, accumulated front to back\nout vec4 f_out;\n\nvec3 srgb_encode(vec3 x) {\n    x = clamp(x, 0.0, 1.0);\n    return mix(1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, 12.92 * x, lessThanEqual(x, vec3(0.0031308)));\n}\n\nvoid main() {\n    ivec2 p = ivec2(gl_FragCoord.xy);\n    bool covered = texelFetch(u_position, p, 0).w > 0.5;\n    vec4 opaque = covered ? texelFetch(u_color, p, 0) : vec4(0.0);\n    vec4 front = texelFetch(u_transparent, p, 0);\n    float alpha = front.a + (1.0 - front.a) * opaque.a;\n    vec3 rgb = front.rgb + (1.0 - front.a) * opaque.rgb * opaque.a;\n    vec3 straight = alpha > 0.0 ? rgb / alpha : vec3(0.0);\n    f_out = covered || front.a > 0.0 ? vec4(srgb_encode(straight), clamp(alpha, 0.0, 1.0))\n                                     : vec4(0.0);\n}\n#endif\n";
-
 // web/src/executor.js
 var FRAME_ATTACHMENTS = 3;
 var MODES = { triangles: "TRIANGLES", points: "POINTS", lines: "LINES", triangle_strip: "TRIANGLE_STRIP" };
@@ -1188,8 +1182,9 @@ function createContext(canvas) {
   return gl;
 }
 var Executor = class {
-  /** ``hooks``: the view hooks' ports by the Python function's "module:name" (web/src/hooks/). */
-  constructor(gl, draw, name, hooks = {}) {
+  /** ``hooks``: the view hooks' ports by the Python function's "module:name" (web/src/hooks/);
+   *  ``programs``: the page's own programs (inputs.json: present, copy_depth). */
+  constructor(gl, draw, name, hooks, programs) {
     this.gl = gl;
     this.name = name;
     this.hooks = hooks;
@@ -1204,8 +1199,8 @@ var Executor = class {
     this.timer = gl.getExtension("EXT_disjoint_timer_query_webgl2");
     this.query = null;
     this.gpuMs = null;
-    this.present = this.link("present.glsl", sourcePair(present_default));
-    this.copyDepth = this.link("copy_depth.glsl", sourcePair(copy_depth_default));
+    this.present = this.link(programs.present.name, programs.present);
+    this.copyDepth = this.link(programs.copy_depth.name, programs.copy_depth);
   }
   /** Take ``plan`` to draw (its programs compiled); throws `Unsupported` for one it cannot
    *  draw yet, or an Error (a shader that does not compile). */
@@ -1493,15 +1488,6 @@ function counts(gl, plan) {
     else count = Math.min(...Object.values(g.attributes).filter((a) => !a.per_instance).map((a) => a.array.shape[0]));
   }
   return { mode: gl[MODES[g.primitive]], count, first: plan.first || 0, instances: g.instances, indexed: !!g.indices };
-}
-function sourcePair(text) {
-  const [version, ...rest] = text.split("\n");
-  const body = rest.join("\n");
-  return { vertex: `${version}
-#define VERTEX_SHADER
-${body}`, fragment: `${version}
-#define FRAGMENT_SHADER
-${body}` };
 }
 function flat(value) {
   if (value && value.data && value.shape) return Array.from(value.data, Number);
@@ -2897,7 +2883,7 @@ async function fetchOk(url) {
   if (!response.ok) throw new Error(`cannot load ${url} (${response.status} ${response.statusText})`);
   return response;
 }
-async function openInput(input, size) {
+async function openInput(input, size, programs) {
   const panel = document.createElement("figure");
   const canvas = document.createElement("canvas");
   [canvas.width, canvas.height] = size;
@@ -2913,7 +2899,7 @@ async function openInput(input, size) {
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
     const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name, HOOKS);
+    const executor = new Executor(gl, draw, input.name, HOOKS, programs);
     const drawn = [];
     for (const plan of plans) {
       try {
@@ -2942,7 +2928,7 @@ async function main() {
   const [lightAz, lightEl] = parseView(params.get("light") || manifest.light.angles);
   const light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds2 = union(manifest.inputs.map((i) => i.bounds));
-  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size)))).filter(Boolean);
+  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
   const readout = document.getElementById("stats");
   const render = () => {
     const start = performance.now();
