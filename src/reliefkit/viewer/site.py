@@ -46,9 +46,10 @@ def load_inputs(specs) -> list[Input]:
 def make_input(spec: str, obj, options: dict | None = None) -> Input:
     """``obj`` (loaded from ``spec``) exported in memory with its draw plans, made with the
     render ``options`` it declares (checked by the caller), and their GLSL ES sources; no
-    fallback mesh: the page draws the plans."""
+    fallback mesh: the page draws the plans (and, where it counts them, the iteration-counting
+    plans of its heat map)."""
     return Input(str(spec), kind_of(obj), export_bytes(obj, fallback=False, embed_shaders=True,
-                                                       options=options),
+                                                       options=options, instrumented=True),
                  framing_bounds(obj).tolist())
 
 
