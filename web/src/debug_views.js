@@ -106,10 +106,21 @@ export class DebugViews {
     return [this.reference, ...panels.filter((p) => p !== this.reference)];
   }
 
+  /** The view ``p`` shows now: the current one, or the picture where it cannot. */
+  shown(p) {
+    return this.unavailable(p) ? 'picture' : this.mode;
+  }
+
+  /** The executor that draws ``p`` now (its GPU time is the panel's). */
+  executor(p) {
+    return this.shown(p) === 'iterations' ? p.counting.executor : p.executor;
+  }
+
   /** Draw panel ``p`` from ``camera`` and show the current view. */
   draw(p, camera, light) {
-    const mode = this.unavailable(p) ? 'picture' : this.mode;
-    const { executor, plans, targets } = mode === 'iterations' ? { ...p.counting } : p;
+    const mode = this.shown(p);
+    const { plans, targets } = mode === 'iterations' ? p.counting : p;
+    const executor = this.executor(p);
     executor.frame(plans, camera, light, targets, (drawn) => this.presenting(p, mode, drawn, camera));
   }
 

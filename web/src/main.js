@@ -82,7 +82,7 @@ async function main() {
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start; // the CPU's clock around the draws and a read back
     const shown = () => {
-      const gpu = panels.map((p) => p.executor.gpuTime());
+      const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
       readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
         + `frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? '' : `, GPU ${state.gpuMs.toFixed(2)} ms`);

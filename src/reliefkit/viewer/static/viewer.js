@@ -2969,10 +2969,19 @@ var DebugViews = class {
     if (this.mode !== "mask" || !this.reference) return panels;
     return [this.reference, ...panels.filter((p) => p !== this.reference)];
   }
+  /** The view ``p`` shows now: the current one, or the picture where it cannot. */
+  shown(p) {
+    return this.unavailable(p) ? "picture" : this.mode;
+  }
+  /** The executor that draws ``p`` now (its GPU time is the panel's). */
+  executor(p) {
+    return this.shown(p) === "iterations" ? p.counting.executor : p.executor;
+  }
   /** Draw panel ``p`` from ``camera`` and show the current view. */
   draw(p, camera, light) {
-    const mode = this.unavailable(p) ? "picture" : this.mode;
-    const { executor, plans, targets } = mode === "iterations" ? { ...p.counting } : p;
+    const mode = this.shown(p);
+    const { plans, targets } = mode === "iterations" ? p.counting : p;
+    const executor = this.executor(p);
     executor.frame(plans, camera, light, targets, (drawn) => this.presenting(p, mode, drawn, camera));
   }
   /** present.glsl's uniforms and textures of ``mode`` for the panel's drawn ``targets``. */
@@ -3105,7 +3114,7 @@ async function main() {
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start;
     const shown = () => {
-      const gpu = panels.map((p) => p.executor.gpuTime());
+      const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
       readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? "" : `, GPU ${state.gpuMs.toFixed(2)} ms`);
     };
