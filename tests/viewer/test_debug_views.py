@@ -5,6 +5,8 @@ metrics.error_image colours it); a panel that cannot show one says why."""
 
 from __future__ import annotations
 
+from urllib.parse import parse_qs, urlsplit
+
 import numpy as np
 import pytest
 from browser import canvas_rgba, launch, open_page, playwright, served, state
@@ -51,17 +53,23 @@ def both(gl, browser, relief):
     counted = render(load_input(relief), camera, light=light, count_iterations=True)
     with served(site_files(load_inputs(specs))) as (base, log):
         page = open_page(browser, f"{base}?view={VIEW}&size={SIZE[0]}x{SIZE[1]}&debug=normals")
-        yield {"page": page, "frames": frames, "counted": counted, "camera": camera,
+        yield {"page": page, "opened": state(page), "frames": frames, "counted": counted,
+               "camera": camera,
                "radius": float(np.linalg.norm(union[1] - union[0]) / 2), "log": log}
         page.close()
 
 
 def show(page, mode: str) -> None:
-    """Pick ``mode`` in the page's selector and wait for the frame drawn with it."""
+    """Pick ``mode`` in the page's selector and wait for the frame drawn with it; the URL
+    follows."""
     frames = state(page)["frames"]
+    if state(page)["debug"]["mode"] == mode:
+        return
     page.select_option("#debug-views select", mode)
     page.wait_for_function(f"window.reliefkit.frames > {frames}")
     assert state(page)["debug"]["mode"] == mode
+    query = parse_qs(urlsplit(page.url).query)
+    assert query.get("debug") == (None if mode == "picture" else [mode])
 
 
 def agreement(page: np.ndarray, covered: np.ndarray, rgb: np.ndarray) -> tuple[float, float]:
@@ -76,8 +84,8 @@ def agreement(page: np.ndarray, covered: np.ndarray, rgb: np.ndarray) -> tuple[f
 
 def test_normals(both):
     page = both["page"]
-    assert state(page)["debug"]["mode"] == "normals" and state(page)["errors"] == []
-    assert "debug=normals" in page.url
+    assert both["opened"]["debug"]["mode"] == "normals" and both["opened"]["errors"] == []
+    show(page, "normals")
     for index, frame in enumerate(both["frames"]):
         iou, within = agreement(canvas_rgba(page, index), frame.mask, frame.normal * 0.5 + 0.5)
         print(f"normals, panel {index}: IoU {iou:.4f}, {within:.2%} within 4/255")
@@ -131,6 +139,11 @@ def test_mask(both):
     assert same >= 0.99 and (got[..., 3] == 255).all()
     assert (got[..., 0] > 0).any() and (got[..., 2] > 0).any()  # both differences are seen
     assert state(page)["errors"] == [] and both["log"] == []
+    show(page, "picture")  # and back
+    for index, frame in enumerate(both["frames"]):
+        want = frame.rgba8()
+        iou, within = agreement(canvas_rgba(page, index), want[..., 3] > 0, want[..., :3] / 255)
+        assert iou >= 0.99 and within >= 0.99
 
 
 def test_mask_without_a_mesh_says_so(gl, browser, relief):
