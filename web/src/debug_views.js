@@ -40,10 +40,11 @@ export class DebugViews {
       report(`error: debug must be one of ${Object.keys(MODES).join(', ')}, got '${mode}'`);
       mode = 'picture';
     }
-    this.selector = this.makeSelector(mode);
+    this.makeSelector(mode);
     this.ready = this.select(mode);
   }
 
+  /** The selector above the pictures, showing ``mode``. */
   makeSelector(mode) {
     const label = document.createElement('label');
     label.id = 'debug-views';
@@ -53,7 +54,6 @@ export class DebugViews {
     select.addEventListener('change', () => this.select(select.value).then(() => this.onChange()));
     label.appendChild(select);
     document.getElementById('panels').before(label);
-    return select;
   }
 
   /** Switch to ``mode``: the URL follows; the instrumented plans are made when first needed. */
@@ -64,6 +64,7 @@ export class DebugViews {
     else this.params.set('debug', mode);
     if (mode === 'iterations') {
       await Promise.all(this.panels.map((p) => this.counting(p)));
+      if (this.mode !== mode) return; // another view was picked meanwhile
     }
     for (const p of this.panels) {
       const reference = mode === 'mask' && p === this.reference ? 'the reference of the mask difference' : '';

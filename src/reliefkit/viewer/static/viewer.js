@@ -2910,9 +2910,10 @@ var DebugViews = class {
       report2(`error: debug must be one of ${Object.keys(MODES2).join(", ")}, got '${mode}'`);
       mode = "picture";
     }
-    this.selector = this.makeSelector(mode);
+    this.makeSelector(mode);
     this.ready = this.select(mode);
   }
+  /** The selector above the pictures, showing ``mode``. */
   makeSelector(mode) {
     const label = document.createElement("label");
     label.id = "debug-views";
@@ -2922,7 +2923,6 @@ var DebugViews = class {
     select.addEventListener("change", () => this.select(select.value).then(() => this.onChange()));
     label.appendChild(select);
     document.getElementById("panels").before(label);
-    return select;
   }
   /** Switch to ``mode``: the URL follows; the instrumented plans are made when first needed. */
   async select(mode) {
@@ -2932,6 +2932,7 @@ var DebugViews = class {
     else this.params.set("debug", mode);
     if (mode === "iterations") {
       await Promise.all(this.panels.map((p) => this.counting(p)));
+      if (this.mode !== mode) return;
     }
     for (const p of this.panels) {
       const reference = mode === "mask" && p === this.reference ? "the reference of the mask difference" : "";
