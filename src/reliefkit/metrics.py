@@ -317,6 +317,12 @@ def heat_ramp(values) -> np.ndarray:
     return ((1.0 - f) * _RAMP[i] + f * _RAMP[i + 1]).astype(np.float32)
 
 
+def heat_ramp_stops() -> np.ndarray:
+    """The colours `heat_ramp` interpolates between, at 0, 1/(n-1), ..., 1: (n, 3) float32
+    (what the viewer's shaders get, so the ramp has one source)."""
+    return _RAMP.astype(np.float32)
+
+
 def _check_scale(scale) -> float:
     if not (math.isfinite(scale) and scale > 0):
         raise UsageError(f"scale must be a positive finite number, got {scale!r}")

@@ -40,7 +40,7 @@ def test_the_page_has_no_glsl_of_its_own():
     programs = json.loads(files["inputs.json"])["programs"]
     assert set(programs) == {"present", "copy_depth"}
     for program in programs.values():
-        sources = stage_sources(program["name"], es=True)
+        sources = stage_sources(program["name"], program["defines"], es=True)
         assert program["vertex"] == sources["vertex_shader"]
         assert program["fragment"] == sources["fragment_shader"]
     bundle = files["viewer.js"].decode()

@@ -162,8 +162,10 @@ export class Executor {
   }
 
   /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas: the
-   *  opaque pass, then the transparent plans front to back (gl/targets.py draw_passes). */
-  frame(plans, camera, light, targets) {
+   *  opaque pass, then the transparent plans front to back (gl/targets.py draw_passes).
+   *  ``presenting(targets)``, called once they are drawn, gives present.glsl's further
+   *  uniforms and textures (a debug view's: web/src/debug_views.js). */
+  frame(plans, camera, light, targets, presenting = () => ({})) {
     const gl = this.gl;
     const [w, h] = camera.size;
     const pass = (fbo) => () => {
@@ -179,7 +181,7 @@ export class Executor {
     }
     opaque();
     gl.depthMask(true);
-    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    for (let i = 0; i < targets.attachments; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
     gl.clearBufferfv(gl.DEPTH, 0, [1]);
     for (const plan of plans.filter((p) => p.render_pass === 'opaque')) this.draw(plan, camera, light, opaque);
     transparent();
@@ -192,12 +194,13 @@ export class Executor {
       this.draw(plan, camera, light, transparent, { uniforms: front, targets });
     }
     if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
+    const { uniforms = {}, textures = {} } = presenting(targets);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     this.setRaster({ depth_test: false, cull: 'none', blend: 'none', depth_write: false });
     gl.useProgram(this.present.prog);
-    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position, u_transparent: targets.transparent });
-    for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
+    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position, u_transparent: targets.transparent, ...textures });
+    for (const [name, value] of Object.entries({ u_debug: 0, ...uniforms, ...samplers })) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
@@ -317,11 +320,13 @@ export class Executor {
 
 const MAX_TARGET_BYTES = 1 << 30; // the float AOV targets of one canvas
 
-/** The AOV targets of a WxH frame (gl/targets.py render_target), sizes checked first. */
-export function createTargets(gl, [w, h]) {
+/** The AOV targets of a WxH frame (gl/targets.py render_target), sizes checked first;
+ *  ``extra`` more RGBA32F attachments in the opaque pass (1: the iteration counts of the
+ *  instrumented plans, `iterations`). */
+export function createTargets(gl, [w, h], extra = 0) {
   const side = gl.getParameter(gl.MAX_TEXTURE_SIZE);
   // RGBA32F: both passes' attachments, the depth copy and the front opacity; float depth
-  const bytes = w * h * ((2 * FRAME_ATTACHMENTS + 2) * 16 + 4);
+  const bytes = w * h * ((2 * FRAME_ATTACHMENTS + extra + 2) * 16 + 4);
   if (w > side || h > side || bytes > MAX_TARGET_BYTES) {
     throw new Error(`a ${w}x${h} frame needs ${Math.ceil(bytes / 2 ** 20)} MiB of float render targets `
       + `(limits: ${side} texels a side, ${MAX_TARGET_BYTES / 2 ** 20} MiB): ask for a smaller size`);
@@ -334,7 +339,7 @@ export function createTargets(gl, [w, h]) {
     gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
     return { tex, target: gl.TEXTURE_2D };
   };
-  const attachments = [...Array(FRAME_ATTACHMENTS).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
+  const attachments = (n) => [...Array(n).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
   const framebuffer = (colors, depth) => {
     const fbo = gl.createFramebuffer();
     gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
@@ -353,15 +358,15 @@ export function createTargets(gl, [w, h]) {
     for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
     return { tex, target: gl.TEXTURE_2D };
   })();
-  const [fbo, [color, position]] = framebuffer(attachments, depth);
+  const [fbo, [color, position, normal, iterations]] = framebuffer(attachments(FRAME_ATTACHMENTS + extra), depth);
   // the transparent pass shares the opaque depth (tested, never written)
-  const [transparentFbo, [transparent]] = framebuffer(attachments, depth);
+  const [transparentFbo, [transparent]] = framebuffer(attachments(FRAME_ATTACHMENTS), depth);
   const [depthCopyFbo, [depthCopy]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
   const [frontFbo, [frontOpacity]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
   gl.bindFramebuffer(gl.FRAMEBUFFER, frontFbo);
   gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-  return { fbo, color, position, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h] };
+  return { fbo, color, position, normal, iterations, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h], attachments: FRAME_ATTACHMENTS + extra };
 }
 
 /** render/executor.py _counts. */

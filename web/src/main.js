@@ -2,14 +2,15 @@
 // framing bounds) drawn side by side from one camera by the WebGL2 executor. The view is in
 // the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL, kept up to date); a drag (mouse or touch)
 // or the arrow keys orbit, the wheel or + and - zoom.
+// ?debug=normals|depth|iterations|mask shows a debug view instead (debug_views.js).
 // window.reliefkit.ready turns true after the first complete frame; errors show in the page
 // and are posted to the server's log.
 
 import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
-import { createContext, createTargets, Executor, Unsupported } from './executor.js';
-import { drawOf, parseGlb, readArrays } from './glb.js';
-import { HOOKS } from './hooks/index.js';
-import { decodePlans } from './plans.js';
+import { DebugViews } from './debug_views.js';
+import { makeDrawable } from './drawable.js';
+import { createContext, createTargets } from './executor.js';
+import { drawOf, parseGlb } from './glb.js';
 
 const state = window.reliefkit = { ready: false, errors: [], frames: 0 };
 
@@ -48,19 +49,8 @@ async function openInput(input, size, programs) {
     canvas.addEventListener('webglcontextlost', () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
-    const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name, HOOKS, programs);
-    const drawn = [];
-    for (const plan of plans) {
-      try {
-        executor.add(plan);
-        drawn.push(plan);
-      } catch (e) {
-        if (!(e instanceof Unsupported)) throw e;
-        report(`${input.name}: ${e.message}`);
-      }
-    }
-    return { canvas, executor, plans: drawn, targets: createTargets(gl, size) };
+    const { executor, plans } = await makeDrawable(gl, glb, draw, input.name, programs, report);
+    return { canvas, executor, plans, targets: createTargets(gl, size), input, gl, glb, draw, panel };
   } catch (e) {
     report(`${input.name}: ${e.message}`);
     return null;
@@ -81,17 +71,18 @@ async function main() {
   const light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds = union(manifest.inputs.map((i) => i.bounds));
   const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
+  const debug = new DebugViews(params, manifest, panels, report);
 
   const readout = document.getElementById('stats');
   const render = () => {
     const start = performance.now();
     const camera = orbitBounds(bounds, az, el, dist, size, frame);
     dist = camera.distance;
-    for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
+    for (const p of debug.order(panels)) debug.draw(p, camera, light);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start; // the CPU's clock around the draws and a read back
     const shown = () => {
-      const gpu = panels.map((p) => p.executor.gpuTime());
+      const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
       readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
         + `frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? '' : `, GPU ${state.gpuMs.toFixed(2)} ms`);
@@ -111,6 +102,7 @@ async function main() {
       requestAnimationFrame(() => { pending = false; render(); });
     }
   };
+  debug.onChange = redraw;
   for (const p of panels) {
     p.canvas.addEventListener('pointerdown', (e) => p.canvas.setPointerCapture(e.pointerId));
     p.canvas.addEventListener('pointermove', (e) => {
@@ -136,6 +128,7 @@ async function main() {
       redraw();
     }, { passive: false });
   }
+  await debug.ready;
   render();
 }
 

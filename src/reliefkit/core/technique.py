@@ -79,7 +79,8 @@ class DrawableSpec:
     instance. ``instrument`` asks for the iteration-counting variant (the core reads the
     counters back, see `reliefkit.gl.targets`). The drawable returned has ``plans`` (its
     `render.plan.DrawPlan` list, which the executor draws), optionally
-    ``extra_attachments`` (int), ``sort_distance(camera)`` (transparent drawables),
+    ``extra_attachments`` (int), ``counts_iterations`` (False: its instrumented variant
+    counts fragments, no loop iterations), ``sort_distance(camera)`` (transparent drawables),
     ``finish(frame, stats)`` (``stats``: its view hooks' for that frame) and ``timed``
     (True: ``stats`` also has the wall time of its draw calls, ``draw_seconds``).
     """

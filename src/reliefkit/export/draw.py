@@ -26,17 +26,40 @@ from ..io.rk import decoded_array, stored_form
 from ..render.plan import from_json, to_json
 from ..render.registry import make_drawables
 
-__all__ = ["draw_extension", "read_plans"]
+__all__ = ["counts_iterations", "draw_extension", "read_plans"]
 
 _ACCESSOR_WIDTHS = (1, 2, 3, 4, 16)
 
 
 def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False,
-                   options: dict | None = None) -> dict:
+                   options: dict | None = None, instrumented: bool = False) -> dict:
     """The ``draw`` object of ``rep``'s extension (see the module): its plans with its
-    render defaults, or with ``options`` (render options it declares: `reliefkit view`)."""
-    (drawable,) = make_drawables([rep], dict(options or {}))
-    document, arrays = to_json(drawable.plans)
+    render defaults, or with ``options`` (render options it declares: `reliefkit view`).
+    ``instrumented`` adds ``instrumented``: the same form for the iteration-counting variant
+    (`render(..., count_iterations=True)`), where ``rep``'s drawable counts loop iterations
+    (the page's heat map); its arrays equal to the plain plans' are stored once."""
+    options = dict(options or {})
+    (drawable,) = make_drawables([rep], options)
+    out = _plans_object(builder, drawable.plans, embed_shaders)
+    if instrumented:
+        (counting,) = make_drawables([rep], options, instrument=True)
+        if counts_iterations(counting):
+            out["instrumented"] = _plans_object(builder, counting.plans, embed_shaders)
+    return out
+
+
+def counts_iterations(drawable) -> bool:
+    """Whether ``drawable`` (made with ``instrument=True``) writes loop counts: an extra
+    attachment, and a shader with a loop (a mesh's or billboard cloud's counts only
+    fragments: ``counts_iterations = False``)."""
+    return bool(getattr(drawable, "extra_attachments", 0)) and \
+        getattr(drawable, "counts_iterations", True)
+
+
+def _plans_object(builder: GlbBuilder, plans, embed_shaders: bool) -> dict:
+    """``plans`` as `render.plan.to_json`'s document with its arrays as typed references
+    (and the programs' GLSL ES sources)."""
+    document, arrays = to_json(plans)
     geometry, images = _geometry_arrays(document), _texture_arrays(document)
     refs = {}
     for name, array in arrays.items():
@@ -52,7 +75,7 @@ def draw_extension(builder: GlbBuilder, rep, *, embed_shaders: bool = False,
         refs[name] = ref
     out = {**document, "arrays": refs}
     if embed_shaders:
-        out["programs"] = _programs(drawable.plans)
+        out["programs"] = _programs(plans)
     return out
 
 

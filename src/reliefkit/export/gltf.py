@@ -60,13 +60,15 @@ def fallback_of(rep, triangles: int) -> RenderMesh:
 def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
                         fallback_triangles: int = DEFAULT_FALLBACK_TRIANGLES,
                         embed_shaders: bool = False, source_hash: str | None = None,
-                        name: str | None = None, options: dict | None = None) -> int:
+                        name: str | None = None, options: dict | None = None,
+                        instrumented: bool = False) -> int:
     """Add ``rep``'s node (extension, extras, the fallback as its child) to the builder's
-    document; the node's index. ``options``: render options its draw plans are made with."""
+    document; the node's index. ``options``: render options its draw plans are made with;
+    ``instrumented``: add the iteration-counting plans (`draw_extension`)."""
     codec, arrays, params = rk.prepare(rep)
     extension = representation_extension(builder, codec, arrays, params)
     extension["draw"] = draw_extension(builder, rep, embed_shaders=embed_shaders,
-                                       options=options)
+                                       options=options, instrumented=instrumented)
     ext_name = extension_name(codec.kind)
     report = rep.bake_report() if hasattr(rep, "bake_report") else []
     node = {"name": name or codec.kind, "extensions": {ext_name: extension},
@@ -130,10 +132,12 @@ def export(rep, path, *, fallback: bool = True,
 
 
 def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False,
-                 options: dict | None = None) -> bytes:
+                 options: dict | None = None, instrumented: bool = False) -> bytes:
     """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves),
-    its draw plans made with the render ``options`` it declares."""
+    its draw plans made with the render ``options`` it declares; ``instrumented`` adds the
+    iteration-counting plans (the page's heat map)."""
     builder = _generated(GlbBuilder())
     _one_scene(builder, [representation_node(builder, rep, fallback=fallback,
-                                             embed_shaders=embed_shaders, options=options)])
+                                             embed_shaders=embed_shaders, options=options,
+                                             instrumented=instrumented)])
     return builder.glb()

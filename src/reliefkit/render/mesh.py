@@ -49,6 +49,9 @@ class MeshDrawable:
     """A RenderMesh as draw plans: one vertex and index array, one plan per material (its
     triangles are a contiguous range of the indices), one texture per distinct image."""
 
+    #: its instrumented variant counts fragments only: its shader has no loop
+    counts_iterations = False
+
     def __init__(self, mesh: RenderMesh, options: MeshRenderOptions | None = None,
                  instrument: bool = False):
         self.mesh = mesh

@@ -19,6 +19,7 @@ from ..export.gltf import export_bytes
 from ..gl.shaders import stage_sources
 from ..io.atomic import atomic_path, written_together
 from ..io.inputs import kind_of, load_input
+from ..metrics import heat_ramp_stops
 from ..scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
 from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW, FIT_MARGIN, framing_bounds
 
@@ -46,30 +47,34 @@ def load_inputs(specs) -> list[Input]:
 def make_input(spec: str, obj, options: dict | None = None) -> Input:
     """``obj`` (loaded from ``spec``) exported in memory with its draw plans, made with the
     render ``options`` it declares (checked by the caller), and their GLSL ES sources; no
-    fallback mesh: the page draws the plans."""
+    fallback mesh: the page draws the plans (and, where it counts them, the iteration-counting
+    plans of its heat map)."""
     return Input(str(spec), kind_of(obj), export_bytes(obj, fallback=False, embed_shaders=True,
-                                                       options=options),
+                                                       options=options, instrumented=True),
                  framing_bounds(obj).tolist())
 
 
-#: The page's own programs (the picture it shows, the opaque depth it copies), in the core
-#: shader namespace: built as GLSL ES by the shader loader like every plan's program.
-PAGE_PROGRAMS = {"present": "core:viewer/present.glsl", "copy_depth": "core:viewer/copy_depth.glsl"}
+#: The page's own programs (the picture or a debug view it shows, the opaque depth it
+#: copies), in the core shader namespace: built as GLSL ES by the shader loader like every
+#: plan's program, with the defines each takes.
+PAGE_PROGRAMS = {
+    "present": ("core:viewer/present.glsl", {"HEAT_RAMP_STOPS": len(heat_ramp_stops())}),
+    "copy_depth": ("core:viewer/copy_depth.glsl", {})}
 
 
 def page_programs() -> dict:
     """Each of `PAGE_PROGRAMS` as its GLSL ES vertex and fragment sources."""
     out = {}
-    for key, name in PAGE_PROGRAMS.items():
-        sources = stage_sources(name, es=True)
-        out[key] = {"name": name, "vertex": sources["vertex_shader"],
+    for key, (name, defines) in PAGE_PROGRAMS.items():
+        sources = stage_sources(name, defines, es=True)
+        out[key] = {"name": name, "defines": defines, "vertex": sources["vertex_shader"],
                     "fragment": sources["fragment_shader"]}
     return out
 
 
 def manifest(inputs: list[Input]) -> dict:
     """inputs.json: the inputs, the page's own programs and the defaults of `reliefkit render`
-    the page uses."""
+    the page uses (camera, light, the heat ramp of `reliefkit.metrics`)."""
     light = DirectionalLight().uniforms()
     light.pop("u_light_dir")  # the page computes it from the angles (`--light`)
     az, el, _ = DEFAULT_VIEW
@@ -80,7 +85,9 @@ def manifest(inputs: list[Input]) -> dict:
                        "fov": DEFAULT_FOV, "fit_margin": FIT_MARGIN},
             "light": {"angles": ",".join(f"{a:g}" for a in DEFAULT_LIGHT_ANGLES),
                       "uniforms": light},
-            "programs": page_programs()}
+            "programs": page_programs(),
+            # the debug views' heat ramp (metrics.heat_ramp), u_heat_ramp of present.glsl
+            "heat_ramp": heat_ramp_stops().tolist()}
 
 
 def site_files(inputs: list[Input]) -> dict[str, bytes]:

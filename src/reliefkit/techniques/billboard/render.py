@@ -51,6 +51,9 @@ def cloud_plan(cloud: BillboardCloud, instrument: bool = False) -> DrawPlan:
 class BillboardCloudDrawable:
     """A BillboardCloud as its draw plan (`cloud_plan`)."""
 
+    #: its instrumented variant counts fragments only: its shader has no loop
+    counts_iterations = False
+
     def __init__(self, cloud: BillboardCloud, options=None, instrument: bool = False):
         self.cloud = cloud
         self.extra_attachments = 1 if instrument else 0

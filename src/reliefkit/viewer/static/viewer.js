@@ -1294,8 +1294,10 @@ var Executor = class {
     return this.textures.get(t);
   }
   /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas: the
-   *  opaque pass, then the transparent plans front to back (gl/targets.py draw_passes). */
-  frame(plans, camera, light, targets) {
+   *  opaque pass, then the transparent plans front to back (gl/targets.py draw_passes).
+   *  ``presenting(targets)``, called once they are drawn, gives present.glsl's further
+   *  uniforms and textures (a debug view's: web/src/debug_views.js). */
+  frame(plans, camera, light, targets, presenting = () => ({})) {
     const gl = this.gl;
     const [w, h] = camera.size;
     const pass = (fbo) => () => {
@@ -1311,7 +1313,7 @@ var Executor = class {
     }
     opaque();
     gl.depthMask(true);
-    for (let i = 0; i < FRAME_ATTACHMENTS; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
+    for (let i = 0; i < targets.attachments; i++) gl.clearBufferfv(gl.COLOR, i, [0, 0, 0, 0]);
     gl.clearBufferfv(gl.DEPTH, 0, [1]);
     for (const plan of plans.filter((p) => p.render_pass === "opaque")) this.draw(plan, camera, light, opaque);
     transparent();
@@ -1323,12 +1325,13 @@ var Executor = class {
       this.draw(plan, camera, light, transparent, { uniforms: front, targets });
     }
     if (timing) gl.endQuery(this.timer.TIME_ELAPSED_EXT);
+    const { uniforms = {}, textures = {} } = presenting(targets);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, w, h);
     this.setRaster({ depth_test: false, cull: "none", blend: "none", depth_write: false });
     gl.useProgram(this.present.prog);
-    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position, u_transparent: targets.transparent });
-    for (const [name, value] of Object.entries(samplers)) setUniform(gl, this.present, name, value);
+    const samplers = this.bindTextures({ u_color: targets.color, u_position: targets.position, u_transparent: targets.transparent, ...textures });
+    for (const [name, value] of Object.entries({ u_debug: 0, ...uniforms, ...samplers })) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
@@ -1437,9 +1440,9 @@ var Executor = class {
   }
 };
 var MAX_TARGET_BYTES = 1 << 30;
-function createTargets(gl, [w, h]) {
+function createTargets(gl, [w, h], extra = 0) {
   const side = gl.getParameter(gl.MAX_TEXTURE_SIZE);
-  const bytes = w * h * ((2 * FRAME_ATTACHMENTS + 2) * 16 + 4);
+  const bytes = w * h * ((2 * FRAME_ATTACHMENTS + extra + 2) * 16 + 4);
   if (w > side || h > side || bytes > MAX_TARGET_BYTES) {
     throw new Error(`a ${w}x${h} frame needs ${Math.ceil(bytes / 2 ** 20)} MiB of float render targets (limits: ${side} texels a side, ${MAX_TARGET_BYTES / 2 ** 20} MiB): ask for a smaller size`);
   }
@@ -1451,7 +1454,7 @@ function createTargets(gl, [w, h]) {
     gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
     return { tex, target: gl.TEXTURE_2D };
   };
-  const attachments = [...Array(FRAME_ATTACHMENTS).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
+  const attachments = (n) => [...Array(n).keys()].map((i) => gl.COLOR_ATTACHMENT0 + i);
   const framebuffer = (colors, depth2) => {
     const fbo2 = gl.createFramebuffer();
     gl.bindFramebuffer(gl.FRAMEBUFFER, fbo2);
@@ -1470,14 +1473,14 @@ function createTargets(gl, [w, h]) {
     for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
     return { tex, target: gl.TEXTURE_2D };
   })();
-  const [fbo, [color, position]] = framebuffer(attachments, depth);
-  const [transparentFbo, [transparent]] = framebuffer(attachments, depth);
+  const [fbo, [color, position, normal, iterations]] = framebuffer(attachments(FRAME_ATTACHMENTS + extra), depth);
+  const [transparentFbo, [transparent]] = framebuffer(attachments(FRAME_ATTACHMENTS), depth);
   const [depthCopyFbo, [depthCopy]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
   const [frontFbo, [frontOpacity]] = framebuffer([gl.COLOR_ATTACHMENT0], null);
   gl.bindFramebuffer(gl.FRAMEBUFFER, frontFbo);
   gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-  return { fbo, color, position, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h] };
+  return { fbo, color, position, normal, iterations, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h], attachments: FRAME_ATTACHMENTS + extra };
 }
 function counts(gl, plan) {
   const g = plan.geometry;
@@ -2864,6 +2867,190 @@ var HOOKS = {
   "reliefkit.render.instancing:instanced_view": instancedView
 };
 
+// web/src/drawable.js
+async function makeDrawable(gl, glb, draw, name, programs, report2) {
+  const plans = decodePlans(draw, await readArrays(gl, glb, draw));
+  const executor = new Executor(gl, draw, name, HOOKS, programs);
+  const drawn = [];
+  for (const plan of plans) {
+    try {
+      executor.add(plan);
+      drawn.push(plan);
+    } catch (e) {
+      if (!(e instanceof Unsupported)) throw e;
+      report2(`${name}: ${e.message}`);
+    }
+  }
+  return { executor, plans: drawn };
+}
+
+// web/src/debug_views.js
+var MODES2 = { picture: 0, normals: 1, depth: 2, iterations: 3, mask: 4 };
+var ITERATIONS_ATTACHMENT = 3;
+var DebugViews = class {
+  /** ``params``: the page's URL parameters (``debug`` read, and kept up to date);
+   *  ``report``: the page's error line. */
+  constructor(params, manifest, panels, report2) {
+    this.params = params;
+    this.panels = panels;
+    this.report = report2;
+    this.ramp = manifest.heat_ramp;
+    this.programs = manifest.programs;
+    this.reference = panels.find((p) => p.input.kind === "mesh") || null;
+    this.onChange = () => {
+    };
+    this.state = window.reliefkit.debug = { mode: "picture", notes: [], iterations: [] };
+    for (const p of panels) {
+      p.note = document.createElement("p");
+      p.note.className = "note";
+      p.panel.appendChild(p.note);
+    }
+    let mode = params.get("debug") || "picture";
+    if (!(mode in MODES2)) {
+      report2(`error: debug must be one of ${Object.keys(MODES2).join(", ")}, got '${mode}'`);
+      mode = "picture";
+    }
+    this.makeSelector(mode);
+    this.ready = this.select(mode);
+  }
+  /** The selector above the pictures, showing ``mode``. */
+  makeSelector(mode) {
+    const label = document.createElement("label");
+    label.id = "debug-views";
+    label.textContent = "show ";
+    const select = document.createElement("select");
+    for (const name of Object.keys(MODES2)) select.add(new Option(name, name, false, name === mode));
+    select.addEventListener("change", () => this.select(select.value).then(() => this.onChange()));
+    label.appendChild(select);
+    document.getElementById("panels").before(label);
+  }
+  /** Switch to ``mode``: the URL follows; the instrumented plans are made when first needed. */
+  async select(mode) {
+    this.mode = mode;
+    this.state.mode = mode;
+    if (mode === "picture") this.params.delete("debug");
+    else this.params.set("debug", mode);
+    if (mode === "iterations") {
+      await Promise.all(this.panels.map((p) => this.counting(p)));
+      if (this.mode !== mode) return;
+    }
+    for (const p of this.panels) {
+      const reference = mode === "mask" && p === this.reference ? "the reference of the mask difference" : "";
+      this.setNote(p, this.unavailable(p) || reference);
+    }
+  }
+  /** The panel's iteration-counting plans and their targets (one more attachment), made
+   *  once; null for a kind whose export has none. */
+  async counting(p) {
+    if (p.counting === void 0) {
+      p.counting = null;
+      if (p.draw.instrumented) {
+        try {
+          const made = await makeDrawable(p.gl, p.glb, p.draw.instrumented, p.input.name, this.programs, this.report);
+          p.counting = { ...made, targets: createTargets(p.gl, p.targets.size, 1) };
+        } catch (e) {
+          this.report(`${p.input.name}: ${e.message}`);
+        }
+      }
+    }
+    return p.counting;
+  }
+  /** Why ``p`` cannot show the current view (it shows the picture then), or null. */
+  unavailable(p) {
+    if (this.mode === "iterations" && !p.counting) return `no iteration counts for ${p.input.kind}`;
+    if (this.mode === "mask" && !this.reference) return `mask difference needs the mesh as another input: reliefkit view ${p.input.name} MESH`;
+    return null;
+  }
+  setNote(p, text) {
+    p.note.textContent = text;
+    this.state.notes[this.panels.indexOf(p)] = text;
+  }
+  /** The panels in the order they draw: the mask's reference first. */
+  order(panels) {
+    if (this.mode !== "mask" || !this.reference) return panels;
+    return [this.reference, ...panels.filter((p) => p !== this.reference)];
+  }
+  /** The view ``p`` shows now: the current one, or the picture where it cannot. */
+  shown(p) {
+    return this.unavailable(p) ? "picture" : this.mode;
+  }
+  /** The executor that draws ``p`` now (its GPU time is the panel's). */
+  executor(p) {
+    return this.shown(p) === "iterations" ? p.counting.executor : p.executor;
+  }
+  /** Draw panel ``p`` from ``camera`` and show the current view. */
+  draw(p, camera, light) {
+    const mode = this.shown(p);
+    const { plans, targets } = mode === "iterations" ? p.counting : p;
+    const executor = this.executor(p);
+    executor.frame(plans, camera, light, targets, (drawn) => this.presenting(p, mode, drawn, camera));
+  }
+  /** present.glsl's uniforms and textures of ``mode`` for the panel's drawn ``targets``. */
+  presenting(p, mode, targets, camera) {
+    if (mode === "picture") return {};
+    const uniforms = { u_debug: MODES2[mode], u_heat_ramp: this.ramp };
+    const textures = { u_normal: targets.normal };
+    if (mode === "depth") {
+      const toEye = camera.eye.map((x, i) => x - camera.target[i]);
+      const distance = Math.hypot(...toEye);
+      const radius = distance / camera.distance;
+      uniforms.u_eye = camera.eye.map((x, i) => x - camera.origin[i]);
+      uniforms.u_depth_range = [distance - radius, distance + radius];
+    } else if (mode === "iterations") {
+      const counts2 = this.iterations(p, readAttachment(p.gl, targets, ITERATIONS_ATTACHMENT));
+      uniforms.u_iteration_scale = counts2.max > 0 ? counts2.max : 1;
+      textures.u_iterations = targets.iterations;
+    } else if (mode === "mask") {
+      if (p === this.reference) this.referenceMask = coverage(readAttachment(p.gl, targets, 1));
+      textures.u_reference = uploadMask(p, this.referenceMask, targets.size);
+    }
+    return { uniforms, textures };
+  }
+  /** render/draw.py _iteration_stats' iterations_mean and iterations_max of the counts,
+   *  shown in the panel's caption and kept in window.reliefkit.debug.iterations. */
+  iterations(p, counts2) {
+    let fragments = 0, sum = 0, max = 0;
+    for (let i = 0; i < counts2.length; i += 4) {
+      if (counts2[i + 2] <= 0.5) continue;
+      fragments += 1;
+      sum += counts2[i];
+      max = Math.max(max, counts2[i]);
+    }
+    const seen = { fragments, mean: fragments ? sum / fragments : 0, max };
+    this.state.iterations[this.panels.indexOf(p)] = seen;
+    this.setNote(p, `iterations: mean ${seen.mean.toFixed(2)}, max ${seen.max} (heat ramp 0..${seen.max})`);
+    return seen;
+  }
+};
+function readAttachment(gl, targets, index) {
+  const [w, h] = targets.size;
+  const out = new Float32Array(w * h * 4);
+  gl.bindFramebuffer(gl.READ_FRAMEBUFFER, targets.fbo);
+  gl.readBuffer(gl.COLOR_ATTACHMENT0 + index);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, out);
+  gl.readBuffer(gl.COLOR_ATTACHMENT0);
+  gl.bindFramebuffer(gl.READ_FRAMEBUFFER, null);
+  return out;
+}
+function coverage(position) {
+  const out = new Uint8Array(position.length / 4);
+  for (let i = 0; i < out.length; i++) out[i] = position[4 * i + 3] > 0.5 ? 255 : 0;
+  return out;
+}
+function uploadMask(p, mask, [w, h]) {
+  const gl = p.gl;
+  if (!p.referenceTexture) {
+    p.referenceTexture = { tex: gl.createTexture(), target: gl.TEXTURE_2D };
+    gl.bindTexture(gl.TEXTURE_2D, p.referenceTexture.tex);
+    for (const param of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, param, gl.NEAREST);
+  }
+  gl.bindTexture(gl.TEXTURE_2D, p.referenceTexture.tex);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  gl.texImage2D(gl.TEXTURE_2D, 0, gl.R8, w, h, 0, gl.RED, gl.UNSIGNED_BYTE, mask);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 4);
+  return p.referenceTexture;
+}
+
 // web/src/main.js
 var state = window.reliefkit = { ready: false, errors: [], frames: 0 };
 function report(message) {
@@ -2898,19 +3085,8 @@ async function openInput(input, size, programs) {
     canvas.addEventListener("webglcontextlost", () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
     const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
     const draw = drawOf(glb);
-    const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name, HOOKS, programs);
-    const drawn = [];
-    for (const plan of plans) {
-      try {
-        executor.add(plan);
-        drawn.push(plan);
-      } catch (e) {
-        if (!(e instanceof Unsupported)) throw e;
-        report(`${input.name}: ${e.message}`);
-      }
-    }
-    return { canvas, executor, plans: drawn, targets: createTargets(gl, size) };
+    const { executor, plans } = await makeDrawable(gl, glb, draw, input.name, programs, report);
+    return { canvas, executor, plans, targets: createTargets(gl, size), input, gl, glb, draw, panel };
   } catch (e) {
     report(`${input.name}: ${e.message}`);
     return null;
@@ -2929,16 +3105,17 @@ async function main() {
   const light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds2 = union(manifest.inputs.map((i) => i.bounds));
   const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
+  const debug = new DebugViews(params, manifest, panels, report);
   const readout = document.getElementById("stats");
   const render = () => {
     const start = performance.now();
     const camera = orbitBounds(bounds2, az, el, dist, size, frame);
     dist = camera.distance;
-    for (const p of panels) p.executor.frame(p.plans, camera, light, p.targets);
+    for (const p of debug.order(panels)) debug.draw(p, camera, light);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start;
     const shown = () => {
-      const gpu = panels.map((p) => p.executor.gpuTime());
+      const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
       readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? "" : `, GPU ${state.gpuMs.toFixed(2)} ms`);
     };
@@ -2960,6 +3137,7 @@ async function main() {
       });
     }
   };
+  debug.onChange = redraw;
   for (const p of panels) {
     p.canvas.addEventListener("pointerdown", (e) => p.canvas.setPointerCapture(e.pointerId));
     p.canvas.addEventListener("pointermove", (e) => {
@@ -2992,6 +3170,7 @@ async function main() {
       redraw();
     }, { passive: false });
   }
+  await debug.ready;
   render();
 }
 main().catch((e) => report(`error: ${e.message}`)).finally(() => {
