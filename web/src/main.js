@@ -1,11 +1,13 @@
 // reliefkit's viewer page: every input of `reliefkit view` (inputs.json: its GLB, kind and
 // framing bounds) drawn side by side from one camera by the WebGL2 executor. The view is in
-// the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL, kept up to date); a drag (mouse or touch)
-// or the arrow keys orbit, the wheel or + and - zoom.
+// the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL and the render options that differ from
+// their defaults, kept up to date); a drag (mouse or touch) or the arrow keys orbit, the wheel
+// or + and - zoom; controls.js switches render options and moves the light.
 // window.reliefkit.ready turns true after the first complete frame; errors show in the page
 // and are posted to the server's log.
 
 import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
+import { lightControls, optionControls } from './controls.js';
 import { createContext, createTargets, Executor, Unsupported } from './executor.js';
 import { drawOf, parseGlb, readArrays } from './glb.js';
 import { HOOKS } from './hooks/index.js';
@@ -28,12 +30,51 @@ window.addEventListener('unhandledrejection', (e) => report(`error: ${e.reason &
 
 async function fetchOk(url) {
   const response = await fetch(url);
+  if (response.status === 400 && (response.headers.get('Content-Type') || '').startsWith('text/plain')) {
+    throw new Error(await response.text()); // the server's one-line message (a bad render option)
+  }
   if (!response.ok) throw new Error(`cannot load ${url} (${response.status} ${response.statusText})`);
   return response;
 }
 
+/** The executor and plans of the GLB at ``url``; a plan it cannot draw is said and left out. */
+async function loadPlans(gl, url, input, programs) {
+  const glb = parseGlb(await (await fetchOk(url)).arrayBuffer(), input.name);
+  const draw = drawOf(glb);
+  const plans = decodePlans(draw, await readArrays(gl, glb, draw));
+  const executor = new Executor(gl, draw, input.name, HOOKS, programs);
+  const drawn = [];
+  try {
+    for (const plan of plans) {
+      try {
+        executor.add(plan);
+        drawn.push(plan);
+      } catch (e) {
+        if (!(e instanceof Unsupported)) throw e;
+        report(`${input.name}: ${e.message}`);
+      }
+    }
+  } catch (e) {
+    executor.dispose();
+    throw e;
+  }
+  return { executor, plans: drawn };
+}
+
+/** ``panel``'s plans made again with the render options of ``query``: {swap, discard}. */
+async function reloadPanel(panel, query, programs) {
+  const loaded = await loadPlans(panel.executor.gl, `${panel.input.file}?${query}`, panel.input, programs);
+  return {
+    swap() {
+      panel.executor.dispose();
+      Object.assign(panel, loaded);
+    },
+    discard() { loaded.executor.dispose(); },
+  };
+}
+
 /** One input's panel: its canvas, executor, plans and targets, or its error. */
-async function openInput(input, size, programs) {
+async function openInput(input, index, size, programs) {
   const panel = document.createElement('figure');
   const canvas = document.createElement('canvas');
   [canvas.width, canvas.height] = size;
@@ -46,21 +87,8 @@ async function openInput(input, size, programs) {
   try {
     const gl = createContext(canvas);
     canvas.addEventListener('webglcontextlost', () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
-    const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
-    const draw = drawOf(glb);
-    const plans = decodePlans(draw, await readArrays(gl, glb, draw));
-    const executor = new Executor(gl, draw, input.name, HOOKS, programs);
-    const drawn = [];
-    for (const plan of plans) {
-      try {
-        executor.add(plan);
-        drawn.push(plan);
-      } catch (e) {
-        if (!(e instanceof Unsupported)) throw e;
-        report(`${input.name}: ${e.message}`);
-      }
-    }
-    return { canvas, executor, plans: drawn, targets: createTargets(gl, size) };
+    const { executor, plans } = await loadPlans(gl, input.file, input, programs);
+    return { canvas, input, index, executor, plans, targets: createTargets(gl, size) };
   } catch (e) {
     report(`${input.name}: ${e.message}`);
     return null;
@@ -78,9 +106,9 @@ async function main() {
   let [az, el, dist] = parseView(params.get('view') || frame.default_view);
   const size = parseSize(params.get('size') || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get('light') || manifest.light.angles);
-  const light = lightFrom(manifest.light, lightAz, lightEl);
+  let light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds = union(manifest.inputs.map((i) => i.bounds));
-  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
+  const panels = (await Promise.all(manifest.inputs.map((i, k) => openInput(i, k, size, manifest.programs)))).filter(Boolean);
 
   const readout = document.getElementById('stats');
   const render = () => {
@@ -102,8 +130,9 @@ async function main() {
     params.set('view', `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
     history.replaceState(null, '', `?${params}`); // the view stays in the URL
     state.frames += 1;
-    state.ready = true;
+    state.ready = loads === 0;
   };
+  let loads = 0; // option switches under way: not ready until they end and a frame is drawn
   let pending = false;
   const redraw = () => {
     if (!pending) {
@@ -136,6 +165,23 @@ async function main() {
       redraw();
     }, { passive: false });
   }
+  lightControls({
+    form: document.getElementById('light'), angles: [lightAz, lightEl],
+    onChange: (a, e) => {
+      light = lightFrom(manifest.light, a, e);
+      params.set('light', `${a},${e}`);
+      redraw();
+    },
+  });
+  await optionControls({
+    form: document.getElementById('options'), manifest, params, panels, report,
+    reload: (panel, query) => reloadPanel(panel, query, manifest.programs),
+    loading: (promise) => {
+      loads += 1;
+      state.ready = false;
+      promise.catch(() => {}).finally(() => { loads -= 1; redraw(); });
+    },
+  });
   render();
 }
 

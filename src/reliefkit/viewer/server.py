@@ -33,9 +33,9 @@ def make_server(files: dict[str, bytes], port: int = 0, log=None,
             url = urlsplit(self.path)
             name = url.path.lstrip("/") or "index.html"
             body = files.get(name)
-            if url.query and variants is not None:
+            if url.query and variants is not None:  # a GLB with other render options
                 try:
-                    body = variants.answer(name, url.query)
+                    body = variants.answer(name, url.query) or body
                 except ReliefkitError as exc:
                     self._text(400, f"error: {exc}")
                     return

@@ -91,6 +91,11 @@ class Variants:
             return made[key]
 
 
+    def kept(self, index: int) -> int:
+        """How many GLBs of input ``index`` are kept."""
+        return len(self._made[index])
+
+
 def _key(item: Input, options: dict) -> tuple:
     """``options`` with the declared defaults left out: the same plans, the same key."""
     defaults = {opt.name: opt.default for opt in render_options(item.obj)}
