@@ -25,18 +25,20 @@ from browser import (
 from helpers import sample
 
 from reliefkit import save
-from reliefkit.viewer.site import load_inputs, site_files
+from reliefkit.io.inputs import load_input
+from reliefkit.viewer.site import load_inputs, make_input, site_files
 from reliefkit.viewer.variants import Variants
 
 VIEW = "30,25"
-#: every GL object the page makes and deletes, counted (WebGL cannot list the live ones)
+#: every GL object the page makes and deletes, counted (WebGL cannot list the live ones);
+#: not timer queries, which live from one frame until the browser has their result
 COUNT_GL_OBJECTS = """
 (() => {
   const live = new Set();
   window.__glLive = () => live.size;
   const proto = WebGL2RenderingContext.prototype;
   for (const kind of ['Texture', 'Buffer', 'Framebuffer', 'Renderbuffer', 'VertexArray',
-                      'Program', 'Shader', 'Query']) {
+                      'Program', 'Shader']) {
     const [make, free] = [proto['create' + kind], proto['delete' + kind]];
     proto['create' + kind] = function (...a) {
       const made = make.apply(this, a);
@@ -136,6 +138,13 @@ def test_a_url_with_options_opens_with_them_and_a_select_switches_the_method(gl,
         assert "method" not in url_options(page)
         assert url_options(page)["linear-steps"] == "2"
         assert state(page)["errors"] == []
+    # `reliefkit view relief.rk --method binary ...`: the page opens so, and its URL says it
+    inputs = [make_input(spec, load_input(spec), coarse)]
+    with served(site_files(inputs, live=True), Variants(inputs)) as (base, _):
+        page = page_at(browser, base)
+        assert page.locator("#option-method").input_value() == "binary"
+        assert url_options(page)["method"] == "binary"
+        assert_agrees(page, coarse_ref)
 
 
 def test_a_bad_value_is_said_and_the_picture_stays(gl, browser, specs):

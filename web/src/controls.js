@@ -141,8 +141,7 @@ export function optionControls({ form, manifest, params, panels, reload, loading
         + `${flag}=${current[differing[0]][flag]} (export again with --${flag} ${text} to see them)`);
     }
   }
-  if (!manifest.live) return Promise.resolve();
-  return queue.then(syncUrl);
+  return queue.then(syncUrl); // what is drawn: the values it was exported or switched with
 }
 
 /** The input element for one option: choices a select, a bool a checkbox, numbers a number

@@ -265,7 +265,6 @@ function optionControls({ form, manifest, params, panels, reload, loading, repor
       report2(`the URL asks for ${flag}=${text}, but this static export holds the plans made with ${flag}=${current[differing[0]][flag]} (export again with --${flag} ${text} to see them)`);
     }
   }
-  if (!manifest.live) return Promise.resolve();
   return queue.then(syncUrl);
 }
 function control(opt) {
