@@ -62,9 +62,10 @@ export function optionControls({ form, manifest, params, panels, reload, loading
   const current = inputs.map((input) => Object.fromEntries(
     (input.options || []).map((o) => [o.flag, asText(o.value)])));
   const shown = (flag) => current[union.get(flag).owners[0]][flag];
+  const defaultOf = (k, flag) => asText(inputs[k].options.find((o) => o.flag === flag).default);
   const syncUrl = () => {
     for (const [flag, { opt, owners }] of union) {
-      const differs = owners.some((k) => !sameValue(opt, current[k][flag], asText(inputs[k].options.find((o) => o.flag === flag).default)));
+      const differs = owners.some((k) => !sameValue(opt, current[k][flag], defaultOf(k, flag)));
       if (differs) params.set(flag, shown(flag));
       else params.delete(flag);
     }

@@ -193,9 +193,10 @@ function optionControls({ form, manifest, params, panels, reload, loading, repor
     (input.options || []).map((o) => [o.flag, asText(o.value)])
   ));
   const shown = (flag) => current[union2.get(flag).owners[0]][flag];
+  const defaultOf = (k, flag) => asText(inputs[k].options.find((o) => o.flag === flag).default);
   const syncUrl = () => {
     for (const [flag, { opt, owners }] of union2) {
-      const differs = owners.some((k) => !sameValue(opt, current[k][flag], asText(inputs[k].options.find((o) => o.flag === flag).default)));
+      const differs = owners.some((k) => !sameValue(opt, current[k][flag], defaultOf(k, flag)));
       if (differs) params.set(flag, shown(flag));
       else params.delete(flag);
     }
