@@ -175,17 +175,36 @@ def test_the_light_sliders_and_the_url_give_render_s_light(gl, browser, specs):
         assert_agrees(page, lit)
         page.close()
         page = page_at(browser, base)
-        frames = state(page)["frames"]
-        page.evaluate("""() => {
-          for (const [id, v] of [['light-azimuth', 120], ['light-elevation', 40]]) {
-            const slider = document.getElementById(id);
-            slider.value = String(v);
-            slider.dispatchEvent(new Event('input'));
-          }
-        }""")
-        page.wait_for_function(f"window.reliefkit.frames > {frames}")
+        move_light(page, 120, 40)
         assert_agrees(page, lit)
         assert url_options(page)["light"] == "120,40"
+
+
+def test_a_shadow_map_follows_the_light(gl, browser, specs):
+    """Drawn again for the new light, the old one freed."""
+    spec = specs["octahedral-impostor"]
+    lit = rendered(spec, VIEW, light_angles=(120, 40), shadows=True)
+    with served(*live_site([spec])) as (base, _):
+        page = page_at(browser, base, "&shadows=true")
+        move_light(page, 0, 60)
+        live = page.evaluate("window.__glLive()")
+        for azimuth in (30, 60, 90, 120):
+            move_light(page, azimuth, 40)
+        assert page.evaluate("window.__glLive()") == live
+        assert_agrees(page, lit)
+
+
+def move_light(page, azimuth: float, elevation: float):
+    """The light sliders moved as a user does, and the frame drawn."""
+    frames = state(page)["frames"]
+    page.evaluate("""([az, el]) => {
+      for (const [id, v] of [['light-azimuth', az], ['light-elevation', el]]) {
+        const slider = document.getElementById(id);
+        slider.value = String(v);
+        slider.dispatchEvent(new Event('input'));
+      }
+    }""", [azimuth, elevation])
+    page.wait_for_function(f"window.reliefkit.frames > {frames}")
 
 
 def test_a_static_export_shows_its_options_disabled_and_says_a_url_option(gl, browser, specs):
