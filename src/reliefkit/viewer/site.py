@@ -96,7 +96,7 @@ def manifest(inputs: list[Input], live: bool = False) -> dict:
     light.pop("u_light_dir")  # the page computes it from the angles (`--light`)
     az, el, _ = DEFAULT_VIEW
     return {"live": live,
-            "inputs": [{"name": i.name, "kind": i.kind, "file": glb_name(k),
+            "inputs": [{"name": i.name, "kind": i.kind, "file": _glb_name(k),
                         "bounds": i.bounds, "options": option_controls(i)}
                        for k, i in enumerate(inputs)],
             "camera": {"default_view": f"{az:g},{el:g}",
@@ -112,7 +112,7 @@ def site_files(inputs: list[Input], live: bool = False) -> dict[str, bytes]:
     static = resources.files(__package__) / "static"
     files = {name: (static / name).read_bytes() for name in PAGE_FILES}
     files["inputs.json"] = json.dumps(manifest(inputs, live), indent=1).encode()
-    files.update({glb_name(k): i.glb for k, i in enumerate(inputs)})
+    files.update({_glb_name(k): i.glb for k, i in enumerate(inputs)})
     return files
 
 
@@ -130,5 +130,5 @@ def export_html(files: dict[str, bytes], folder) -> list[Path]:
     return paths
 
 
-def glb_name(index: int) -> str:
+def _glb_name(index: int) -> str:
     return f"input-{index}.glb"

@@ -26,13 +26,6 @@ KEEP = 4
 _GLB_NAME = re.compile(r"input-(\d+)\.glb")
 
 
-def variant(inputs: list[Input], index: int, options: dict) -> bytes:
-    """Input ``index``'s GLB with its plans made with ``options`` (flag names or option names
-    to values, strings as a URL gives them); a value the CLI would refuse is a UsageError with
-    the CLI's message."""
-    return glb_of(inputs[index].obj, checked_options(inputs[index], options))
-
-
 def checked_options(item: Input, options: dict) -> dict:
     """``options`` parsed (booleans 'true'/'false', '' for none) and checked by ``item``'s
     declarations, as `reliefkit render`'s flags are."""
