@@ -26,6 +26,7 @@ FLAGS = ["--headless=new", "--no-sandbox", "--disable-background-networking",
 BACKENDS = {"swiftshader": ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"],
             "mesa": ["--use-angle=gl-egl", "--ignore-gpu-blocklist"]}
 READY_TIMEOUT_MS = 120_000
+SIZE = (128, 128)  # the pages the tests compare with `reliefkit render`
 
 
 def unavailable(reason: str):
@@ -65,12 +66,13 @@ def chromium(backend: str = "swiftshader"):
 
 
 @contextmanager
-def served(files: dict):
-    """The viewer's server of ``files`` on a free port, in a thread: (base URL, log lines)."""
+def served(files: dict, variants=None):
+    """The viewer's server of ``files`` (and ``variants``: the GLBs made with other render
+    options) on a free port, in a thread: (base URL, log lines)."""
     from reliefkit.viewer.server import make_server
 
     lines: list[str] = []
-    server = make_server(files, 0, log=lines.append)
+    server = make_server(files, 0, log=lines.append, variants=variants)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
     try:
@@ -80,9 +82,12 @@ def served(files: dict):
         server.server_close()
 
 
-def open_page(browser, url: str):
-    """A new page at ``url``, waited on until its first frame is complete or it gave up."""
+def open_page(browser, url: str, init_script: str | None = None):
+    """A new page at ``url`` (``init_script`` run before the page's own), waited on until its
+    first frame is complete or it gave up."""
     page = browser.new_page()
+    if init_script:
+        page.add_init_script(init_script)
     page.goto(url)
     page.wait_for_function("window.reliefkit && window.reliefkit.loaded",
                            timeout=READY_TIMEOUT_MS)
@@ -105,3 +110,27 @@ def canvas_rgba(page, index: int = 0) -> np.ndarray:
 def messages(page) -> list[str]:
     """The error lines the page shows."""
     return page.locator("#messages .error").all_inner_texts()
+
+
+def rendered(spec: str, view: str, bounds=None, light_angles=None, **options) -> np.ndarray:
+    """What `reliefkit render SPEC --view VIEW --size 128x128 [--light AZ,EL] [OPTIONS]`
+    writes, as RGBA8 (framed by ``bounds`` instead of the input's own)."""
+    from reliefkit.io.inputs import load_input
+    from reliefkit.render import render
+    from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
+    from reliefkit.scene.views import framing_bounds, orbit_bounds, parse_view
+
+    obj = load_input(spec)
+    box = framing_bounds(obj) if bounds is None else bounds
+    camera = orbit_bounds(box, *parse_view(view), SIZE)
+    light = DirectionalLight.from_angles(*(light_angles or DEFAULT_LIGHT_ANGLES))
+    return render(obj, camera, light=light, **options).rgba8()
+
+
+def agreement(page: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
+    """Mask IoU, and the fraction of pixels both cover whose channels are within 4/255."""
+    a, b = page[..., 3] > 0, reference[..., 3] > 0
+    iou = (a & b).sum() / max((a | b).sum(), 1)
+    both = a & b
+    diff = np.abs(page[..., :3].astype(int) - reference[..., :3].astype(int)).max(-1)[both]
+    return float(iou), float((diff <= 4).mean()) if diff.size else 0.0

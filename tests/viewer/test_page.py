@@ -11,19 +11,27 @@ from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 import pytest
-from browser import canvas_rgba, launch, messages, open_page, playwright, served, state
+from browser import (
+    SIZE,
+    agreement,
+    canvas_rgba,
+    launch,
+    messages,
+    open_page,
+    playwright,
+    rendered,
+    served,
+    state,
+)
 from helpers import sample
 from mesh_scenes import sampler_mesh
 
 from reliefkit import save
 from reliefkit.compact.compact import CompressOptions, compress
 from reliefkit.io.gltf.glb import glb_bytes, read_glb
-from reliefkit.render import render
-from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
-from reliefkit.scene.views import framing_bounds, orbit_bounds, parse_view
+from reliefkit.scene.views import framing_bounds
 from reliefkit.viewer.site import Input, load_inputs, make_input, site_files
 
-SIZE = (128, 128)
 VIEWS = ("30,25", "-100,10", "160,50")
 #: the scenes: a demo asset, a technique's sample, or a mesh of the test's own (saved as a
 #: mesh .rk)
@@ -86,27 +94,6 @@ def specs(tmp_path_factory):
         out[kind] = str(folder / f"{kind}.rk")
         save(out[kind], made)
     return out
-
-
-def rendered(spec: str, view: str, bounds=None, **options) -> np.ndarray:
-    """What `reliefkit render SPEC --view VIEW --size 128x128 [OPTIONS]` writes, as RGBA8
-    (framed by ``bounds`` instead of the input's own)."""
-    from reliefkit.io.inputs import load_input
-
-    obj = load_input(spec)
-    box = framing_bounds(obj) if bounds is None else bounds
-    camera = orbit_bounds(box, *parse_view(view), SIZE)
-    light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
-    return render(obj, camera, light=light, **options).rgba8()
-
-
-def agreement(page: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
-    """Mask IoU, and the fraction of pixels both cover whose channels are within 4/255."""
-    a, b = page[..., 3] > 0, reference[..., 3] > 0
-    iou = (a & b).sum() / max((a | b).sum(), 1)
-    both = a & b
-    diff = np.abs(page[..., :3].astype(int) - reference[..., :3].astype(int)).max(-1)[both]
-    return float(iou), float((diff <= 4).mean()) if diff.size else 0.0
 
 
 def url(base: str, view: str) -> str:

@@ -13,6 +13,7 @@
 
 import { makeDrawable } from './drawable.js';
 import { createTargets } from './executor.js';
+import { releaseAll } from './gl_objects.js';
 
 /** The views by name, present.glsl's u_debug; absent (picture) is 0. */
 const MODES = { picture: 0, normals: 1, depth: 2, iterations: 3, mask: 4 };
@@ -70,6 +71,21 @@ export class DebugViews {
       const reference = mode === 'mask' && p === this.reference ? 'the reference of the mask difference' : '';
       this.setNote(p, this.unavailable(p) || reference);
     }
+  }
+
+  /** Free ``p``'s iteration-counting plans and targets (its render options changed: they are
+   *  made again from its new GLB when next needed). */
+  static forget(p) {
+    if (p.counting) {
+      p.counting.executor.dispose();
+      releaseAll(p.gl, p.counting.targets);
+    }
+    delete p.counting;
+  }
+
+  /** The current view again, after panels' plans were replaced. */
+  refresh() {
+    return this.select(this.mode);
   }
 
   /** The panel's iteration-counting plans and their targets (one more attachment), made

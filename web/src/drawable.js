@@ -12,14 +12,19 @@ export async function makeDrawable(gl, glb, draw, name, programs, report) {
   const plans = decodePlans(draw, await readArrays(gl, glb, draw));
   const executor = new Executor(gl, draw, name, HOOKS, programs);
   const drawn = [];
-  for (const plan of plans) {
-    try {
-      executor.add(plan);
-      drawn.push(plan);
-    } catch (e) {
-      if (!(e instanceof Unsupported)) throw e;
-      report(`${name}: ${e.message}`);
+  try {
+    for (const plan of plans) {
+      try {
+        executor.add(plan);
+        drawn.push(plan);
+      } catch (e) {
+        if (!(e instanceof Unsupported)) throw e;
+        report(`${name}: ${e.message}`);
+      }
     }
+  } catch (e) {
+    executor.dispose(); // what it made so far (a shader that does not compile)
+    throw e;
   }
   return { executor, plans: drawn };
 }

@@ -9,6 +9,7 @@ import { programKey, withView } from './plans.js';
 import { drawDepthPeeled } from './depth_peel.js';
 import { drawWithOpaqueDepth } from './opaque_depth.js';
 import { drawShadowMapped } from './shadow_map.js';
+import { releaseAll } from './gl_objects.js';
 import { drawStencilCounted } from './stencil_count.js';
 import { uploadTexture } from './textures.js';
 
@@ -104,6 +105,7 @@ export class Executor {
       gl.attachShader(prog, shader);
     }
     gl.linkProgram(prog);
+    for (const shader of gl.getAttachedShaders(prog)) gl.deleteShader(shader); // freed with the program
     if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) {
       throw new Error(`${name} does not link in this browser: ${gl.getProgramInfoLog(prog).trim()}`);
     }
@@ -203,6 +205,20 @@ export class Executor {
     for (const [name, value] of Object.entries({ u_debug: 0, ...uniforms, ...samplers })) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+
+  /** Free every GL object this executor made (programs, buffers, vertex arrays, textures,
+   *  a multi-pass kind's targets): its plans are replaced (the page's option controls). */
+  dispose() {
+    const gl = this.gl;
+    for (const { prog } of [...this.programs.values(), this.present, this.copyDepth]) gl.deleteProgram(prog);
+    for (const made of this.buffers.values()) for (const { buffer } of Object.values(made)) gl.deleteBuffer(buffer);
+    for (const vao of this.vaos.values()) gl.deleteVertexArray(vao);
+    for (const { tex } of this.textures.values()) gl.deleteTexture(tex);
+    for (const entry of this.cache.values()) releaseAll(gl, entry);
+    if (this.query) gl.deleteQuery(this.query);
+    for (const map of [this.programs, this.buffers, this.vaos, this.textures, this.cache, this.groups]) map.clear();
+    this.query = null;
   }
 
   /** The GPU time of the latest timed frame's draws in ms (null until one is known): a timer
@@ -366,7 +382,7 @@ export function createTargets(gl, [w, h], extra = 0) {
   gl.bindFramebuffer(gl.FRAMEBUFFER, frontFbo);
   gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-  return { fbo, color, position, normal, iterations, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h], attachments: FRAME_ATTACHMENTS + extra };
+  return { fbo, color, position, normal, iterations, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontFbo, frontOpacity, size: [w, h], attachments: FRAME_ATTACHMENTS + extra };
 }
 
 /** render/executor.py _counts. */

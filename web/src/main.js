@@ -1,12 +1,14 @@
 // reliefkit's viewer page: every input of `reliefkit view` (inputs.json: its GLB, kind and
 // framing bounds) drawn side by side from one camera by the WebGL2 executor. The view is in
-// the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL, kept up to date); a drag (mouse or touch)
-// or the arrow keys orbit, the wheel or + and - zoom.
+// the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL and the render options that differ from
+// their defaults, kept up to date); a drag (mouse or touch) or the arrow keys orbit, the wheel
+// or + and - zoom; controls.js switches render options and moves the light;
 // ?debug=normals|depth|iterations|mask shows a debug view instead (debug_views.js).
 // window.reliefkit.ready turns true after the first complete frame; errors show in the page
 // and are posted to the server's log.
 
 import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
+import { lightControls, optionControls } from './controls.js';
 import { DebugViews } from './debug_views.js';
 import { makeDrawable } from './drawable.js';
 import { createContext, createTargets } from './executor.js';
@@ -29,12 +31,36 @@ window.addEventListener('unhandledrejection', (e) => report(`error: ${e.reason &
 
 async function fetchOk(url) {
   const response = await fetch(url);
+  if (response.status === 400 && (response.headers.get('Content-Type') || '').startsWith('text/plain')) {
+    throw new Error(await response.text()); // the server's one-line message (a bad render option)
+  }
   if (!response.ok) throw new Error(`cannot load ${url} (${response.status} ${response.statusText})`);
   return response;
 }
 
+/** The GLB at ``url`` (the panel's `glb` and `draw`, which the debug views read too) with its
+ *  executor and plans; a plan it cannot draw is said and left out. */
+async function loadPlans(gl, url, input, programs) {
+  const glb = parseGlb(await (await fetchOk(url)).arrayBuffer(), input.name);
+  const draw = drawOf(glb);
+  return { glb, draw, ...await makeDrawable(gl, glb, draw, input.name, programs, report) };
+}
+
+/** ``panel``'s plans made again with the render options of ``query``: {swap, discard}. */
+async function reloadPanel(panel, query, programs) {
+  const loaded = await loadPlans(panel.executor.gl, `${panel.input.file}?${query}`, panel.input, programs);
+  return {
+    swap() {
+      panel.executor.dispose();
+      DebugViews.forget(panel);
+      Object.assign(panel, loaded);
+    },
+    discard() { loaded.executor.dispose(); },
+  };
+}
+
 /** One input's panel: its canvas, executor, plans and targets, or its error. */
-async function openInput(input, size, programs) {
+async function openInput(input, index, size, programs) {
   const panel = document.createElement('figure');
   const canvas = document.createElement('canvas');
   [canvas.width, canvas.height] = size;
@@ -47,10 +73,8 @@ async function openInput(input, size, programs) {
   try {
     const gl = createContext(canvas);
     canvas.addEventListener('webglcontextlost', () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
-    const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
-    const draw = drawOf(glb);
-    const { executor, plans } = await makeDrawable(gl, glb, draw, input.name, programs, report);
-    return { canvas, executor, plans, targets: createTargets(gl, size), input, gl, glb, draw, panel };
+    const loaded = await loadPlans(gl, input.file, input, programs);
+    return { canvas, input, index, targets: createTargets(gl, size), gl, panel, ...loaded };
   } catch (e) {
     report(`${input.name}: ${e.message}`);
     return null;
@@ -68,9 +92,9 @@ async function main() {
   let [az, el, dist] = parseView(params.get('view') || frame.default_view);
   const size = parseSize(params.get('size') || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get('light') || manifest.light.angles);
-  const light = lightFrom(manifest.light, lightAz, lightEl);
+  let light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds = union(manifest.inputs.map((i) => i.bounds));
-  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
+  const panels = (await Promise.all(manifest.inputs.map((i, k) => openInput(i, k, size, manifest.programs)))).filter(Boolean);
   const debug = new DebugViews(params, manifest, panels, report);
 
   const readout = document.getElementById('stats');
@@ -93,8 +117,9 @@ async function main() {
     params.set('view', `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
     history.replaceState(null, '', `?${params}`); // the view stays in the URL
     state.frames += 1;
-    state.ready = true;
+    state.ready = loads === 0;
   };
+  let loads = 0; // option switches under way: not ready until they end and a frame is drawn
   let pending = false;
   const redraw = () => {
     if (!pending) {
@@ -129,6 +154,27 @@ async function main() {
     }, { passive: false });
   }
   await debug.ready;
+  lightControls({
+    form: document.getElementById('light'), angles: [lightAz, lightEl],
+    onChange: (a, e) => {
+      light = lightFrom(manifest.light, a, e);
+      params.set('light', `${a},${e}`);
+      redraw();
+    },
+  });
+  await optionControls({
+    form: document.getElementById('options'), manifest, params, panels, report,
+    reload: (panel, query) => reloadPanel(panel, query, manifest.programs),
+    loading: (promise) => {
+      loads += 1;
+      state.ready = false;
+      promise.catch(() => {}).finally(async () => {
+        await debug.refresh(); // a debug view's plans come from the new GLBs too
+        loads -= 1;
+        redraw();
+      });
+    },
+  });
   render();
 }
 

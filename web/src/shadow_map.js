@@ -1,9 +1,10 @@
 // The "shadow-map" multi-pass kind (render/multipass/shadow_map.py): a depth map of every plan
 // that shares the plan's geometry (all the materials of a mesh cast), drawn from the light's
-// orthographic camera with each plan's ``caster`` program, once per light direction; then the
+// orthographic camera with each plan's ``caster`` program, again when the light moves; then the
 // plan is drawn with the map and the uniforms of shaders/include/shadow_map.glsl.
 
 import { lightCamera, matrix, multiply, translation } from './camera.js';
+import { releaseAll } from './gl_objects.js';
 
 /** Draw ``plan`` shadow-mapped; ``outer`` rebinds the frame's target after the depth pass. */
 export function drawShadowMapped(executor, plan, camera, light, outer, extra = {}) {
@@ -14,7 +15,13 @@ export function drawShadowMapped(executor, plan, camera, light, outer, extra = {
 /** The uniforms and the texture (``u_shadow_map``) of ``light``'s shadow map for ``plan``'s
  *  group, drawn on first use with ``params`` (the Python module's; other kinds pass theirs). */
 export function shadowInputs(executor, plan, light, outer, params = plan.multipass.params) {
-  const key = `shadow-map ${plan.geometry.key} ${light.direction.join(',')}`;
+  const key = `shadow-map ${plan.geometry.key}`;
+  const direction = light.direction.join(',');
+  const made = executor.cache.get(key);
+  if (made && made.direction !== direction) { // the light moved (the page's sliders): drawn again
+    releaseAll(executor.gl, made);
+    executor.cache.delete(key);
+  }
   if (!executor.cache.has(key)) {
     const gl = executor.gl;
     const size = Number(params.size);
@@ -50,9 +57,9 @@ export function shadowInputs(executor, plan, light, outer, params = plan.multipa
       u_shadow_texel: texel,
       u_shadow_bias: 'bias' in params ? Number(params.bias) : texel / (cam.far - cam.near),
     };
-    executor.cache.set(key, [uniforms, { u_shadow_map: { tex: depth, target: gl.TEXTURE_2D } }]);
+    executor.cache.set(key, { direction, inputs: [uniforms, { u_shadow_map: { tex: depth, target: gl.TEXTURE_2D } }] });
   }
-  return executor.cache.get(key);
+  return executor.cache.get(key).inputs;
 }
 
 /** A (2, 3) box given as a plan's array or as nested lists. */

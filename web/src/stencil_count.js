@@ -79,7 +79,7 @@ function stencilTarget(executor, w, h) {
     gl.drawBuffers(SOURCES.map((_, i) => gl.COLOR_ATTACHMENT0 + i));
     const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
     if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`a ${w}x${h} framebuffer with a stencil buffer is incomplete (0x${status.toString(16)})`);
-    executor.cache.set(key, { fbo, textures });
+    executor.cache.set(key, { fbo, textures, rbo });
   }
   return executor.cache.get(key);
 }

@@ -20,7 +20,7 @@ from ..bake import bake
 from ..bench import run_suite
 from ..compact.compact import CompressOptions, gpu_bytes
 from ..compare import compare, metrics_markdown, write_comparison
-from ..core.params import ANIMATION_TIME, options_of
+from ..core.params import ANIMATION_TIME, applicable, options_of
 from ..core.technique import baker, bakers, technique_of
 from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
@@ -47,7 +47,8 @@ from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, sho
 from ..units import format_bytes
 from ..viewer import server as view_server
 from ..viewer import site as view_site
-from .options import applicable, given_options
+from ..viewer.variants import Variants
+from .options import given_options
 
 MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
 
@@ -552,14 +553,15 @@ def cmd_view(args) -> int:
     objects = [load_input(spec) for spec in args.inputs]
     routed = _routed_options(given_options(args), args.inputs, objects)
     with waiting("exporting the inputs"):
-        files = view_site.site_files([view_site.make_input(spec, obj, options) for spec, obj,
-                                      options in zip(args.inputs, objects, routed, strict=True)])
+        inputs = [view_site.make_input(spec, obj, options) for spec, obj, options
+                  in zip(args.inputs, objects, routed, strict=True)]
     if args.export_html:
-        paths = view_site.export_html(files, args.export_html)
+        paths = view_site.export_html(view_site.site_files(inputs), args.export_html)
         print(f"wrote {len(paths)} files into {args.export_html} (index.html: serve the folder, "
               "e.g. python -m http.server -d " + shlex.quote(args.export_html) + ")")
         return 0
-    view_server.serve(files, args.port, open_browser=not args.no_browser)
+    view_server.serve(view_site.site_files(inputs, live=True), args.port,
+                      open_browser=not args.no_browser, variants=Variants(inputs))
     return 0
 
 

@@ -1,7 +1,9 @@
 """The viewer's static site: the page (static/index.html), its bundle (static/viewer.js,
 built from web/src/ by web/build.mjs), one GLB per input, exported in memory with its
 shaders, and inputs.json, which names them with their kind and framing bounds and carries
-the camera's and the light's defaults the page shares with `reliefkit render`.
+the camera's and the light's defaults the page shares with `reliefkit render`, and each
+input's render options (their declarations and the values its GLB was made with), from which
+the page builds its controls.
 
 Everything the page computes per view comes from these files, so the folder that
 `export_html` writes is viewable from any static web server.
@@ -10,7 +12,7 @@ Everything the page computes per view comes from these files, so the folder that
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
@@ -20,6 +22,7 @@ from ..gl.shaders import stage_sources
 from ..io.atomic import atomic_path, written_together
 from ..io.inputs import kind_of, load_input
 from ..metrics import heat_ramp_stops
+from ..render import render_options
 from ..scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
 from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW, FIT_MARGIN, framing_bounds
 
@@ -28,12 +31,15 @@ PAGE_FILES = ("index.html", "viewer.js")
 
 @dataclass(frozen=True)
 class Input:
-    """One input as the page gets it."""
+    """One input as the page gets it; ``obj`` (the loaded input) and the render ``options``
+    its GLB was made with let the server make it again with others."""
 
     name: str
     kind: str
     glb: bytes
     bounds: list
+    obj: object = None
+    options: dict = field(default_factory=dict)
 
 
 def load_inputs(specs) -> list[Input]:
@@ -49,9 +55,26 @@ def make_input(spec: str, obj, options: dict | None = None) -> Input:
     render ``options`` it declares (checked by the caller), and their GLSL ES sources; no
     fallback mesh: the page draws the plans (and, where it counts them, the iteration-counting
     plans of its heat map)."""
-    return Input(str(spec), kind_of(obj), export_bytes(obj, fallback=False, embed_shaders=True,
-                                                       options=options, instrumented=True),
-                 framing_bounds(obj).tolist())
+    return Input(str(spec), kind_of(obj), glb_of(obj, options), framing_bounds(obj).tolist(),
+                 obj, dict(options or {}))
+
+
+def glb_of(obj, options: dict | None) -> bytes:
+    """``obj``'s GLB as the page draws it: its plans made with ``options``, their sources
+    and the iteration-counting plans (the heat map)."""
+    return export_bytes(obj, fallback=False, embed_shaders=True, options=options,
+                        instrumented=True)
+
+
+def option_controls(item: Input) -> list[dict]:
+    """The render options ``item`` declares (`render_options`: what the CLI's flags are made
+    of), each with the value its GLB was made with: the page's controls are built from them."""
+    if item.obj is None:
+        return []
+    return [{"name": opt.name, "flag": opt.flag, "kind": opt.kind, "choices": opt.choices,
+             "lo": opt.lo, "hi": opt.hi, "count": opt.count, "default": opt.default,
+             "help": opt.help, "value": item.options.get(opt.name, opt.default)}
+            for opt in render_options(item.obj)]
 
 
 #: The page's own programs (the picture or a debug view it shows, the opaque depth it
@@ -72,14 +95,18 @@ def page_programs() -> dict:
     return out
 
 
-def manifest(inputs: list[Input]) -> dict:
-    """inputs.json: the inputs, the page's own programs and the defaults of `reliefkit render`
-    the page uses (camera, light, the heat ramp of `reliefkit.metrics`)."""
+def manifest(inputs: list[Input], live: bool = False) -> dict:
+    """inputs.json: the inputs with their render options, the page's own programs and the
+    defaults of `reliefkit render` the page uses (camera, light, the heat ramp of
+    `reliefkit.metrics`); ``live``: a server makes each input again
+    with other options (`viewer.variants`), which a static export cannot."""
     light = DirectionalLight().uniforms()
     light.pop("u_light_dir")  # the page computes it from the angles (`--light`)
     az, el, _ = DEFAULT_VIEW
-    return {"inputs": [{"name": i.name, "kind": i.kind, "file": _glb_name(k),
-                        "bounds": i.bounds} for k, i in enumerate(inputs)],
+    return {"live": live,
+            "inputs": [{"name": i.name, "kind": i.kind, "file": _glb_name(k),
+                        "bounds": i.bounds, "options": option_controls(i)}
+                       for k, i in enumerate(inputs)],
             "camera": {"default_view": f"{az:g},{el:g}",
                        "default_size": f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}",
                        "fov": DEFAULT_FOV, "fit_margin": FIT_MARGIN},
@@ -90,11 +117,11 @@ def manifest(inputs: list[Input]) -> dict:
             "heat_ramp": heat_ramp_stops().tolist()}
 
 
-def site_files(inputs: list[Input]) -> dict[str, bytes]:
-    """Every file of the site by its name."""
+def site_files(inputs: list[Input], live: bool = False) -> dict[str, bytes]:
+    """Every file of the site by its name (``live``: see `manifest`)."""
     static = resources.files(__package__) / "static"
     files = {name: (static / name).read_bytes() for name in PAGE_FILES}
-    files["inputs.json"] = json.dumps(manifest(inputs), indent=1).encode()
+    files["inputs.json"] = json.dumps(manifest(inputs, live), indent=1).encode()
     files.update({_glb_name(k): i.glb for k, i in enumerate(inputs)})
     return files
 

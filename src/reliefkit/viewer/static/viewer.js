@@ -158,6 +158,165 @@ function invert(m) {
   return a.flatMap((row) => row.slice(4));
 }
 
+// web/src/controls.js
+function asText(value) {
+  if (value === null || value === void 0) return "";
+  if (Array.isArray(value)) return value.map(String).join(",");
+  return String(value);
+}
+function sameValue(opt, a, b) {
+  if (["int", "float", "floats"].includes(opt.kind) && a !== "" && b !== "") {
+    const [x, y] = [a, b].map((t) => t.split(",").map(Number));
+    return x.length === y.length && x.every((v, i) => v === y[i]);
+  }
+  return a === b;
+}
+function optionUnion(inputs) {
+  const union2 = /* @__PURE__ */ new Map();
+  inputs.forEach((input, index) => {
+    for (const opt of input.options || []) {
+      if (!union2.has(opt.flag)) union2.set(opt.flag, { opt, owners: [] });
+      union2.get(opt.flag).owners.push(index);
+    }
+  });
+  return union2;
+}
+function optionQuery(input, values) {
+  const query = new URLSearchParams();
+  for (const opt of input.options) query.set(opt.flag, values[opt.flag]);
+  return query.toString();
+}
+function optionControls({ form, manifest, params, panels, reload, loading, report: report2 }) {
+  const inputs = manifest.inputs;
+  const union2 = optionUnion(inputs);
+  const current = inputs.map((input) => Object.fromEntries(
+    (input.options || []).map((o) => [o.flag, asText(o.value)])
+  ));
+  const shown = (flag) => current[union2.get(flag).owners[0]][flag];
+  const defaultOf = (k, flag) => asText(inputs[k].options.find((o) => o.flag === flag).default);
+  const syncUrl = () => {
+    for (const [flag, { opt, owners }] of union2) {
+      const differs = owners.some((k) => !sameValue(opt, current[k][flag], defaultOf(k, flag)));
+      if (differs) params.set(flag, shown(flag));
+      else params.delete(flag);
+    }
+    history.replaceState(null, "", `?${params}`);
+  };
+  let queue = Promise.resolve();
+  const apply = (flag, text) => {
+    const { owners } = union2.get(flag);
+    queue = queue.then(async () => {
+      const targets = panels.filter((p) => owners.includes(p.index) && current[p.index][flag] !== text);
+      const wanted = new Map(targets.map((p) => [p, { ...current[p.index], [flag]: text }]));
+      const loads = await Promise.allSettled(targets.map((p) => reload(p, optionQuery(inputs[p.index], wanted.get(p)))));
+      const failed = loads.filter((r) => r.status === "rejected");
+      if (failed.length) {
+        for (const r of loads) if (r.status === "fulfilled") r.value.discard();
+        for (const r of failed) report2(r.reason.message);
+      } else {
+        for (const r of loads) r.value.swap();
+        for (const [p, values] of wanted) current[p.index] = values;
+      }
+      setControl(flag, shown(flag));
+      syncUrl();
+    });
+    loading(queue);
+    return queue;
+  };
+  const controls = /* @__PURE__ */ new Map();
+  const setControl = (flag, text) => {
+    const input = controls.get(flag);
+    if (input.type === "checkbox") input.checked = text === "true";
+    else input.value = text;
+  };
+  form.replaceChildren();
+  form.addEventListener("submit", (e) => e.preventDefault());
+  for (const [flag, { opt, owners }] of union2) {
+    const label = document.createElement("label");
+    const kinds = [...new Set(owners.map((k) => inputs[k].kind))].join(", ");
+    label.title = `${opt.help} (applies to: ${kinds})`;
+    const name = document.createElement("span");
+    name.textContent = `--${flag}`;
+    const input = control(opt);
+    input.id = `option-${flag}`;
+    input.name = flag;
+    input.disabled = !manifest.live;
+    const small = document.createElement("small");
+    small.textContent = kinds;
+    label.append(name, input, small);
+    form.appendChild(label);
+    controls.set(flag, input);
+    setControl(flag, shown(flag));
+    input.addEventListener("change", () => apply(flag, input.type === "checkbox" ? String(input.checked) : input.value));
+  }
+  if (!union2.size) return Promise.resolve();
+  if (!manifest.live) {
+    const why = document.createElement("p");
+    why.className = "why";
+    why.textContent = "This static export holds the plans made with these options; `reliefkit view ... --method X` (or export again) to change them.";
+    form.appendChild(why);
+  }
+  const asked = [...union2].filter(([flag]) => params.has(flag));
+  for (const [flag, { opt, owners }] of asked) {
+    const text = params.get(flag);
+    const differing = owners.filter((k) => !sameValue(opt, current[k][flag], text));
+    if (!differing.length) continue;
+    if (manifest.live) apply(flag, text);
+    else {
+      report2(`the URL asks for ${flag}=${text}, but this static export holds the plans made with ${flag}=${current[differing[0]][flag]} (export again with --${flag} ${text} to see them)`);
+    }
+  }
+  return queue.then(syncUrl);
+}
+function control(opt) {
+  if (opt.choices) {
+    const select = document.createElement("select");
+    const choices = (opt.default === null ? [""] : []).concat(opt.choices.map(String));
+    for (const choice of choices) {
+      const option = document.createElement("option");
+      option.value = choice;
+      option.textContent = choice === "" ? "(none)" : choice;
+      select.appendChild(option);
+    }
+    return select;
+  }
+  const input = document.createElement("input");
+  if (opt.kind === "bool") {
+    input.type = "checkbox";
+    return input;
+  }
+  if (opt.kind === "int" || opt.kind === "float") {
+    input.type = "number";
+    input.step = opt.kind === "int" ? "1" : "any";
+    if (opt.lo !== null) input.min = String(opt.lo);
+    if (opt.hi !== null) input.max = String(opt.hi);
+  } else input.type = "text";
+  if (opt.default === null) input.placeholder = "none";
+  return input;
+}
+function lightControls({ form, angles, onChange }) {
+  form.addEventListener("submit", (e) => e.preventDefault());
+  const sliders = [["azimuth", -180, 180, angles[0]], ["elevation", -89, 89, angles[1]]].map(([what, lo, hi, value]) => {
+    const label = document.createElement("label");
+    label.title = `the light's ${what} in degrees (render --light AZ,EL)`;
+    const name = document.createElement("span");
+    name.textContent = `light ${what}`;
+    const input = document.createElement("input");
+    Object.assign(input, { type: "range", min: String(lo), max: String(hi), step: "1", value: String(value), id: `light-${what}` });
+    const readout = document.createElement("output");
+    readout.textContent = String(value);
+    label.append(name, input, readout);
+    form.appendChild(label);
+    return [input, readout];
+  });
+  for (const [input, readout] of sliders) {
+    input.addEventListener("input", () => {
+      readout.textContent = input.value;
+      onChange(Number(sliders[0][0].value), Number(sliders[1][0].value));
+    });
+  }
+}
+
 // web/src/plans.js
 function decode(value, arrays) {
   if (Array.isArray(value)) return value.map((v) => decode(v, arrays));
@@ -232,13 +391,30 @@ function withView(plan, update) {
   };
 }
 
+// web/src/gl_objects.js
+function releaseAll(gl, value) {
+  if (value instanceof WebGLTexture) gl.deleteTexture(value);
+  else if (value instanceof WebGLFramebuffer) gl.deleteFramebuffer(value);
+  else if (value instanceof WebGLRenderbuffer) gl.deleteRenderbuffer(value);
+  else if (Array.isArray(value)) for (const v of value) releaseAll(gl, v);
+  else if (value && typeof value === "object" && Object.getPrototypeOf(value) === Object.prototype) {
+    for (const v of Object.values(value)) releaseAll(gl, v);
+  }
+}
+
 // web/src/shadow_map.js
 function drawShadowMapped(executor, plan, camera, light, outer, extra = {}) {
   const [uniforms, textures] = shadowInputs(executor, plan, light, outer);
   executor.drawViewed(plan, camera, light, { uniforms: { ...extra.uniforms, ...uniforms }, textures });
 }
 function shadowInputs(executor, plan, light, outer, params = plan.multipass.params) {
-  const key = `shadow-map ${plan.geometry.key} ${light.direction.join(",")}`;
+  const key = `shadow-map ${plan.geometry.key}`;
+  const direction = light.direction.join(",");
+  const made = executor.cache.get(key);
+  if (made && made.direction !== direction) {
+    releaseAll(executor.gl, made);
+    executor.cache.delete(key);
+  }
   if (!executor.cache.has(key)) {
     const gl = executor.gl;
     const size = Number(params.size);
@@ -274,9 +450,9 @@ function shadowInputs(executor, plan, light, outer, params = plan.multipass.para
       u_shadow_texel: texel,
       u_shadow_bias: "bias" in params ? Number(params.bias) : texel / (cam.far - cam.near)
     };
-    executor.cache.set(key, [uniforms, { u_shadow_map: { tex: depth, target: gl.TEXTURE_2D } }]);
+    executor.cache.set(key, { direction, inputs: [uniforms, { u_shadow_map: { tex: depth, target: gl.TEXTURE_2D } }] });
   }
-  return executor.cache.get(key);
+  return executor.cache.get(key).inputs;
 }
 function nested(box) {
   if (box && box.data) return [Array.from(box.data.slice(0, 3), Number), Array.from(box.data.slice(3, 6), Number)];
@@ -451,7 +627,7 @@ function stencilTarget(executor, w, h) {
     gl.drawBuffers(SOURCES.map((_, i) => gl.COLOR_ATTACHMENT0 + i));
     const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
     if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`a ${w}x${h} framebuffer with a stencil buffer is incomplete (0x${status.toString(16)})`);
-    executor.cache.set(key, { fbo, textures });
+    executor.cache.set(key, { fbo, textures, rbo });
   }
   return executor.cache.get(key);
 }
@@ -1240,6 +1416,7 @@ var Executor = class {
       gl.attachShader(prog, shader);
     }
     gl.linkProgram(prog);
+    for (const shader of gl.getAttachedShaders(prog)) gl.deleteShader(shader);
     if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) {
       throw new Error(`${name} does not link in this browser: ${gl.getProgramInfoLog(prog).trim()}`);
     }
@@ -1334,6 +1511,19 @@ var Executor = class {
     for (const [name, value] of Object.entries({ u_debug: 0, ...uniforms, ...samplers })) setUniform(gl, this.present, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+  /** Free every GL object this executor made (programs, buffers, vertex arrays, textures,
+   *  a multi-pass kind's targets): its plans are replaced (the page's option controls). */
+  dispose() {
+    const gl = this.gl;
+    for (const { prog } of [...this.programs.values(), this.present, this.copyDepth]) gl.deleteProgram(prog);
+    for (const made of this.buffers.values()) for (const { buffer } of Object.values(made)) gl.deleteBuffer(buffer);
+    for (const vao of this.vaos.values()) gl.deleteVertexArray(vao);
+    for (const { tex } of this.textures.values()) gl.deleteTexture(tex);
+    for (const entry of this.cache.values()) releaseAll(gl, entry);
+    if (this.query) gl.deleteQuery(this.query);
+    for (const map of [this.programs, this.buffers, this.vaos, this.textures, this.cache, this.groups]) map.clear();
+    this.query = null;
   }
   /** The GPU time of the latest timed frame's draws in ms (null until one is known): a timer
    *  query's result becomes available only after the page has returned to the browser. */
@@ -1480,7 +1670,7 @@ function createTargets(gl, [w, h], extra = 0) {
   gl.bindFramebuffer(gl.FRAMEBUFFER, frontFbo);
   gl.clearBufferfv(gl.COLOR, 0, [0, 0, 0, 0]);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-  return { fbo, color, position, normal, iterations, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontOpacity, size: [w, h], attachments: FRAME_ATTACHMENTS + extra };
+  return { fbo, color, position, normal, iterations, depth, transparentFbo, transparent, depthCopyFbo, depthCopy, frontFbo, frontOpacity, size: [w, h], attachments: FRAME_ATTACHMENTS + extra };
 }
 function counts(gl, plan) {
   const g = plan.geometry;
@@ -2872,14 +3062,19 @@ async function makeDrawable(gl, glb, draw, name, programs, report2) {
   const plans = decodePlans(draw, await readArrays(gl, glb, draw));
   const executor = new Executor(gl, draw, name, HOOKS, programs);
   const drawn = [];
-  for (const plan of plans) {
-    try {
-      executor.add(plan);
-      drawn.push(plan);
-    } catch (e) {
-      if (!(e instanceof Unsupported)) throw e;
-      report2(`${name}: ${e.message}`);
+  try {
+    for (const plan of plans) {
+      try {
+        executor.add(plan);
+        drawn.push(plan);
+      } catch (e) {
+        if (!(e instanceof Unsupported)) throw e;
+        report2(`${name}: ${e.message}`);
+      }
     }
+  } catch (e) {
+    executor.dispose();
+    throw e;
   }
   return { executor, plans: drawn };
 }
@@ -2938,6 +3133,19 @@ var DebugViews = class {
       const reference = mode === "mask" && p === this.reference ? "the reference of the mask difference" : "";
       this.setNote(p, this.unavailable(p) || reference);
     }
+  }
+  /** Free ``p``'s iteration-counting plans and targets (its render options changed: they are
+   *  made again from its new GLB when next needed). */
+  static forget(p) {
+    if (p.counting) {
+      p.counting.executor.dispose();
+      releaseAll(p.gl, p.counting.targets);
+    }
+    delete p.counting;
+  }
+  /** The current view again, after panels' plans were replaced. */
+  refresh() {
+    return this.select(this.mode);
   }
   /** The panel's iteration-counting plans and their targets (one more attachment), made
    *  once; null for a kind whose export has none. */
@@ -3067,10 +3275,31 @@ window.addEventListener("error", (e) => report(`error: ${e.message}`));
 window.addEventListener("unhandledrejection", (e) => report(`error: ${e.reason && e.reason.message ? e.reason.message : e.reason}`));
 async function fetchOk(url) {
   const response = await fetch(url);
+  if (response.status === 400 && (response.headers.get("Content-Type") || "").startsWith("text/plain")) {
+    throw new Error(await response.text());
+  }
   if (!response.ok) throw new Error(`cannot load ${url} (${response.status} ${response.statusText})`);
   return response;
 }
-async function openInput(input, size, programs) {
+async function loadPlans(gl, url, input, programs) {
+  const glb = parseGlb(await (await fetchOk(url)).arrayBuffer(), input.name);
+  const draw = drawOf(glb);
+  return { glb, draw, ...await makeDrawable(gl, glb, draw, input.name, programs, report) };
+}
+async function reloadPanel(panel, query, programs) {
+  const loaded = await loadPlans(panel.executor.gl, `${panel.input.file}?${query}`, panel.input, programs);
+  return {
+    swap() {
+      panel.executor.dispose();
+      DebugViews.forget(panel);
+      Object.assign(panel, loaded);
+    },
+    discard() {
+      loaded.executor.dispose();
+    }
+  };
+}
+async function openInput(input, index, size, programs) {
   const panel = document.createElement("figure");
   const canvas = document.createElement("canvas");
   [canvas.width, canvas.height] = size;
@@ -3083,10 +3312,8 @@ async function openInput(input, size, programs) {
   try {
     const gl = createContext(canvas);
     canvas.addEventListener("webglcontextlost", () => report(`${input.name}: the browser lost the WebGL context (reload the page)`));
-    const glb = parseGlb(await (await fetchOk(input.file)).arrayBuffer(), input.name);
-    const draw = drawOf(glb);
-    const { executor, plans } = await makeDrawable(gl, glb, draw, input.name, programs, report);
-    return { canvas, executor, plans, targets: createTargets(gl, size), input, gl, glb, draw, panel };
+    const loaded = await loadPlans(gl, input.file, input, programs);
+    return { canvas, input, index, targets: createTargets(gl, size), gl, panel, ...loaded };
   } catch (e) {
     report(`${input.name}: ${e.message}`);
     return null;
@@ -3102,9 +3329,9 @@ async function main() {
   let [az, el, dist] = parseView(params.get("view") || frame.default_view);
   const size = parseSize(params.get("size") || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get("light") || manifest.light.angles);
-  const light = lightFrom(manifest.light, lightAz, lightEl);
+  let light = lightFrom(manifest.light, lightAz, lightEl);
   const bounds2 = union(manifest.inputs.map((i) => i.bounds));
-  const panels = (await Promise.all(manifest.inputs.map((i) => openInput(i, size, manifest.programs)))).filter(Boolean);
+  const panels = (await Promise.all(manifest.inputs.map((i, k) => openInput(i, k, size, manifest.programs)))).filter(Boolean);
   const debug = new DebugViews(params, manifest, panels, report);
   const readout = document.getElementById("stats");
   const render = () => {
@@ -3125,8 +3352,9 @@ async function main() {
     params.set("view", `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
     history.replaceState(null, "", `?${params}`);
     state.frames += 1;
-    state.ready = true;
+    state.ready = loads === 0;
   };
+  let loads = 0;
   let pending = false;
   const redraw = () => {
     if (!pending) {
@@ -3171,6 +3399,33 @@ async function main() {
     }, { passive: false });
   }
   await debug.ready;
+  lightControls({
+    form: document.getElementById("light"),
+    angles: [lightAz, lightEl],
+    onChange: (a, e) => {
+      light = lightFrom(manifest.light, a, e);
+      params.set("light", `${a},${e}`);
+      redraw();
+    }
+  });
+  await optionControls({
+    form: document.getElementById("options"),
+    manifest,
+    params,
+    panels,
+    report,
+    reload: (panel, query) => reloadPanel(panel, query, manifest.programs),
+    loading: (promise) => {
+      loads += 1;
+      state.ready = false;
+      promise.catch(() => {
+      }).finally(async () => {
+        await debug.refresh();
+        loads -= 1;
+        redraw();
+      });
+    }
+  });
   render();
 }
 main().catch((e) => report(`error: ${e.message}`)).finally(() => {
