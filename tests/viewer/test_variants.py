@@ -66,7 +66,7 @@ def test_a_glb_with_options_is_the_export_with_them(gl, relief_spec):
     with served({"input-0.glb": inputs[0].glb}, Variants(inputs)) as (base, _):
         status, body = _get(f"{base}input-0.glb?method=binary&linear-steps=2&binary-steps=1")
         assert status == 200
-        assert body == export_bytes(obj, fallback=False, embed_shaders=True,
+        assert body == export_bytes(obj, fallback=False, embed_shaders=True, instrumented=True,
                                     options={"method": "binary", "linear_steps": 2,
                                              "binary_steps": 1})
         assert body != inputs[0].glb
