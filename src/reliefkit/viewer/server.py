@@ -8,7 +8,9 @@ the user's browser shows where the command runs too.
 from __future__ import annotations
 
 import sys
+import threading
 import webbrowser
+from contextlib import contextmanager
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import urlsplit
 
@@ -56,6 +58,20 @@ def make_server(files: dict[str, bytes], port: int = 0, log=None) -> ThreadingHT
         return ThreadingHTTPServer((HOST, port), Handler)
     except OSError as exc:
         raise UsageError(f"cannot serve on {HOST}:{port}: {exc.strerror or exc}") from None
+
+
+@contextmanager
+def serving(files: dict[str, bytes], log=None):
+    """`make_server` of ``files`` on a free port, serving in a thread while the block runs;
+    yields its base URL."""
+    server = make_server(files, 0, log=log)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://{HOST}:{server.server_address[1]}/"
+    finally:
+        server.shutdown()
+        server.server_close()
 
 
 def serve(files: dict[str, bytes], port: int = 0, *, open_browser: bool = True) -> None:
