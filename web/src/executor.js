@@ -183,6 +183,7 @@ export class Executor {
     this.counts.drawCalls = 1; // the picture's presentation, below
     const timing = this.timer && !this.query;
     if (timing) {
+      this.gpuMs = null; // this frame's, once known: never an older frame's
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }

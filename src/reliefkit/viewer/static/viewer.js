@@ -1315,6 +1315,7 @@ var Executor = class {
     this.counts.drawCalls = 1;
     const timing = this.timer && !this.query;
     if (timing) {
+      this.gpuMs = null;
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }

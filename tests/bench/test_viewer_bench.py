@@ -1,0 +1,101 @@
+"""`reliefkit bench viewer`: its quick run's report per input (the mesh and one kind, in
+headless Chromium at a tiny size) with counts that match the GLB the page was given; without
+a browser, one line saying what to install."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from browser import playwright
+from helpers import assert_one_line_error, run_cli
+
+from reliefkit.bench import run_suite, viewer
+from reliefkit.export.draw import read_plans
+from reliefkit.io.gltf.glb import read_glb
+from reliefkit.scene.light import DirectionalLight
+from reliefkit.scene.views import orbit_bounds
+from reliefkit.viewer.site import make_input
+
+SIZE = (48, 48)
+
+
+def plans_in(glb_bytes: bytes, folder):
+    """The draw plans of an input's GLB, read back in Python."""
+    path = folder / "input.glb"
+    path.write_bytes(glb_bytes)
+    glb = read_glb(path)
+    (node,) = [n for n in glb.document["nodes"] if "extensions" in n]
+    (extension,) = node["extensions"].values()
+    return read_plans(glb, extension["draw"])
+
+
+def uploaded_bytes(plans) -> int:
+    """What the page uploads for the plans' textures, once each: the given levels or the
+    array, float64 as float32 (WebGL has no float64 texture)."""
+    textures = {id(t): t for p in plans for t in p.textures.values()}.values()
+    assert not any(t.encoded for t in textures)  # an encoded one is decoded first: not here
+    arrays = [a for t in textures for a in (t.levels or [t.array])]
+    return sum(a.size * min(a.dtype.itemsize, 4) if a.dtype == np.float64 else a.nbytes
+               for a in arrays)
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    with playwright():  # skips where Chromium's driver is missing (fails on CI)
+        pass
+    out = tmp_path_factory.mktemp("bench")
+    markdown, paths = run_suite("viewer", quick=True, out=out, log=lambda line: None,
+                                size=SIZE)
+    return markdown, json.loads((out / "viewer.json").read_text()), paths
+
+
+def test_the_quick_report_has_the_mesh_and_a_kind_with_frames_and_ratios(quick_run):
+    markdown, data, paths = quick_run
+    assert [p.name for p in paths] == ["viewer.json", "viewer.md"]
+    assert data["size"] == list(SIZE) and len(data["azimuths"]) == viewer.QUICK_VIEWS
+    assert "SwiftShader" in data["webgl_renderer"]
+    mesh, kind = data["rows"]
+    assert (mesh["asset"], mesh["kind"]) == ("vehicle", "mesh") and kind["kind"] != "mesh"
+    for row in (mesh, kind):
+        assert len(row["frame_ms"]) == viewer.QUICK_VIEWS
+        assert 0 < row["fastest_ms"] <= row["median_ms"]
+        assert row["fps"] == pytest.approx(1000.0 / row["median_ms"])
+        assert row["meets_target"] == (row["fps"] >= viewer.TARGET_FPS)
+        assert f"| {row['asset']} | {row['kind']} |" in markdown
+    assert mesh["mesh_ratio"] == 1.0
+    assert kind["mesh_ratio"] == pytest.approx(kind["median_ms"] / mesh["median_ms"])
+
+
+def test_the_counts_are_the_plans_and_texture_bytes_of_the_glb(quick_run, tmp_path):
+    """Plans drawn, draw calls of the last frame (one per single-pass plan its view hook
+    leaves on, seen in Python from the orbit's last view, and the picture's presentation)
+    and texture bytes against the GLB each page was given, read in Python."""
+    _, data, _ = quick_run
+    inputs = list(viewer._inputs(True, lambda line: None))
+    assert len(inputs) == len(data["rows"])
+    for (_, kind, spec, obj), row in zip(inputs, data["rows"], strict=True):
+        made = make_input(spec, obj)
+        plans = plans_in(made.glb, tmp_path)
+        assert row["plans"] == len(plans), kind
+        assert not any(p.multipass for p in plans)  # one draw each
+        camera = orbit_bounds(made.bounds, data["azimuths"][-1], data["elevation"], size=SIZE)
+        drawn = [p for p in plans if p.with_view(camera, DirectionalLight())[0].count != 0]
+        assert row["draw_calls"] == len(drawn) + 1, kind
+        assert row["texture_bytes"] == uploaded_bytes(plans), kind
+    assert data["rows"][1]["texture_bytes"] > 0  # the kind's textures are counted
+
+
+def test_without_chromium_the_bench_says_what_to_install(tmp_path):
+    result = run_cli("bench", "viewer", "--quick", "--out", tmp_path / "out",
+                     env={"RELIEFKIT_CHROMIUM": str(tmp_path / "no-chromium")})
+    assert_one_line_error(result, "RELIEFKIT_CHROMIUM", "no executable browser")
+    assert not (tmp_path / "out").exists()
+
+
+def test_size_and_browser_apply_to_the_viewer_bench_only(tmp_path):
+    result = run_cli("bench", "export", "--size", "64x64", "--out", tmp_path)
+    assert_one_line_error(result, "bench export takes no --size", "viewer")
+    result = run_cli("bench", "viewer", "--size", "64y64", "--out", tmp_path)
+    assert_one_line_error(result, "--size must be WxH")
