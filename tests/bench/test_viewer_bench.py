@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 import pytest
-from browser import playwright
+from browser import launch, playwright
 from helpers import assert_one_line_error, run_cli
 
 from reliefkit.bench import run_suite, viewer
@@ -43,8 +43,8 @@ def uploaded_bytes(plans) -> int:
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
-    with playwright():  # skips where Chromium's driver is missing (fails on CI)
-        pass
+    with playwright() as p:  # skips where Playwright or Chromium is missing (fails on CI)
+        launch(p).close()
     out = tmp_path_factory.mktemp("bench")
     markdown, paths = run_suite("viewer", quick=True, out=out, log=lambda line: None,
                                 size=SIZE)
@@ -69,9 +69,10 @@ def test_the_quick_report_has_the_mesh_and_a_kind_with_frames_and_ratios(quick_r
 
 
 def test_the_counts_are_the_plans_and_texture_bytes_of_the_glb(quick_run, tmp_path):
-    """Plans drawn, draw calls of the last frame (one per single-pass plan its view hook
-    leaves on, seen in Python from the orbit's last view, and the picture's presentation)
-    and texture bytes against the GLB each page was given, read in Python."""
+    """Plans drawn, draw calls and vertices of the last frame (one draw per single-pass plan
+    its view hook leaves on, seen in Python from the orbit's last view, and the picture's
+    presentation: a full-screen triangle) and texture bytes against the GLB each page was
+    given, read in Python."""
     _, data, _ = quick_run
     inputs = list(viewer._inputs(True, lambda line: None))
     assert len(inputs) == len(data["rows"])
@@ -81,8 +82,13 @@ def test_the_counts_are_the_plans_and_texture_bytes_of_the_glb(quick_run, tmp_pa
         assert row["plans"] == len(plans), kind
         assert not any(p.multipass for p in plans)  # one draw each
         camera = orbit_bounds(made.bounds, data["azimuths"][-1], data["elevation"], size=SIZE)
-        drawn = [p for p in plans if p.with_view(camera, DirectionalLight())[0].count != 0]
+        viewed = [p.with_view(camera, DirectionalLight())[0] for p in plans]
+        drawn = [p for p in viewed if p.count != 0]
         assert row["draw_calls"] == len(drawn) + 1, kind
+        assert all(p.geometry.indices is not None for p in drawn)  # counted by their indices
+        assert row["vertices"] == 3 + sum(
+            (p.geometry.indices.size if p.count is None else p.count)
+            * (p.geometry.instances or 1) for p in drawn), kind
         assert row["texture_bytes"] == uploaded_bytes(plans), kind
     assert data["rows"][1]["texture_bytes"] > 0  # the kind's textures are counted
 

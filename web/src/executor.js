@@ -59,8 +59,9 @@ export class Executor {
     this.query = null;
     this.gpuMs = null;
     // what explains a frame's cost, whatever the device (reliefkit bench viewer): the plans
-    // taken, the texture bytes uploaded (as given: no built mipmaps), the last frame's draw calls
-    this.counts = { plans: 0, textureBytes: 0, drawCalls: 0 };
+    // taken, the texture bytes uploaded (as given: no built mipmaps), the last frame's draw
+    // calls and vertices (instances included: a slice stack's many quads)
+    this.counts = { plans: 0, textureBytes: 0, drawCalls: 0, vertices: 0 };
     // the page's own programs, built by reliefkit's shader loader (inputs.json `programs`)
     this.present = this.link(programs.present.name, programs.present);
     this.copyDepth = this.link(programs.copy_depth.name, programs.copy_depth);
@@ -180,7 +181,7 @@ export class Executor {
     };
     const opaque = pass(targets.fbo);
     const transparent = pass(targets.transparentFbo);
-    this.counts.drawCalls = 1; // the picture's presentation, below
+    Object.assign(this.counts, { drawCalls: 1, vertices: 3 }); // the picture's presentation, below
     const timing = this.timer && !this.query;
     if (timing) {
       this.gpuMs = null; // this frame's, once known: never an older frame's
@@ -266,6 +267,7 @@ export class Executor {
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     this.counts.drawCalls += 1;
+    this.counts.vertices += 3;
   }
 
   /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
@@ -286,6 +288,7 @@ export class Executor {
     else if (instances != null) gl.drawArraysInstanced(mode, first, count, instances);
     else gl.drawArrays(mode, first, count);
     this.counts.drawCalls += 1;
+    this.counts.vertices += count * (instances ?? 1);
     gl.bindVertexArray(null);
   }
 

@@ -7,8 +7,8 @@ the baseline, each alone in the page (`reliefkit view`'s site, served by its own
 fastest frame (the page's CPU clock around the draws and a one-pixel read back), the GPU
 timer query's time where the browser has the extension, fps from the median, the ratio to
 its asset's mesh in the same run, and what explains the cost on any device: the plans drawn,
-the draw calls of a frame and the texture bytes uploaded. With ``--quick``: the vehicle's
-mesh and the first kind at 256 x 256, two views.
+the draw calls and vertices of a frame (instances included) and the texture bytes
+uploaded. With ``--quick``: the vehicle's mesh and the first kind at 256 x 256, two views.
 """
 
 from __future__ import annotations
@@ -131,7 +131,7 @@ def _measure(chrome, spec: str, obj, size, azimuths) -> tuple[dict, str | None]:
             "fps": 1000.0 / median if median > 0 else None,
             "meets_target": median > 0 and 1000.0 / median >= TARGET_FPS,
             "plans": counts["plans"], "draw_calls": counts["drawCalls"],
-            "texture_bytes": counts["textureBytes"]}, renderer
+            "vertices": counts["vertices"], "texture_bytes": counts["textureBytes"]}, renderer
 
 
 def _add_ratios(rows: list[dict]) -> None:
@@ -153,17 +153,18 @@ def _markdown(data: dict) -> str:
              f"Browser: headless Chromium, backend {data['backend']}, WebGL renderer "
              f"{data['webgl_renderer'] or 'unknown'}.", machine_line(data["machine"]), "",
              "| asset | kind | median frame | fastest | GPU (timer query) | fps | x mesh | "
-             f"{data['target_fps']:g} fps | plans | draw calls | texture bytes |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             f"{data['target_fps']:g} fps | plans | draw calls | vertices | texture bytes |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in data["rows"]:
         if "refused" in r or "error" in r:
             why = f"refused: {r['refused']}" if "refused" in r else f"error: {r['error']}"
-            lines.append(f"| {r['asset']} | {r['kind']} | {why} | | | | | | | | |")
+            lines.append(f"| {r['asset']} | {r['kind']} | {why} | | | | | | | | | |")
             continue
         fps = "n/a" if r["fps"] is None else f"{r['fps']:.1f}"
         ratio = f"{r['mesh_ratio']:.2f}" if "mesh_ratio" in r else "n/a"
         lines.append(f"| {r['asset']} | {r['kind']} | {_ms(r['median_ms'])} | "
                      f"{_ms(r['fastest_ms'])} | {_ms(r['gpu_median_ms'])} | {fps} | {ratio} | "
                      f"{'yes' if r['meets_target'] else 'no'} | {r['plans']} | "
-                     f"{r['draw_calls']} | {format_bytes(r['texture_bytes'])} |")
+                     f"{r['draw_calls']} | {r['vertices']:,} | "
+                     f"{format_bytes(r['texture_bytes'])} |")
     return "\n".join(lines) + "\n"

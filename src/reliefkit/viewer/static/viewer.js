@@ -1201,7 +1201,7 @@ var Executor = class {
     this.timer = gl.getExtension("EXT_disjoint_timer_query_webgl2");
     this.query = null;
     this.gpuMs = null;
-    this.counts = { plans: 0, textureBytes: 0, drawCalls: 0 };
+    this.counts = { plans: 0, textureBytes: 0, drawCalls: 0, vertices: 0 };
     this.present = this.link(programs.present.name, programs.present);
     this.copyDepth = this.link(programs.copy_depth.name, programs.copy_depth);
   }
@@ -1312,7 +1312,7 @@ var Executor = class {
     };
     const opaque = pass(targets.fbo);
     const transparent = pass(targets.transparentFbo);
-    this.counts.drawCalls = 1;
+    Object.assign(this.counts, { drawCalls: 1, vertices: 3 });
     const timing = this.timer && !this.query;
     if (timing) {
       this.gpuMs = null;
@@ -1392,6 +1392,7 @@ var Executor = class {
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     this.counts.drawCalls += 1;
+    this.counts.vertices += 3;
   }
   /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
    *  ``raster``, ``uniforms`` and ``textures`` replace or add to the plan's. */
@@ -1411,6 +1412,7 @@ var Executor = class {
     else if (instances != null) gl.drawArraysInstanced(mode, first, count, instances);
     else gl.drawArrays(mode, first, count);
     this.counts.drawCalls += 1;
+    this.counts.vertices += count * (instances ?? 1);
     gl.bindVertexArray(null);
   }
   /** Bind textures (sampler name -> plan texture or {tex, target}) to units 0, 1, ...;
