@@ -42,9 +42,14 @@ def uploaded_bytes(plans) -> int:
 
 
 @pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    with playwright() as p:  # skips where Playwright or Chromium is missing (fails on CI)
+def chromium_here():
+    """Skips where Playwright or Chromium is missing (a failure on CI)."""
+    with playwright() as p:
         launch(p).close()
+
+
+@pytest.fixture(scope="module")
+def quick_run(chromium_here, tmp_path_factory):
     out = tmp_path_factory.mktemp("bench")
     markdown, paths = run_suite("viewer", quick=True, out=out, log=lambda line: None,
                                 size=SIZE)
@@ -97,6 +102,18 @@ def test_without_chromium_the_bench_says_what_to_install(tmp_path):
     result = run_cli("bench", "viewer", "--quick", "--out", tmp_path / "out",
                      env={"RELIEFKIT_CHROMIUM": str(tmp_path / "no-chromium")})
     assert_one_line_error(result, "RELIEFKIT_CHROMIUM", "no executable browser")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_frame_the_page_refuses_stops_the_bench_before_any_bake(chromium_here, tmp_path):
+    """The baseline mesh comes first: its page's refusal (5000² of float targets, over its
+    1 GiB) is the bench's one error line, after its progress line, with nothing written."""
+    result = run_cli("bench", "viewer", "--quick", "--size", "5000x5000", "--out",
+                     tmp_path / "out")
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    *progress, error = result.stderr.strip().splitlines()
+    assert progress == ["bench viewer: demo:vehicle: mesh at 5000x5000, 2 views"]
+    assert error.startswith("error: the viewer page: demo:vehicle: a 5000x5000 frame needs")
     assert not (tmp_path / "out").exists()
 
 

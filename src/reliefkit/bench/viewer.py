@@ -59,7 +59,7 @@ def run_suite(quick: bool, out: Path, log, size: tuple[int, int] | None = None,
                 row, renderer = _measure(chrome, spec, obj, size, azimuths)
                 rows.append({"asset": asset, "kind": kind, **row})
                 if kind == "mesh" and "error" in row:  # the mesh drawn nowhere: nothing will be
-                    raise UsageError(f"the viewer page cannot draw {spec}: {row['error']}")
+                    raise UsageError(f"the viewer page: {row['error']}")
         finally:
             chrome.close()
     _add_ratios(rows)
