@@ -42,6 +42,8 @@ RENDERER_JS = """() => {
 
 def run_suite(quick: bool, out: Path, log, size: tuple[int, int] | None = None,
               browser: str = "swiftshader") -> tuple[str, list[Path]]:
+    """The suite at ``size`` (None: 1920x1080, or 256x256 with ``quick``) on Chromium's
+    ``browser`` backend (`viewer.browser.BACKENDS`)."""
     size = tuple(size or (QUICK_SIZE if quick else SIZE))
     chromium_path()  # what to install, said before anything is baked
     require_playwright()
@@ -56,9 +58,10 @@ def run_suite(quick: bool, out: Path, log, size: tuple[int, int] | None = None,
                     rows.append({"asset": asset, "kind": kind, "refused": spec})
                     continue
                 log(f"{spec}: {kind} at {size[0]}x{size[1]}, {n} views")
-                row, renderer = _measure(chrome, spec, obj, size, azimuths)
+                row, seen = _measure(chrome, spec, obj, size, azimuths)
+                renderer = renderer or seen
                 rows.append({"asset": asset, "kind": kind, **row})
-                if kind == "mesh" and "error" in row:  # the mesh drawn nowhere: nothing will be
+                if kind == "mesh" and "error" in row:  # a frame size it refuses, say
                     raise UsageError(f"the viewer page: {row['error']}")
         finally:
             chrome.close()
