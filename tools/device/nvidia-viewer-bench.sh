@@ -5,7 +5,8 @@
 # OUT/viewer/viewer.{md,json} and OUT/viewer.log (OUT defaults to out/nvidia). Extra arguments
 # go to the bench (say --quick for a dry run). PY picks the Python (default python3).
 #
-# UNRUN: written when no device was lent (issue 32); checked by reading only.
+# NOT RUN ON A GPU: written when no device was lent (issue 32). A --quick dry run on the
+# 2-core machine without a GPU went through (llvmpipe drew, and the warning below said so).
 # What it needs there, besides prepare.sh's .gl/ and .whl/ (tools/device/fetch-deps.sh):
 # - Chromium. It cannot travel with the device tool: Debian's chromium .deb alone is 81 MB
 #   (290 MB installed, with ~40 libraries the image lacks: GTK, NSS, ...), over the 64 MiB the
