@@ -1,6 +1,7 @@
-"""Headless Chromium for the viewer's tests: Debian's ``chromium`` driven by Playwright for
-Python (`page(site)` opens a served site), and the site served from memory by the viewer's
-own server (`served`), with the lines the page posts to its log.
+"""Headless Chromium for the viewer's tests (launched by `reliefkit.viewer.browser`: Debian's
+``chromium`` driven by Playwright for Python; `open_page` opens a served site), and the site
+served from memory by the viewer's own server (`served`), with the lines the page posts to
+its log.
 
 Where Chromium or Playwright is missing the calling test skips with the reason, except on CI
 (``CI=true``), where that is a failure: `./run test` and `.ci/run` install both.
@@ -11,20 +12,15 @@ from __future__ import annotations
 import base64
 import io
 import os
-import shutil
-import threading
 from contextlib import contextmanager
 
 import numpy as np
 import pytest
 
-CHROMIUM = "/usr/bin/chromium"
-# headless, on a closed network (ecosystem notes), with WebGL2 through ANGLE on SwiftShader
-# or on Mesa's llvmpipe (what `reliefkit render` draws with here; blocklisted without the flag)
-FLAGS = ["--headless=new", "--no-sandbox", "--disable-background-networking",
-         "--disable-component-update"]
-BACKENDS = {"swiftshader": ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"],
-            "mesa": ["--use-angle=gl-egl", "--ignore-gpu-blocklist"]}
+from reliefkit.errors import UsageError
+from reliefkit.viewer import browser
+from reliefkit.viewer.server import serving
+
 READY_TIMEOUT_MS = 120_000
 SIZE = (128, 128)  # the pages the tests compare with `reliefkit render`
 
@@ -39,47 +35,40 @@ def unavailable(reason: str):
 def playwright():
     """Playwright's sync API, once per test module (it runs one instance at a time)."""
     try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        unavailable("playwright is not installed (pip install playwright)")
-    with sync_playwright() as p:
+        browser.require_playwright()
+    except UsageError as exc:
+        unavailable(str(exc))
+    with browser.playwright() as p:
         yield p
 
 
 def launch(p, backend: str = "swiftshader"):
     """A headless Chromium (Playwright's Browser) drawing WebGL2 with ``backend``."""
-    path = shutil.which("chromium") or (CHROMIUM if os.path.exists(CHROMIUM) else None)
-    if path is None:
-        unavailable("chromium is not installed (apt-get install chromium)")
-    return p.chromium.launch(executable_path=path, args=FLAGS + BACKENDS[backend])
+    try:
+        browser.chromium_path()
+    except UsageError as exc:
+        unavailable(str(exc))
+    return browser.launch(p, backend)
 
 
 @contextmanager
 def chromium(backend: str = "swiftshader"):
     """A headless Chromium of its own, closed at the end."""
     with playwright() as p:
-        browser = launch(p, backend)
+        b = launch(p, backend)
         try:
-            yield browser
+            yield b
         finally:
-            browser.close()
+            b.close()
 
 
 @contextmanager
 def served(files: dict, variants=None):
     """The viewer's server of ``files`` (and ``variants``: the GLBs made with other render
     options) on a free port, in a thread: (base URL, log lines)."""
-    from reliefkit.viewer.server import make_server
-
     lines: list[str] = []
-    server = make_server(files, 0, log=lines.append, variants=variants)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{server.server_address[1]}/", lines
-    finally:
-        server.shutdown()
-        server.server_close()
+    with serving(files, lines.append, variants) as url:
+        yield url, lines
 
 
 def open_page(browser, url: str, init_script: str | None = None):

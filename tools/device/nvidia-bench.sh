@@ -8,27 +8,10 @@
 # PY picks the Python (default python3).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
-PY="${PY:-python3}"
 OUT="${OUT:-out/nvidia}"
 mkdir -p "$OUT"
-if [ -d /usr/local/nvidia ] && [ -d .gl ]; then  # unpack the GL loaders (not on a workstation)
-    for f in .gl/*.deb; do dpkg -x "$f" /; done
-    ldconfig
-    egl_vendor=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-    [ -f "$egl_vendor" ] && export __EGL_VENDOR_LIBRARY_FILENAMES="$egl_vendor"
-fi
-if ! "$PY" -c "import moderngl, glcontext, trimesh" 2>/dev/null; then
-    [ -d .whl ] || { echo "error: no .whl/ here: run tools/device/fetch-deps.sh first" >&2; exit 2; }
-    "$PY" -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
-        --target /tmp/site .whl/*.whl || exit 2
-    export PYTHONPATH="/tmp/site${PYTHONPATH:+:$PYTHONPATH}"
-fi
-export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1
-# the image's own numpy, scipy and numba are used: say so if they do not go together
-"$PY" -c "import numpy, scipy, numba; print('numpy', numpy.__version__, 'numba', numba.__version__)" \
-    || { echo "error: the image's numba/numpy do not import together: add numba and llvmlite" \
-              "wheels to .whl/" >&2; exit 2; }
-command -v nvidia-smi >/dev/null && nvidia-smi -L
+# shellcheck source=prepare.sh
+. tools/device/prepare.sh || exit 2
 "$PY" -c "from reliefkit.gl.context import get_context, gl_info; print(gl_info(get_context()))" \
     || exit 3
 "$PY" -c 'import sys; from reliefkit.cli import main; sys.exit(main(sys.argv[1:]))' \

@@ -59,6 +59,10 @@ export class Executor {
     this.timer = gl.getExtension('EXT_disjoint_timer_query_webgl2'); // GPU time, where the browser has it
     this.query = null;
     this.gpuMs = null;
+    // what explains a frame's cost, whatever the device (reliefkit bench viewer): the plans
+    // taken, the texture bytes uploaded (as given: no built mipmaps), the last frame's draw
+    // calls and vertices (instances included: a slice stack's many quads)
+    this.counts = { plans: 0, textureBytes: 0, drawCalls: 0, vertices: 0 };
     // the page's own programs, built by reliefkit's shader loader (inputs.json `programs`)
     this.present = this.link(programs.present.name, programs.present);
     this.copyDepth = this.link(programs.copy_depth.name, programs.copy_depth);
@@ -74,6 +78,7 @@ export class Executor {
       if (!this.groups.has(plan.geometry.key)) this.groups.set(plan.geometry.key, []);
       this.groups.get(plan.geometry.key).push(plan);
     }
+    this.counts.plans += 1;
   }
 
   check(plan) {
@@ -159,7 +164,11 @@ export class Executor {
   }
 
   texture(t) {
-    if (!this.textures.has(t)) this.textures.set(t, uploadTexture(this.gl, t));
+    if (!this.textures.has(t)) {
+      const made = uploadTexture(this.gl, t);
+      this.counts.textureBytes += made.bytes;
+      this.textures.set(t, made);
+    }
     return this.textures.get(t);
   }
 
@@ -176,8 +185,10 @@ export class Executor {
     };
     const opaque = pass(targets.fbo);
     const transparent = pass(targets.transparentFbo);
+    Object.assign(this.counts, { drawCalls: 1, vertices: 3 }); // the picture's presentation, below
     const timing = this.timer && !this.query;
     if (timing) {
+      this.gpuMs = null; // this frame's, once known: never an older frame's
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }
@@ -274,6 +285,8 @@ export class Executor {
     for (const [name, value] of Object.entries(this.bindTextures(textures))) setUniform(gl, linked, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+    this.counts.drawCalls += 1;
+    this.counts.vertices += 3;
   }
 
   /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
@@ -293,6 +306,8 @@ export class Executor {
     else if (indexed) gl.drawElements(mode, count, gl.UNSIGNED_INT, first * 4);
     else if (instances != null) gl.drawArraysInstanced(mode, first, count, instances);
     else gl.drawArrays(mode, first, count);
+    this.counts.drawCalls += 1;
+    this.counts.vertices += count * (instances ?? 1);
     gl.bindVertexArray(null);
   }
 

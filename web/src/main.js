@@ -4,8 +4,9 @@
 // their defaults, kept up to date); a drag (mouse or touch) or the arrow keys orbit, the wheel
 // or + and - zoom; controls.js switches render options and moves the light;
 // ?debug=normals|depth|iterations|mask shows a debug view instead (debug_views.js).
-// window.reliefkit.ready turns true after the first complete frame; errors show in the page
-// and are posted to the server's log.
+// window.reliefkit.ready turns true after the first complete frame (frameMs, gpuMs and each
+// panel's counts are the latest frame's; setView(az, el, dist) draws a view: the bench's
+// orbit); errors show in the page and are posted to the server's log.
 
 import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
 import { lightControls, optionControls } from './controls.js';
@@ -105,6 +106,7 @@ async function main() {
     for (const p of debug.order(panels)) debug.draw(p, camera, light);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start; // the CPU's clock around the draws and a read back
+    state.counts = panels.map((p) => ({ ...p.executor.counts }));
     const shown = () => {
       const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
@@ -175,6 +177,13 @@ async function main() {
       });
     },
   });
+  // reliefkit bench viewer's orbit: draw AZ,EL,DIST (DIST null: framed) now; resolves after
+  // the browser has had the frame, with the timer query's result where it has one
+  state.setView = (a, e, d = null) => {
+    [az, el, dist] = [a, e, d];
+    render();
+    return new Promise((resolve) => setTimeout(() => resolve({ frameMs: state.frameMs, gpuMs: state.gpuMs }), 60));
+  };
   render();
 }
 

@@ -54,9 +54,11 @@ export function uploadTexture(gl, t) {
   const tex = gl.createTexture();
   gl.bindTexture(target, tex);
   gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  let bytes = 0;
   levels.forEach((level, k) => {
     const [d, h, w] = planar ? [1, ...level.shape.slice(0, 2)] : level.shape.slice(0, 3);
     const data = level.dtype === 'float64' ? new Float32Array(level.data) : level.data;
+    bytes += data.byteLength;
     if (planar) gl.texImage2D(target, k, internal, w, h, 0, fmt, type, data);
     else gl.texImage3D(target, k, internal, w, h, d, 0, fmt, type, data);
   });
@@ -79,5 +81,5 @@ export function uploadTexture(gl, t) {
   (t.wrap || []).slice(0, planar ? 2 : 3).forEach((w, i) => {
     gl.texParameteri(target, wraps[i], w === 'repeat' ? gl.REPEAT : gl.CLAMP_TO_EDGE);
   });
-  return { tex, target };
+  return { tex, target, bytes };
 }

@@ -1,7 +1,8 @@
 """Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique, or one of the
 core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering;
 `compact`: compressed textures' bytes and error; `scene`: instancing; `export`: glTF
-exports' bytes, time and fallbacks).
+exports' bytes, time and fallbacks; `viewer`: the viewer page's frame time per kind in
+headless Chromium).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
@@ -15,14 +16,15 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import compact, export, loading, platform, scene
+from . import compact, export, loading, platform, scene, viewer
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
-              log=None, mesh: str | None = None) -> tuple[str, list[Path]]:
+              log=None, mesh: str | None = None, **options) -> tuple[str, list[Path]]:
     """Run the suite ``name``; returns its markdown report and the files it wrote.
 
-    ``mesh`` (a mesh file) replaces the built-in assets of a suite that ``takes_mesh``.
+    ``mesh`` (a mesh file) replaces the built-in assets of a suite that ``takes_mesh``;
+    ``options`` (None: not given) go to a suite that names them in its ``options``.
     Without ``log`` the suite's step messages are its progress (`reliefkit.progress.activity`:
     ``bench NAME: ...`` lines on stderr, a spinner on a terminal).
     """
@@ -37,6 +39,13 @@ def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
             raise UsageError(f"bench {name} runs on its own assets only: --mesh applies to "
                              f"{takers}")
         kwargs["mesh"] = str(mesh)
+    for key, value in options.items():
+        if value is None:
+            continue
+        if key not in suite.options:
+            takers = ", ".join(n for n, s in table.items() if key in s.options) or "none"
+            raise UsageError(f"bench {name} takes no --{key}: it applies to {takers}")
+        kwargs[key] = value
     if log is not None:
         return suite.run(quick, Path(out), log, **kwargs)
     with activity(f"bench {name}") as progress_log:
@@ -56,7 +65,10 @@ def suites() -> dict:
                                 scene.run_suite, takes_mesh=True),
             "export": BenchSuite("export", "glTF export per demo asset and kind: .rk against "
                                  ".glb bytes, export time, the fallback's triangles and "
-                                 "coverage against the mesh", export.run_suite)}
+                                 "coverage against the mesh", export.run_suite),
+            "viewer": BenchSuite("viewer", "the viewer page's frame time per kind in headless "
+                                 "Chromium against the mesh's, with its draw calls and texture "
+                                 "bytes", viewer.run_suite, options=("size", "browser"))}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 

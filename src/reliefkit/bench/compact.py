@@ -21,7 +21,6 @@ import numpy as np
 
 from ..bake import bake
 from ..compact.compact import CompressOptions, compress, gpu_bytes
-from ..core.technique import bakers
 from ..errors import UsageError
 from ..io.inputs import load_input
 from ..io.rk import save
@@ -29,6 +28,7 @@ from ..metrics import mask_iou, psnr, ssim
 from ..render.draw import render
 from ..scene.views import orbit_bounds
 from ..units import format_bytes
+from .kinds import mesh_kinds
 from .report import machine, machine_line, write_report
 
 ASSETS = ("vehicle", "tree", "blob")
@@ -40,7 +40,7 @@ VARIANTS = (("bc7, 16-bit heights", BC), ("bc7, 8-bit heights", replace(BC, heig
 
 
 def run_suite(quick: bool, out: Path, log) -> tuple[str, list[Path]]:
-    kinds = [name for name, (_, b) in bakers().items() if "mesh" in b.sources]
+    kinds = mesh_kinds()
     rows = []
     for asset in ASSETS[:1] if quick else ASSETS:
         mesh = load_input(f"demo:{asset}")

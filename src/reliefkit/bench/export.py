@@ -20,7 +20,6 @@ import time
 from pathlib import Path
 
 from ..bake import bake
-from ..core.technique import bakers
 from ..errors import UsageError
 from ..export import export
 from ..export.gltf import DEFAULT_FALLBACK_TRIANGLES, fallback_of
@@ -30,6 +29,7 @@ from ..metrics import mask_iou
 from ..render.draw import render
 from ..scene.views import orbit_bounds
 from ..units import format_bytes
+from .kinds import mesh_kinds
 from .report import machine, machine_line, write_report
 
 ASSETS = ("vehicle", "tree", "blob", "torus")
@@ -39,7 +39,7 @@ TEXTURES = (("raw", {}), ("bc", {"compress": "bc"}))
 
 
 def run_suite(quick: bool, out: Path, log) -> tuple[str, list[Path]]:
-    kinds = [name for name, (_, b) in bakers().items() if "mesh" in b.sources]
+    kinds = mesh_kinds()
     rows = []
     for asset in ASSETS[:1] if quick else ASSETS:
         mesh = load_input(f"demo:{asset}")

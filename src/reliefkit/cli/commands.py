@@ -461,7 +461,8 @@ def cmd_bench(args) -> int:
     check_writable(args.out, "--out", folder=True)
     if args.mesh is not None:
         _check_mesh_file(args.mesh, "--mesh")
-    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out), mesh=args.mesh)
+    report, paths = run_suite(args.name, quick=args.quick, out=Path(args.out), mesh=args.mesh,
+                              size=args.size and parse_size(args.size), browser=args.browser)
     print(report)
     print("wrote " + ", ".join(map(str, paths)))
     return 0

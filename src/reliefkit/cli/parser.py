@@ -16,6 +16,7 @@ from ..scene.assets import DEMO_NAMES
 from ..scene.light import DEFAULT_LIGHT_ANGLES
 from ..scene.views import DEFAULT_FOV, DEFAULT_SIZE, DEFAULT_VIEW
 from ..shootout.sizing import candidates as shootout_candidates
+from ..viewer.browser import BACKENDS as BROWSER_BACKENDS
 from .commands import (
     cmd_bake,
     cmd_bench,
@@ -280,6 +281,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mesh", metavar="FILE",
                    help="run on this mesh file instead of the built-in assets (suites: "
                         + ", ".join(n for n, s in suites().items() if s.takes_mesh) + ")")
+    p.add_argument("--size", metavar="WxH",
+                   help="frame size (suites: viewer; default 1920x1080, --quick 256x256)")
+    p.add_argument("--browser", choices=tuple(BROWSER_BACKENDS),
+                   help="Chromium's WebGL backend (suites: viewer; default swiftshader; gpu: "
+                        "the machine's GPU through its EGL driver)")
     p.add_argument("--out", default="out/bench", help="folder for .md and .json results")
     p.set_defaults(run=cmd_bench)
 

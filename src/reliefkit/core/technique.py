@@ -131,13 +131,15 @@ class BenchSuite:
     """``reliefkit bench NAME``: ``run(quick, out, log) -> (markdown, written paths)``.
 
     A suite with ``takes_mesh`` also runs on a user's mesh instead of its built-in assets
-    (``bench NAME --mesh FILE``): ``run(quick, out, log, mesh=FILE)``.
+    (``bench NAME --mesh FILE``): ``run(quick, out, log, mesh=FILE)``. ``options`` names the
+    bench command's other options it takes (``size``, ``browser``), given as keywords.
     """
 
     name: str
     summary: str
     run: Callable
     takes_mesh: bool = False
+    options: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,9 @@ refuse is a 400 whose body is its one-line message.
 from __future__ import annotations
 
 import sys
+import threading
 import webbrowser
+from contextlib import contextmanager
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import urlsplit
 
@@ -75,6 +77,20 @@ def make_server(files: dict[str, bytes], port: int = 0, log=None,
         return ThreadingHTTPServer((HOST, port), Handler)
     except OSError as exc:
         raise UsageError(f"cannot serve on {HOST}:{port}: {exc.strerror or exc}") from None
+
+
+@contextmanager
+def serving(files: dict[str, bytes], log=None, variants=None):
+    """`make_server` of ``files`` on a free port, serving in a thread while the block runs;
+    yields its base URL."""
+    server = make_server(files, 0, log=log, variants=variants)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://{HOST}:{server.server_address[1]}/"
+    finally:
+        server.shutdown()
+        server.server_close()
 
 
 def serve(files: dict[str, bytes], port: int = 0, *, open_browser: bool = True,

@@ -1306,9 +1306,11 @@ function uploadTexture(gl, t) {
   const tex = gl.createTexture();
   gl.bindTexture(target, tex);
   gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  let bytes = 0;
   levels.forEach((level, k) => {
     const [d, h, w] = planar ? [1, ...level.shape.slice(0, 2)] : level.shape.slice(0, 3);
     const data = level.dtype === "float64" ? new Float32Array(level.data) : level.data;
+    bytes += data.byteLength;
     if (planar) gl.texImage2D(target, k, internal, w, h, 0, fmt, type, data);
     else gl.texImage3D(target, k, internal, w, h, d, 0, fmt, type, data);
   });
@@ -1331,7 +1333,7 @@ function uploadTexture(gl, t) {
   (t.wrap || []).slice(0, planar ? 2 : 3).forEach((w, i) => {
     gl.texParameteri(target, wraps[i], w === "repeat" ? gl.REPEAT : gl.CLAMP_TO_EDGE);
   });
-  return { tex, target };
+  return { tex, target, bytes };
 }
 
 // web/src/executor.js
@@ -1375,6 +1377,7 @@ var Executor = class {
     this.timer = gl.getExtension("EXT_disjoint_timer_query_webgl2");
     this.query = null;
     this.gpuMs = null;
+    this.counts = { plans: 0, textureBytes: 0, drawCalls: 0, vertices: 0 };
     this.present = this.link(programs.present.name, programs.present);
     this.copyDepth = this.link(programs.copy_depth.name, programs.copy_depth);
   }
@@ -1388,6 +1391,7 @@ var Executor = class {
       if (!this.groups.has(plan.geometry.key)) this.groups.set(plan.geometry.key, []);
       this.groups.get(plan.geometry.key).push(plan);
     }
+    this.counts.plans += 1;
   }
   check(plan) {
     if (plan.per_view && !this.hooks[plan.per_view.function]) throw new Unsupported(`${plan.name}: its view hook ${plan.per_view.function} is not supported by the viewer yet`);
@@ -1467,7 +1471,11 @@ var Executor = class {
     return this.vaos.get(key);
   }
   texture(t) {
-    if (!this.textures.has(t)) this.textures.set(t, uploadTexture(this.gl, t));
+    if (!this.textures.has(t)) {
+      const made = uploadTexture(this.gl, t);
+      this.counts.textureBytes += made.bytes;
+      this.textures.set(t, made);
+    }
     return this.textures.get(t);
   }
   /** Draw ``plans`` from ``camera`` into ``targets`` and present them on the canvas: the
@@ -1483,8 +1491,10 @@ var Executor = class {
     };
     const opaque = pass(targets.fbo);
     const transparent = pass(targets.transparentFbo);
+    Object.assign(this.counts, { drawCalls: 1, vertices: 3 });
     const timing = this.timer && !this.query;
     if (timing) {
+      this.gpuMs = null;
       this.query = gl.createQuery();
       gl.beginQuery(this.timer.TIME_ELAPSED_EXT, this.query);
     }
@@ -1574,6 +1584,8 @@ var Executor = class {
     for (const [name, value] of Object.entries(this.bindTextures(textures))) setUniform(gl, linked, name, value);
     gl.bindVertexArray(null);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+    this.counts.drawCalls += 1;
+    this.counts.vertices += 3;
   }
   /** One draw of a plan already seen from ``camera``; ``program`` (a [name, defines] role),
    *  ``raster``, ``uniforms`` and ``textures`` replace or add to the plan's. */
@@ -1592,6 +1604,8 @@ var Executor = class {
     else if (indexed) gl.drawElements(mode, count, gl.UNSIGNED_INT, first * 4);
     else if (instances != null) gl.drawArraysInstanced(mode, first, count, instances);
     else gl.drawArrays(mode, first, count);
+    this.counts.drawCalls += 1;
+    this.counts.vertices += count * (instances ?? 1);
     gl.bindVertexArray(null);
   }
   /** Bind textures (sampler name -> plan texture or {tex, target}) to units 0, 1, ...;
@@ -3341,6 +3355,7 @@ async function main() {
     for (const p of debug.order(panels)) debug.draw(p, camera, light);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start;
+    state.counts = panels.map((p) => ({ ...p.executor.counts }));
     const shown = () => {
       const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
@@ -3426,6 +3441,11 @@ async function main() {
       });
     }
   });
+  state.setView = (a, e, d = null) => {
+    [az, el, dist] = [a, e, d];
+    render();
+    return new Promise((resolve) => setTimeout(() => resolve({ frameMs: state.frameMs, gpuMs: state.gpuMs }), 60));
+  };
   render();
 }
 main().catch((e) => report(`error: ${e.message}`)).finally(() => {
