@@ -26,6 +26,9 @@ from helpers import sample
 
 from reliefkit import save
 from reliefkit.io.inputs import load_input
+from reliefkit.render import render
+from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
+from reliefkit.scene.views import framing_bounds, orbit_bounds, parse_view
 from reliefkit.viewer.site import load_inputs, make_input, site_files
 from reliefkit.viewer.variants import Variants
 
@@ -145,6 +148,34 @@ def test_a_url_with_options_opens_with_them_and_a_select_switches_the_method(gl,
         assert page.locator("#option-method").input_value() == "binary"
         assert url_options(page)["method"] == "binary"
         assert_agrees(page, coarse_ref)
+
+
+def test_the_iteration_heat_map_follows_an_option_switch(gl, browser, specs):
+    """The counting plans come from the GLB made with the new options: the page's counts are
+    render's with them."""
+    spec = specs["relief"]
+    coarse = {"method": "binary", "linear_steps": 2, "binary_steps": 1}
+    counted = {name: rendered_counts(spec, **options)
+               for name, options in (("robust", {}), ("binary", coarse))}
+    assert counted["robust"]["iterations_max"] != counted["binary"]["iterations_max"]
+    with served(*live_site([spec])) as (base, _):
+        page = page_at(browser, base, "&debug=iterations&linear-steps=2&binary-steps=1")
+        for method in ("robust", "binary"):
+            if page.locator("#option-method").input_value() != method:
+                page.locator("#option-method").select_option(method)
+                settle(page)
+            got = state(page)["debug"]["iterations"][0]
+            assert got["max"] == counted[method]["iterations_max"], method
+            assert got["mean"] == pytest.approx(counted[method]["iterations_mean"], rel=0.01)
+        assert state(page)["errors"] == []
+
+
+def rendered_counts(spec: str, **options) -> dict:
+    """`render --stats`'s iteration counts of ``spec`` at VIEW, 128x128."""
+    obj = load_input(spec)
+    camera = orbit_bounds(framing_bounds(obj), *parse_view(VIEW), SIZE)
+    light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
+    return render(obj, camera, light=light, count_iterations=True, **options).stats
 
 
 def test_a_bad_value_is_said_and_the_picture_stays(gl, browser, specs):
