@@ -193,6 +193,55 @@ def test_a_drag_orbits(gl, browser, specs):
             page.wait_for_function("window.reliefkit.gpuMs > 0")  # the readout's GPU time
 
 
+def test_a_right_drag_pans_and_the_url_reopens_it(gl, browser, specs):
+    """Panning moves the orbited point in the picture's plane: the page draws what render
+    draws from a camera orbiting that point; the URL carries it, and 0 goes back."""
+    from reliefkit.io.inputs import load_input
+    from reliefkit.render import render
+    from reliefkit.scene.camera import Camera
+    from reliefkit.scene.light import DEFAULT_LIGHT_ANGLES, DirectionalLight
+
+    spec = specs["mesh"]
+    with served(site_files(load_inputs([spec]))) as (base, _):
+        page = open_page(browser, url(base, "30,25"))
+        first = state(page)
+        box = page.locator("canvas").bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.mouse.move(x, y)
+        page.mouse.down(button="right")
+        page.mouse.move(x + 30, y - 10, steps=3)
+        page.mouse.up(button="right")
+        page.wait_for_function(f"window.reliefkit.frames > {first['frames']}")
+        panned = state(page)
+        assert panned["view"] == first["view"]  # a pan does not orbit
+        target = np.array(panned["target"])
+        centre = framing_bounds(load_input(spec)).mean(axis=0)
+        assert np.linalg.norm(target - np.array(first["target"])) > 0
+        # the reference: render's camera orbiting the panned point, near/far around the box
+        box3 = framing_bounds(load_input(spec))
+        radius = float(np.linalg.norm(box3[1] - box3[0]) / 2)
+        az, el, dist = panned["view"]
+        probe = Camera.orbit(tuple(target), az, el, dist * radius, size=SIZE)
+        to_centre = float(np.linalg.norm(centre - np.asarray(probe.eye)))
+        camera = Camera.orbit(tuple(target), az, el, dist * radius, size=SIZE,
+                              near=max(to_centre - 1.05 * radius, 0.005 * dist * radius),
+                              far=to_centre + 1.05 * radius)
+        light = DirectionalLight.from_angles(*DEFAULT_LIGHT_ANGLES)
+        want = render(load_input(spec), camera, light=light).rgba8()
+        iou, within = agreement(canvas_rgba(page), want)
+        assert iou >= 0.99 and within >= 0.99, (iou, within)
+        query = parse_qs(urlsplit(page.url).query)
+        assert np.allclose([float(v) for v in query["target"][0].split(",")], target, rtol=1e-5)
+        again = open_page(browser, page.url)  # the URL opens on the panned view
+        assert np.allclose(state(again)["target"], target, rtol=1e-5)
+        assert agreement(canvas_rgba(again), want)[0] >= 0.99
+        frames = state(page)["frames"]
+        page.locator("canvas").press("0")  # back to the opening view: the box's centre
+        page.wait_for_function(f"window.reliefkit.frames > {frames}")
+        assert np.allclose(state(page)["target"], centre) and state(page)["view"] == first["view"]
+        assert "target" not in parse_qs(urlsplit(page.url).query)
+
+
 def test_a_bad_view_in_the_url_is_said(gl, browser, specs):
     with served(site_files(load_inputs([specs["mesh"]]))) as (base, log):
         page = open_page(browser, f"{base}?view=30")

@@ -81,7 +81,7 @@ export function lightCamera(bounds, direction, size) {
 
 /** The camera orbiting ``bounds``' centre (scene.views.orbit_bounds); ``frame`` holds the
  *  page's copies of the Python constants (fov, fit margin). */
-export function orbitBounds(bounds, az, el, dist, size, frame) {
+export function orbitBounds(bounds, az, el, dist, size, frame, target = null) {
   const [w, h] = size;
   if (dist === null) {
     const halfV = rad(frame.fov) / 2;
@@ -91,14 +91,16 @@ export function orbitBounds(bounds, az, el, dist, size, frame) {
   const diag = norm(sub(bounds[1], bounds[0])) / 2;
   const radius = diag > 0 ? diag : 1;
   const d = dist * radius;
-  const near = Math.max(d - 1.05 * radius, 0.005 * d);
-  const far = d + 1.05 * radius;
-  const target = [0, 1, 2].map((i) => (bounds[0][i] + bounds[1][i]) / 2);
+  const centre = [0, 1, 2].map((i) => (bounds[0][i] + bounds[1][i]) / 2);
+  const orbited = target || centre; // a panned view orbits another point
   const [a, e] = [rad(az), rad(el)];
-  const eye = [0, 1, 2].map((i) => target[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
+  const eye = [0, 1, 2].map((i) => orbited[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
+  const toCentre = target ? norm(sub(centre, eye)) : d; // near and far hug the box wherever the camera looks
+  const near = Math.max(toCentre - 1.05 * radius, 0.005 * d);
+  const far = toCentre + 1.05 * radius;
   return {
-    eye, target, up: [0, 1, 0], fov_deg: frame.fov, size, near, far, ortho_height: null, origin: target,
-    view: lookAt(eye, target), proj: perspective(frame.fov, w / h, near, far), distance: dist,
+    eye, target: orbited, up: [0, 1, 0], fov_deg: frame.fov, size, near, far, ortho_height: null, origin: orbited,
+    view: lookAt(eye, orbited), proj: perspective(frame.fov, w / h, near, far), distance: dist,
   };
 }
 

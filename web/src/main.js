@@ -1,19 +1,20 @@
 // reliefkit's viewer page: every input of `reliefkit view` (inputs.json: its GLB, kind and
 // framing bounds) drawn side by side from one camera by the WebGL2 executor. The view is in
 // the URL (?view=AZ,EL,DIST&size=WxH&light=AZ,EL and the render options that differ from
-// their defaults, kept up to date); a drag (mouse or touch) or the arrow keys orbit, the wheel
-// or + and - zoom; controls.js switches render options and moves the light;
+// their defaults, kept up to date; target=X,Y,Z once panned); navigation.js orbits, pans and
+// zooms by mouse, touch and keys; controls.js switches render options and moves the light;
 // ?debug=normals|depth|iterations|mask shows a debug view instead (debug_views.js).
 // window.reliefkit.ready turns true after the first complete frame (frameMs, gpuMs and each
 // panel's counts are the latest frame's; setView(az, el, dist) draws a view: the bench's
 // orbit); errors show in the page and are posted to the server's log.
 
-import { lightFrom, orbitBounds, parseSize, parseView } from './camera.js';
+import { lightFrom, parseSize, parseView } from './camera.js';
 import { lightControls, optionControls } from './controls.js';
 import { DebugViews } from './debug_views.js';
 import { makeDrawable } from './drawable.js';
 import { createContext, createTargets } from './executor.js';
 import { drawOf, parseGlb } from './glb.js';
+import { Navigation } from './navigation.js';
 
 const state = window.reliefkit = { ready: false, errors: [], frames: 0 };
 
@@ -90,19 +91,17 @@ async function main() {
   const params = new URLSearchParams(location.search);
   const manifest = await (await fetchOk('inputs.json')).json();
   const frame = manifest.camera;
-  let [az, el, dist] = parseView(params.get('view') || frame.default_view);
   const size = parseSize(params.get('size') || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get('light') || manifest.light.angles);
   let light = lightFrom(manifest.light, lightAz, lightEl);
-  const bounds = union(manifest.inputs.map((i) => i.bounds));
+  const nav = new Navigation(params, union(manifest.inputs.map((i) => i.bounds)), size, frame);
   const panels = (await Promise.all(manifest.inputs.map((i, k) => openInput(i, k, size, manifest.programs)))).filter(Boolean);
   const debug = new DebugViews(params, manifest, panels, report);
 
   const readout = document.getElementById('stats');
   const render = () => {
     const start = performance.now();
-    const camera = orbitBounds(bounds, az, el, dist, size, frame);
-    dist = camera.distance;
+    const camera = nav.camera();
     for (const p of debug.order(panels)) debug.draw(p, camera, light);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start; // the CPU's clock around the draws and a read back
@@ -110,13 +109,14 @@ async function main() {
     const shown = () => {
       const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
-      readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  `
+      readout.textContent = `view ${nav.az.toFixed(1)},${nav.el.toFixed(1)},${nav.dist.toFixed(3)}  ${size[0]}x${size[1]}  `
         + `frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? '' : `, GPU ${state.gpuMs.toFixed(2)} ms`);
     };
     shown();
     setTimeout(shown, 50); // the timer query's result, once the browser has it
-    state.view = [az, el, dist];
-    params.set('view', `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
+    state.view = [nav.az, nav.el, nav.dist];
+    state.target = camera.target;
+    nav.toUrl(params);
     history.replaceState(null, '', `?${params}`); // the view stays in the URL
     state.frames += 1;
     state.ready = loads === 0;
@@ -130,31 +130,8 @@ async function main() {
     }
   };
   debug.onChange = redraw;
-  for (const p of panels) {
-    p.canvas.addEventListener('pointerdown', (e) => p.canvas.setPointerCapture(e.pointerId));
-    p.canvas.addEventListener('pointermove', (e) => {
-      if (!p.canvas.hasPointerCapture(e.pointerId)) return;
-      az -= e.movementX * 0.4;
-      el = Math.max(-89, Math.min(89, el + e.movementY * 0.4));
-      redraw();
-    });
-    p.canvas.tabIndex = 0; // arrows orbit, + and - zoom
-    p.canvas.addEventListener('keydown', (e) => {
-      const step = { ArrowLeft: [5, 0, 1], ArrowRight: [-5, 0, 1], ArrowUp: [0, 5, 1], ArrowDown: [0, -5, 1],
-        '+': [0, 0, 1 / 1.1], '=': [0, 0, 1 / 1.1], '-': [0, 0, 1.1] }[e.key];
-      if (!step) return;
-      e.preventDefault();
-      az += step[0];
-      el = Math.max(-89, Math.min(89, el + step[1]));
-      dist = Math.max(0.01, Math.min(1e4, dist * step[2]));
-      redraw();
-    });
-    p.canvas.addEventListener('wheel', (e) => {
-      e.preventDefault();
-      dist = Math.max(0.01, Math.min(1e4, dist * Math.exp(e.deltaY * 0.001)));
-      redraw();
-    }, { passive: false });
-  }
+  nav.onChange = redraw;
+  for (const p of panels) nav.attach(p.canvas);
   await debug.ready;
   lightControls({
     form: document.getElementById('light'), angles: [lightAz, lightEl],
@@ -180,7 +157,7 @@ async function main() {
   // reliefkit bench viewer's orbit: draw AZ,EL,DIST (DIST null: framed) now; resolves after
   // the browser has had the frame, with the timer query's result where it has one
   state.setView = (a, e, d = null) => {
-    [az, el, dist] = [a, e, d];
+    nav.set(a, e, d);
     render();
     return new Promise((resolve) => setTimeout(() => resolve({ frameMs: state.frameMs, gpuMs: state.gpuMs }), 60));
   };

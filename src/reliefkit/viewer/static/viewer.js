@@ -73,7 +73,7 @@ function lightCamera(bounds2, direction, size) {
     proj: orthographic(radius, 1, near, far)
   };
 }
-function orbitBounds(bounds2, az, el, dist, size, frame) {
+function orbitBounds(bounds2, az, el, dist, size, frame, target = null) {
   const [w, h] = size;
   if (dist === null) {
     const halfV = rad(frame.fov) / 2;
@@ -83,22 +83,24 @@ function orbitBounds(bounds2, az, el, dist, size, frame) {
   const diag = norm(sub(bounds2[1], bounds2[0])) / 2;
   const radius = diag > 0 ? diag : 1;
   const d = dist * radius;
-  const near = Math.max(d - 1.05 * radius, 5e-3 * d);
-  const far = d + 1.05 * radius;
-  const target = [0, 1, 2].map((i) => (bounds2[0][i] + bounds2[1][i]) / 2);
+  const centre = [0, 1, 2].map((i) => (bounds2[0][i] + bounds2[1][i]) / 2);
+  const orbited = target || centre;
   const [a, e] = [rad(az), rad(el)];
-  const eye = [0, 1, 2].map((i) => target[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
+  const eye = [0, 1, 2].map((i) => orbited[i] + d * [Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a)][i]);
+  const toCentre = target ? norm(sub(centre, eye)) : d;
+  const near = Math.max(toCentre - 1.05 * radius, 5e-3 * d);
+  const far = toCentre + 1.05 * radius;
   return {
     eye,
-    target,
+    target: orbited,
     up: [0, 1, 0],
     fov_deg: frame.fov,
     size,
     near,
     far,
     ortho_height: null,
-    origin: target,
-    view: lookAt(eye, target),
+    origin: orbited,
+    view: lookAt(eye, orbited),
     proj: perspective(frame.fov, w / h, near, far),
     distance: dist
   };
@@ -3273,6 +3275,123 @@ function uploadMask(p, mask, [w, h]) {
   return p.referenceTexture;
 }
 
+// web/src/navigation.js
+var ORBIT_DEG_PER_PIXEL = 0.4;
+var KEY_ORBIT_DEG = 5;
+var KEY_PAN_PIXELS = 20;
+var KEY_ZOOM = 1.1;
+var clampEl = (e) => Math.max(-89, Math.min(89, e));
+var clampDist = (d) => Math.max(0.01, Math.min(1e4, d));
+function parseTarget(text) {
+  const parts = text.split(",").map(Number);
+  if (parts.length !== 3 || !parts.every(Number.isFinite)) {
+    throw new Error(`target must be X,Y,Z (world coordinates, e.g. 0,0.5,0), got '${text}'`);
+  }
+  return parts;
+}
+var Navigation = class {
+  /** ``params``: the URL's (view, target read; kept up to date by `toUrl`); ``bounds`` the
+   *  union of the inputs' framing boxes; ``frame``: inputs.json's camera defaults. */
+  constructor(params, bounds2, size, frame) {
+    this.bounds = bounds2;
+    this.size = size;
+    this.frame = frame;
+    this.centre = [0, 1, 2].map((i) => (bounds2[0][i] + bounds2[1][i]) / 2);
+    const view = parseView(params.get("view") || frame.default_view);
+    const target = params.has("target") ? parseTarget(params.get("target")) : null;
+    this.opening = { view, target };
+    this.reset();
+    this.onChange = () => {
+    };
+  }
+  reset() {
+    [this.az, this.el, this.dist] = this.opening.view;
+    this.target = this.opening.target;
+  }
+  /** The camera of the current view (its distance fitted the first time when not given). */
+  camera() {
+    const camera = orbitBounds(this.bounds, this.az, this.el, this.dist, this.size, this.frame, this.target);
+    this.dist = camera.distance;
+    return camera;
+  }
+  set(az, el, dist = null) {
+    [this.az, this.el, this.dist] = [az, el, dist];
+  }
+  orbit(dx, dy) {
+    this.az -= dx * ORBIT_DEG_PER_PIXEL;
+    this.el = clampEl(this.el + dy * ORBIT_DEG_PER_PIXEL);
+  }
+  zoom(factor) {
+    this.dist = clampDist(this.dist * factor);
+  }
+  /** Move the orbited point by ``dx``, ``dy`` pixels of the picture, so what is under the
+   *  pointer stays under it at the target's depth. */
+  pan(dx, dy) {
+    const camera = this.camera();
+    const toEye = camera.eye.map((x, i) => x - camera.target[i]);
+    const d = Math.hypot(...toEye);
+    const perPixel = 2 * d * Math.tan(camera.fov_deg * Math.PI / 360) / this.size[1];
+    const [right, up] = [camera.view.slice(0, 3), camera.view.slice(4, 7)];
+    this.target = camera.target.map((t, i) => t - (dx * right[i] - dy * up[i]) * perPixel);
+  }
+  /** The view in ``params``: view always, target once panned. */
+  toUrl(params) {
+    params.set("view", `${+this.az.toFixed(3)},${+this.el.toFixed(3)},${+this.dist.toFixed(4)}`);
+    if (this.target) params.set("target", this.target.map((x) => +x.toPrecision(7)).join(","));
+    else params.delete("target");
+  }
+  /** Mouse, touch and keyboard on ``canvas``. */
+  attach(canvas) {
+    const pointers = /* @__PURE__ */ new Map();
+    const changed = () => this.onChange();
+    canvas.addEventListener("contextmenu", (e) => e.preventDefault());
+    canvas.addEventListener("pointerdown", (e) => {
+      canvas.setPointerCapture(e.pointerId);
+      pointers.set(e.pointerId, [e.clientX, e.clientY]);
+    });
+    const lift = (e) => pointers.delete(e.pointerId);
+    canvas.addEventListener("pointerup", lift);
+    canvas.addEventListener("pointercancel", lift);
+    canvas.addEventListener("pointermove", (e) => {
+      const last = pointers.get(e.pointerId);
+      if (!last) return;
+      const [dx, dy] = [e.clientX - last[0], e.clientY - last[1]];
+      if (pointers.size === 2) {
+        const other = [...pointers].find(([id]) => id !== e.pointerId)[1];
+        const apart = (a) => Math.hypot(a[0] - other[0], a[1] - other[1]);
+        const before = apart(last);
+        const after = apart([e.clientX, e.clientY]);
+        if (before > 0 && after > 0) this.zoom(before / after);
+        this.pan(dx / 2, dy / 2);
+      } else if (pointers.size === 1) {
+        if (e.buttons & 2 || e.buttons & 4 || e.shiftKey) this.pan(dx, dy);
+        else this.orbit(dx, dy);
+      }
+      pointers.set(e.pointerId, [e.clientX, e.clientY]);
+      changed();
+    });
+    canvas.tabIndex = 0;
+    canvas.addEventListener("keydown", (e) => {
+      const arrow = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] }[e.key];
+      if (arrow && e.shiftKey) this.pan(arrow[0] * KEY_PAN_PIXELS, arrow[1] * KEY_PAN_PIXELS);
+      else if (arrow) {
+        this.az -= arrow[0] * KEY_ORBIT_DEG;
+        this.el = clampEl(this.el - arrow[1] * KEY_ORBIT_DEG);
+      } else if (e.key === "+" || e.key === "=") this.zoom(1 / KEY_ZOOM);
+      else if (e.key === "-") this.zoom(KEY_ZOOM);
+      else if (e.key === "0") this.reset();
+      else return;
+      e.preventDefault();
+      changed();
+    });
+    canvas.addEventListener("wheel", (e) => {
+      e.preventDefault();
+      this.zoom(Math.exp(e.deltaY * 1e-3));
+      changed();
+    }, { passive: false });
+  }
+};
+
 // web/src/main.js
 var state = window.reliefkit = { ready: false, errors: [], frames: 0 };
 function report(message) {
@@ -3340,18 +3459,16 @@ async function main() {
   const params = new URLSearchParams(location.search);
   const manifest = await (await fetchOk("inputs.json")).json();
   const frame = manifest.camera;
-  let [az, el, dist] = parseView(params.get("view") || frame.default_view);
   const size = parseSize(params.get("size") || frame.default_size);
   const [lightAz, lightEl] = parseView(params.get("light") || manifest.light.angles);
   let light = lightFrom(manifest.light, lightAz, lightEl);
-  const bounds2 = union(manifest.inputs.map((i) => i.bounds));
+  const nav = new Navigation(params, union(manifest.inputs.map((i) => i.bounds)), size, frame);
   const panels = (await Promise.all(manifest.inputs.map((i, k) => openInput(i, k, size, manifest.programs)))).filter(Boolean);
   const debug = new DebugViews(params, manifest, panels, report);
   const readout = document.getElementById("stats");
   const render = () => {
     const start = performance.now();
-    const camera = orbitBounds(bounds2, az, el, dist, size, frame);
-    dist = camera.distance;
+    const camera = nav.camera();
     for (const p of debug.order(panels)) debug.draw(p, camera, light);
     for (const p of panels) p.executor.finish();
     state.frameMs = performance.now() - start;
@@ -3359,12 +3476,13 @@ async function main() {
     const shown = () => {
       const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
-      readout.textContent = `view ${az.toFixed(1)},${el.toFixed(1)},${dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? "" : `, GPU ${state.gpuMs.toFixed(2)} ms`);
+      readout.textContent = `view ${nav.az.toFixed(1)},${nav.el.toFixed(1)},${nav.dist.toFixed(3)}  ${size[0]}x${size[1]}  frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? "" : `, GPU ${state.gpuMs.toFixed(2)} ms`);
     };
     shown();
     setTimeout(shown, 50);
-    state.view = [az, el, dist];
-    params.set("view", `${+az.toFixed(3)},${+el.toFixed(3)},${+dist.toFixed(4)}`);
+    state.view = [nav.az, nav.el, nav.dist];
+    state.target = camera.target;
+    nav.toUrl(params);
     history.replaceState(null, "", `?${params}`);
     state.frames += 1;
     state.ready = loads === 0;
@@ -3381,38 +3499,8 @@ async function main() {
     }
   };
   debug.onChange = redraw;
-  for (const p of panels) {
-    p.canvas.addEventListener("pointerdown", (e) => p.canvas.setPointerCapture(e.pointerId));
-    p.canvas.addEventListener("pointermove", (e) => {
-      if (!p.canvas.hasPointerCapture(e.pointerId)) return;
-      az -= e.movementX * 0.4;
-      el = Math.max(-89, Math.min(89, el + e.movementY * 0.4));
-      redraw();
-    });
-    p.canvas.tabIndex = 0;
-    p.canvas.addEventListener("keydown", (e) => {
-      const step = {
-        ArrowLeft: [5, 0, 1],
-        ArrowRight: [-5, 0, 1],
-        ArrowUp: [0, 5, 1],
-        ArrowDown: [0, -5, 1],
-        "+": [0, 0, 1 / 1.1],
-        "=": [0, 0, 1 / 1.1],
-        "-": [0, 0, 1.1]
-      }[e.key];
-      if (!step) return;
-      e.preventDefault();
-      az += step[0];
-      el = Math.max(-89, Math.min(89, el + step[1]));
-      dist = Math.max(0.01, Math.min(1e4, dist * step[2]));
-      redraw();
-    });
-    p.canvas.addEventListener("wheel", (e) => {
-      e.preventDefault();
-      dist = Math.max(0.01, Math.min(1e4, dist * Math.exp(e.deltaY * 1e-3)));
-      redraw();
-    }, { passive: false });
-  }
+  nav.onChange = redraw;
+  for (const p of panels) nav.attach(p.canvas);
   await debug.ready;
   lightControls({
     form: document.getElementById("light"),
@@ -3442,7 +3530,7 @@ async function main() {
     }
   });
   state.setView = (a, e, d = null) => {
-    [az, el, dist] = [a, e, d];
+    nav.set(a, e, d);
     render();
     return new Promise((resolve) => setTimeout(() => resolve({ frameMs: state.frameMs, gpuMs: state.gpuMs }), 60));
   };
