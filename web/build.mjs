@@ -10,7 +10,7 @@ await esbuild.build({
   entryPoints: ['web/src/main.js'],
   outfile: process.argv[2] || 'src/reliefkit/viewer/static/viewer.js',
   bundle: true,
-  format: 'esm',
+  format: 'iife', // a classic script: it runs from file:// too, to say the page needs a server
   target: 'es2022',
   legalComments: 'none',
   logLevel: 'warning',

@@ -10,7 +10,7 @@ import subprocess
 import sys
 import urllib.request
 
-from browser import canvas_rgba, chromium, open_page, state
+from browser import canvas_rgba, chromium, messages, open_page, state
 from helpers import assert_one_line_error, run_cli
 
 TIMEOUT_S = 300
@@ -58,16 +58,24 @@ def test_export_html_opens_from_a_static_server(gl, tmp_path):
             page = open_page(browser, f"http://127.0.0.1:{port}/?view=30,25&size=64x64")
             seen = state(page)
             covered = int((canvas_rgba(page)[..., 3] > 0).sum())
+            # opened as a file (double-clicked): no browser lets it read its inputs, and it says so
+            as_file = open_page(browser, (site / "index.html").as_uri())
+            said = messages(as_file)
     finally:
         server.kill()
         server.wait()
     assert seen["ready"] and seen["errors"] == [], seen
     assert covered > 200
+    assert said == ["error: this page was opened as a file: browsers let no page read the files "
+                    "beside it. Serve its folder and open the address printed: python -m "
+                    "http.server -d FOLDER"]
 
 
 def test_bad_inputs_are_one_line():
     assert_one_line_error(run_cli("view", "no-such-file.obj", "--no-browser"), "no-such-file")
     assert_one_line_error(run_cli("view", "demo:cup", "--port", "70000"), "--port")
+    assert_one_line_error(run_cli("view", "demo:cup", "--port", "8000", "--export-html", "x"),
+                          "--port serves the page, --export-html writes it into a folder")
     assert_one_line_error(run_cli("view"), "INPUT")
     assert_one_line_error(run_cli("view", "demo:cup", "--parallax-steps", "2"),
                           "--parallax-steps applies to none of the inputs")

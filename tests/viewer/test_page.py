@@ -183,9 +183,14 @@ def test_a_drag_orbits(gl, browser, specs):
         az, el, dist = state(page)["view"]
         assert az < 30 and el > 25
         assert (canvas_rgba(page) != before).any()
-        query = parse_qs(urlsplit(page.url).query)  # the view stays in the URL
-        assert np.allclose([float(x) for x in query["view"][0].split(",")], [az, el, dist],
-                           atol=1e-3) and query["size"] == ["128x128"]
+        query = parse_qs(urlsplit(page.url).query)  # the view stays in the URL (the fitted
+        assert np.allclose([float(x) for x in query["view"][0].split(",")], [az, el],  # distance
+                           atol=1e-3) and query["size"] == ["128x128"]  # left out: refitted)
+        page.locator("canvas").press("-")  # zoomed: the distance joins, to 10 digits
+        page.wait_for_function(f"window.reliefkit.view[2] > {dist}")
+        view = [float(x) for x in parse_qs(urlsplit(page.url).query)["view"][0].split(",")]
+        assert view[2] == pytest.approx(state(page)["view"][2], rel=1e-9)
+        el = state(page)["view"][1]
         page.locator("canvas").press("ArrowUp")
         page.wait_for_function(f"window.reliefkit.view[1] > {el}")
         if page.evaluate("!!document.querySelector('canvas').getContext('webgl2')"
@@ -242,16 +247,26 @@ def test_a_right_drag_pans_and_the_url_reopens_it(gl, browser, specs):
         assert "target" not in parse_qs(urlsplit(page.url).query)
 
 
-def test_a_bad_view_in_the_url_is_said(gl, browser, specs):
+def test_a_bad_url_is_said_and_the_page_opens_on_the_defaults(gl, browser, specs):
     with served(site_files(load_inputs([specs["mesh"]]))) as (base, log):
-        page = open_page(browser, f"{base}?view=30")
-        shown = messages(page)
+        page = open_page(browser, f"{base}?view=30&light=10,200&bogus=1&size=128x128")
+        shown, opened = messages(page), state(page)
         huge = open_page(browser, f"{base}?size=5000x5000")  # 5000² x 132 bytes of targets
-        refused = messages(huge)
-    assert shown == ["error: view must be AZ,EL or AZ,EL,DIST with |EL| < 90 (e.g. 30,25,2.6), "
-                     "got '30'"]
-    assert log[0] == "page: " + shown[0]
+        refused, never = messages(huge), state(huge)
+    assert shown == [
+        "error: the URL's bogus=1 is no parameter of this page (view, size, light, target, "
+        "debug) and no render option of its inputs (shadows): ignored",
+        "error: light must be AZ,EL in degrees with an elevation within [-90, 90] (e.g. -60,30), "
+        "got '10,200'; showing the default",
+        "error: view must be AZ,EL or AZ,EL,DIST with |EL| < 90 (e.g. 30,25,2.6), got '30'; "
+        "showing the default"]
+    assert {"page: " + line for line in shown + refused} == set(log)  # posted as they came
+    assert opened["ready"] and opened["view"][:2] == [30, 25]  # render's default view
+    assert agreement(canvas_rgba(page), rendered(specs["mesh"], "30,25"))[0] >= 0.99
+    assert "bogus" not in parse_qs(urlsplit(page.url).query)
+    # nothing can be drawn: said, and never ready (a screenshot script must not take it)
     assert len(refused) == 1 and "a 5000x5000 frame needs 3148 MiB" in refused[0], refused
+    assert never["loaded"] and not never["ready"]
 
 
 def test_a_plan_it_cannot_draw_is_said(gl, browser, tmp_path):

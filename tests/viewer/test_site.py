@@ -4,6 +4,8 @@ path); --export-html writes all of its files or none."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from reliefkit.errors import UsageError
@@ -55,3 +57,20 @@ def test_export_html_refuses_a_file_in_the_way(tmp_path):
     written = export_html(files, tmp_path / "out")
     assert {p.name for p in written} == set(files)
     assert all(p.read_bytes() == files[p.name] for p in written)
+
+
+def test_export_html_again_leaves_no_other_inputs_and_names_files_without_folders(tmp_path):
+    """A second export of fewer inputs into the same folder removed nothing (the first's
+    megabytes stayed), and inputs.json published the exporting machine's folders."""
+    mesh = tmp_path / "secret" / "cube.obj"
+    mesh.parent.mkdir()
+    mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+    export_html(site_files(load_inputs(["demo:cup", str(mesh)])), tmp_path / "site")
+    (tmp_path / "site" / "input-7.txt").write_text("not ours")
+    export_html(site_files(load_inputs([str(mesh)])), tmp_path / "site")
+    assert sorted(p.name for p in (tmp_path / "site").iterdir()) == [
+        "index.html", "input-0.glb", "input-7.txt", "inputs.json", "viewer.js"]
+    published = json.loads((tmp_path / "site" / "inputs.json").read_text())
+    assert [i["name"] for i in published["inputs"]] == ["cube.obj"]
+    live = json.loads(site_files(load_inputs([str(mesh)]), live=True)["inputs.json"])
+    assert live["inputs"][0]["name"] == str(mesh)  # served on 127.0.0.1: as the user gave it

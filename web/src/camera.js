@@ -19,6 +19,15 @@ export function parseView(text) {
   return [parts[0], parts[1], parts.length === 3 ? parts[2] : null];
 }
 
+/** 'AZ,EL' -> the light's [az, el] in degrees; throws in the words of `--light`. */
+export function parseLight(text) {
+  const parts = text.split(',').map(Number);
+  if (parts.length !== 2 || !parts.every(Number.isFinite) || Math.abs(parts[1]) > 90) {
+    throw new Error(`light must be AZ,EL in degrees with an elevation within [-90, 90] (e.g. -60,30), got '${text}'`);
+  }
+  return parts;
+}
+
 /** 'WxH' -> [W, H]. */
 export function parseSize(text) {
   const m = /^(\d{1,5})x(\d{1,5})$/.exec(text);

@@ -125,8 +125,8 @@ export function optionControls({ form, manifest, params, panels, reload, loading
   if (!manifest.live) {
     const why = document.createElement('p');
     why.className = 'why';
-    why.textContent = 'This static export holds the plans made with these options; '
-      + '`reliefkit view ... --method X` (or export again) to change them.';
+    why.textContent = 'This static export holds the plans made with these options: run '
+      + '`reliefkit view` on its inputs with other render options (or export again with them) to change them.';
     form.appendChild(why);
   }
 
@@ -177,7 +177,7 @@ function control(opt) {
 /** Two sliders (azimuth, elevation in degrees) for the light; ``onChange(az, el)`` as they move. */
 export function lightControls({ form, angles, onChange }) {
   form.addEventListener('submit', (e) => e.preventDefault());
-  const sliders = [['azimuth', -180, 180, angles[0]], ['elevation', -89, 89, angles[1]]].map(([what, lo, hi, value]) => {
+  const sliders = [['azimuth', -180, 180, angles[0]], ['elevation', -90, 90, angles[1]]].map(([what, lo, hi, value]) => {
     const label = document.createElement('label');
     label.title = `the light's ${what} in degrees (render --light AZ,EL)`;
     const name = document.createElement('span');

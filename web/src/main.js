@@ -8,13 +8,13 @@
 // panel's counts are the latest frame's; setView(az, el, dist) draws a view: the bench's
 // orbit); errors show in the page and are posted to the server's log.
 
-import { lightFrom, parseSize, parseView } from './camera.js';
+import { lightFrom, parseLight, parseSize, parseView } from './camera.js';
 import { lightControls, optionControls } from './controls.js';
 import { DebugViews } from './debug_views.js';
 import { makeDrawable } from './drawable.js';
 import { createContext, createTargets } from './executor.js';
 import { drawOf, parseGlb } from './glb.js';
-import { Navigation } from './navigation.js';
+import { Navigation, parseTarget } from './navigation.js';
 
 const state = window.reliefkit = { ready: false, errors: [], frames: 0 };
 
@@ -83,19 +83,56 @@ async function openInput(input, index, size, programs) {
   }
 }
 
+/** The page's own URL parameters (render options are the inputs' flags). */
+const PAGE_PARAMETERS = ['view', 'size', 'light', 'target', 'debug'];
+
+/** The URL's ``name`` parsed, or where it does not parse, ``fallback``'s, said (the page opens
+ *  on the default rather than not at all) and dropped from the URL. */
+function fromUrl(params, name, parse, fallback) {
+  if (params.has(name)) {
+    try {
+      return parse(params.get(name));
+    } catch (e) {
+      report(`error: ${e.message}; showing the default`);
+      params.delete(name);
+    }
+  }
+  return fallback === null ? null : parse(fallback);
+}
+
+/** URL parameters that are neither the page's nor a render option of an input: said, and
+ *  dropped (the CLI refuses such flags too). */
+function unknownParameters(params, inputs) {
+  const flags = new Set(inputs.flatMap((i) => (i.options || []).map((o) => o.flag)));
+  for (const name of [...params.keys()]) {
+    if (PAGE_PARAMETERS.includes(name) || flags.has(name)) continue;
+    report(`error: the URL's ${name}=${params.get(name)} is no parameter of this page (${PAGE_PARAMETERS.join(', ')}) `
+      + `and no render option of its inputs${flags.size ? ` (${[...flags].join(', ')})` : ''}: ignored`);
+    params.delete(name);
+  }
+}
+
 function union(boxes) {
   return [0, 1].map((k) => [0, 1, 2].map((i) => (k ? Math.max : Math.min)(...boxes.map((b) => b[k][i]))));
 }
 
 async function main() {
+  if (location.protocol === 'file:') {
+    throw new Error('this page was opened as a file: browsers let no page read the files beside it. '
+      + 'Serve its folder and open the address printed: python -m http.server -d FOLDER');
+  }
   const params = new URLSearchParams(location.search);
   const manifest = await (await fetchOk('inputs.json')).json();
   const frame = manifest.camera;
-  const size = parseSize(params.get('size') || frame.default_size);
-  const [lightAz, lightEl] = parseView(params.get('light') || manifest.light.angles);
+  unknownParameters(params, manifest.inputs);
+  const size = fromUrl(params, 'size', parseSize, frame.default_size);
+  const [lightAz, lightEl] = fromUrl(params, 'light', parseLight, manifest.light.angles);
   let light = lightFrom(manifest.light, lightAz, lightEl);
-  const nav = new Navigation(params, union(manifest.inputs.map((i) => i.bounds)), size, frame);
+  const opening = { view: fromUrl(params, 'view', parseView, frame.default_view),
+    target: fromUrl(params, 'target', parseTarget, null) };
+  const nav = new Navigation(opening, union(manifest.inputs.map((i) => i.bounds)), size, frame);
   const panels = (await Promise.all(manifest.inputs.map((i, k) => openInput(i, k, size, manifest.programs)))).filter(Boolean);
+  if (!panels.length) return; // each said why; nothing is drawn, so never ready
   const debug = new DebugViews(params, manifest, panels, report);
 
   const readout = document.getElementById('stats');
@@ -110,7 +147,8 @@ async function main() {
       const gpu = panels.map((p) => debug.executor(p).gpuTime());
       state.gpuMs = gpu.every((t) => t !== null) ? gpu.reduce((a, b) => a + b, 0) : null;
       readout.textContent = `view ${nav.az.toFixed(1)},${nav.el.toFixed(1)},${nav.dist.toFixed(3)}  ${size[0]}x${size[1]}  `
-        + `frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? '' : `, GPU ${state.gpuMs.toFixed(2)} ms`);
+        + `frame ${state.frameMs.toFixed(1)} ms` + (state.gpuMs === null ? '' : `, GPU ${state.gpuMs.toFixed(2)} ms`)
+        + (loads ? '  (making the plans with the new render options...)' : '');
     };
     shown();
     setTimeout(shown, 50); // the timer query's result, once the browser has it
@@ -147,6 +185,7 @@ async function main() {
     loading: (promise) => {
       loads += 1;
       state.ready = false;
+      readout.textContent += '  (making the plans with the new render options...)';
       promise.catch(() => {}).finally(async () => {
         await debug.refresh(); // a debug view's plans come from the new GLBs too
         loads -= 1;

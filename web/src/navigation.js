@@ -5,7 +5,7 @@
 // orbits, two pan and pinch-zoom; keys: arrows orbit, shift+arrows pan, + and - zoom, 0 goes
 // back to the opening view.
 
-import { orbitBounds, parseView } from './camera.js';
+import { orbitBounds } from './camera.js';
 
 const ORBIT_DEG_PER_PIXEL = 0.4;
 const KEY_ORBIT_DEG = 5;
@@ -24,22 +24,20 @@ export function parseTarget(text) {
 }
 
 export class Navigation {
-  /** ``params``: the URL's (view, target read; kept up to date by `toUrl`); ``bounds`` the
-   *  union of the inputs' framing boxes; ``frame``: inputs.json's camera defaults. */
-  constructor(params, bounds, size, frame) {
+  /** ``opening``: the view the page opens on ({view: [az, el, dist or null], target or
+   *  null}, from the URL); ``bounds`` the union of the inputs' framing boxes; ``frame``:
+   *  inputs.json's camera defaults. */
+  constructor(opening, bounds, size, frame) {
     this.bounds = bounds;
     this.size = size;
     this.frame = frame;
-    this.centre = [0, 1, 2].map((i) => (bounds[0][i] + bounds[1][i]) / 2);
-    const view = parseView(params.get('view') || frame.default_view);
-    const target = params.has('target') ? parseTarget(params.get('target')) : null;
-    this.opening = { view, target };
+    this.opening = opening;
     this.reset();
     this.onChange = () => {};
   }
 
   reset() {
-    [this.az, this.el, this.dist] = this.opening.view;
+    this.set(...this.opening.view);
     this.target = this.opening.target;
   }
 
@@ -52,6 +50,7 @@ export class Navigation {
 
   set(az, el, dist = null) {
     [this.az, this.el, this.dist] = [az, el, dist];
+    this.fitted = dist === null; // the distance that fits the view: left out of the URL
   }
 
   orbit(dx, dy) {
@@ -61,6 +60,7 @@ export class Navigation {
 
   zoom(factor) {
     this.dist = clampDist(this.dist * factor);
+    this.fitted = false;
   }
 
   /** Move the orbited point by ``dx``, ``dy`` pixels of the picture, so what is under the
@@ -74,9 +74,11 @@ export class Navigation {
     this.target = camera.target.map((t, i) => t - (dx * right[i] - dy * up[i]) * perPixel);
   }
 
-  /** The view in ``params``: view always, target once panned. */
+  /** The view in ``params``: view always (its distance once zoomed, to 10 digits: a copied
+   *  URL draws the same picture), target once panned. */
   toUrl(params) {
-    params.set('view', `${+this.az.toFixed(3)},${+this.el.toFixed(3)},${+this.dist.toFixed(4)}`);
+    const angles = `${+this.az.toFixed(3)},${+this.el.toFixed(3)}`;
+    params.set('view', this.fitted ? angles : `${angles},${+this.dist.toPrecision(10)}`);
     if (this.target) params.set('target', this.target.map((x) => +x.toPrecision(7)).join(','));
     else params.delete('target');
   }

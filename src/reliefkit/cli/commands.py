@@ -547,8 +547,12 @@ def cmd_demo(args) -> int:
 
 
 def cmd_view(args) -> int:
-    if not 0 <= args.port <= 65535:
-        raise UsageError(f"--port must be within 0..65535, got {args.port}")
+    if args.export_html and args.port is not None:
+        raise UsageError("--port serves the page, --export-html writes it into a folder instead: "
+                         "give one of them")
+    port = 0 if args.port is None else args.port
+    if not 0 <= port <= 65535:
+        raise UsageError(f"--port must be within 0..65535, got {port}")
     for spec in args.inputs:
         _check_not_empty(spec)
     objects = [load_input(spec) for spec in args.inputs]
@@ -561,7 +565,7 @@ def cmd_view(args) -> int:
         print(f"wrote {len(paths)} files into {args.export_html} (index.html: serve the folder, "
               "e.g. python -m http.server -d " + shlex.quote(args.export_html) + ")")
         return 0
-    view_server.serve(view_site.site_files(inputs, live=True), args.port,
+    view_server.serve(view_site.site_files(inputs, live=True), port,
                       open_browser=not args.no_browser, variants=Variants(inputs))
     return 0
 

@@ -263,7 +263,7 @@ def build_parser() -> argparse.ArgumentParser:
                  "inputs that declare it); Ctrl-C stops it. docs/viewer.md.")
     p.add_argument("inputs", nargs="+", metavar="INPUT",
                    help=".rk file, a .glb reliefkit wrote, a mesh file or demo:NAME")
-    p.add_argument("--port", type=int, default=0, metavar="N",
+    p.add_argument("--port", type=int, default=None, metavar="N",
                    help="port on 127.0.0.1 (default: a free one)")
     p.add_argument("--no-browser", action="store_true", help="print the URL, open no browser")
     p.add_argument("--export-html", metavar="DIR",

@@ -12,9 +12,10 @@ Everything the page computes per view comes from these files, so the folder that
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
 from importlib import resources
-from pathlib import Path
+from pathlib import Path, PurePath
 
 from ..errors import UsageError
 from ..export.gltf import export_bytes
@@ -104,7 +105,8 @@ def manifest(inputs: list[Input], live: bool = False) -> dict:
     light.pop("u_light_dir")  # the page computes it from the angles (`--light`)
     az, el, _ = DEFAULT_VIEW
     return {"live": live,
-            "inputs": [{"name": i.name, "kind": i.kind, "file": _glb_name(k),
+            "inputs": [{"name": i.name if live else _published(i.name), "kind": i.kind,
+                        "file": _glb_name(k),
                         "bounds": i.bounds, "options": option_controls(i)}
                        for k, i in enumerate(inputs)],
             "camera": {"default_view": f"{az:g},{el:g}",
@@ -127,17 +129,33 @@ def site_files(inputs: list[Input], live: bool = False) -> dict[str, bytes]:
 
 
 def export_html(files: dict[str, bytes], folder) -> list[Path]:
-    """Write the site into ``folder`` (created), all files or none; their paths."""
+    """Write the site into ``folder`` (created), all files or none; their paths. The input
+    GLBs of an earlier export into the same folder that this one does not write go (a
+    site of fewer inputs left the others' megabytes behind)."""
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise UsageError(f"--export-html {folder}: exists and is not a folder")
     folder.mkdir(parents=True, exist_ok=True)
     paths = [folder / name for name in files]
+    stale = [p for p in folder.glob("input-*.glb")
+             if _GLB_NAME.fullmatch(p.name) and p.name not in files] \
+        if (folder / "inputs.json").is_file() else []
     with written_together():
         for path in paths:
             with atomic_path(path) as tmp:
                 Path(tmp).write_bytes(files[path.name])
+    for path in stale:
+        path.unlink(missing_ok=True)
     return paths
+
+
+_GLB_NAME = re.compile(r"input-\d+\.glb")
+
+
+def _published(name: str) -> str:
+    """An input's name as a static export shows it: a file's name without the folders of
+    the machine it was exported on."""
+    return name if name.startswith("demo:") else PurePath(name).name
 
 
 def _glb_name(index: int) -> str:

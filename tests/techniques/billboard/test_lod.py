@@ -110,11 +110,11 @@ def test_pixels_hand_over_to_the_cloud_in_proportion(gl):
 
 
 @pytest.mark.parametrize("refused, accepted, message", [
-    ({"lod": "auto", "flatten": 0.5}, {"flatten": 0.5}, "flatten applies with lod off"),
+    ({"lod": "auto", "flatten": 0.5}, {"flatten": 0.5}, "--flatten applies with --lod off"),
     ({"transition": 0.3}, {"lod": "auto", "transition": 0.3},
-     "transition applies only with lod auto"),
+     "--transition applies only with --lod auto"),
     ({"march": "sphere", "samples": 4}, {"march": "uniform", "samples": 4},
-     "samples applies only to the uniform march"),
+     "--samples applies only to --march uniform"),
 ])
 def test_options_that_another_option_voids_are_refused(gl, refused, accepted, message):
     """--flatten with --lod auto was honoured near and dropped beyond the switch; the other

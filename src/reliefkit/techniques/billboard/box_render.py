@@ -113,12 +113,12 @@ def _check_applicable(opts: BoxRenderOptions) -> None:
     for flatten under lod auto, honoured near and dropped far)."""
     default = BoxRenderOptions()
     if opts.lod == "auto" and opts.flatten != default.flatten:
-        raise UsageError("flatten applies with lod off: lod auto sets the flattening from "
+        raise UsageError("--flatten applies with --lod off: --lod auto sets the flattening from "
                          "the distance (§3.4.2); give one or the other")
     if opts.lod != "auto" and opts.transition != default.transition:
-        raise UsageError("transition applies only with lod auto")
+        raise UsageError("--transition applies only with --lod auto")
     if opts.march != "uniform" and opts.samples != default.samples:
-        raise UsageError(f"samples applies only to the uniform march, not {opts.march}")
+        raise UsageError(f"--samples applies only to --march uniform, not {opts.march}")
 
 
 def scale_w(factor: float) -> np.ndarray:
