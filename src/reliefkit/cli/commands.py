@@ -20,7 +20,7 @@ from ..bake import bake
 from ..bench import run_suite
 from ..compact.compact import CompressOptions, gpu_bytes
 from ..compare import compare, metrics_markdown, write_comparison
-from ..core.params import ANIMATION_TIME, options_of
+from ..core.params import ANIMATION_TIME, applicable, options_of
 from ..core.technique import baker, bakers, technique_of
 from ..demo import build_demo
 from ..errors import FormatError, MeshError, UsageError
@@ -47,7 +47,7 @@ from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, sho
 from ..units import format_bytes
 from ..viewer import server as view_server
 from ..viewer import site as view_site
-from .options import applicable, given_options
+from .options import given_options
 
 MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
 

@@ -3,11 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import math
 
 from ..core.params import describe_default
-from ..core.transforms import MAX_COORDINATE
-from ..errors import UsageError
 
 
 def add_flag(parser, *args, within=None, dash_value: bool = False, **kwargs):
@@ -80,34 +77,3 @@ def given_options(args) -> dict:
     """The declared options the user gave (the rest keep their declared defaults)."""
     return {key[len(OPTION_PREFIX):]: value for key, value in vars(args).items()
             if key.startswith(OPTION_PREFIX) and value is not None}
-
-
-def applicable(given: dict, options, what: str) -> dict:
-    """``given`` restricted to ``options`` and checked by their declarations; a flag that
-    does not apply, or a bad value, is a UsageError naming the flag as the user typed it."""
-    by_name = {opt.name: opt for opt in options}
-    wrong = [k for k in given if k not in by_name]
-    if wrong:
-        flags = ", ".join("--" + k.replace("_", "-") for k in wrong)
-        has = ", ".join("--" + opt.flag for opt in options) or "none"
-        raise UsageError(f"{flags} does not apply to {what} (its options: {has})")
-    return {name: checked(by_name[name], value, what) for name, value in given.items()}
-
-
-def checked(opt, value, what: str):
-    """``opt.check`` with the message saying ``--flag`` (the declaration says ``flag``)."""
-    try:
-        checked = opt.check(value, what)
-    except UsageError as exc:
-        message, bare = str(exc), f"{what}: {opt.flag} "
-        if message.startswith(bare):
-            message = f"--{opt.flag} {message[len(bare):]} ({what})"
-        raise UsageError(message) from None
-    if opt.kind in ("float", "floats") and checked is not None:
-        for v in (checked if opt.kind == "floats" else (checked,)):
-            if not (math.isfinite(v) and abs(v) <= MAX_COORDINATE):
-                raise UsageError(f"--{opt.flag} needs finite numbers of magnitude at most "
-                                 f"{MAX_COORDINATE:g}, got {value!r} ({what})")
-    return checked
-
-

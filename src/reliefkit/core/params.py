@@ -14,10 +14,12 @@ where each default lives.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from functools import cache
 
 from ..errors import UsageError
+from .transforms import MAX_COORDINATE
 
 KINDS = ("bool", "int", "float", "str", "floats")
 
@@ -156,4 +158,34 @@ def describe_default(opt: Option) -> str:
     if opt.kind == "floats":
         return ",".join(f"{x:g}" for x in opt.default)
     return str(opt.default)
+
+
+def applicable(given: dict, options, what: str) -> dict:
+    """``given`` restricted to ``options`` and checked by their declarations; a flag that
+    does not apply, or a bad value, is a UsageError naming the flag as the user typed it."""
+    by_name = {opt.name: opt for opt in options}
+    wrong = [k for k in given if k not in by_name]
+    if wrong:
+        flags = ", ".join("--" + k.replace("_", "-") for k in wrong)
+        has = ", ".join("--" + opt.flag for opt in options) or "none"
+        raise UsageError(f"{flags} does not apply to {what} (its options: {has})")
+    return {name: checked(by_name[name], value, what) for name, value in given.items()}
+
+
+def checked(opt, value, what: str):
+    """``opt.check`` with the message saying ``--flag`` (the declaration says ``flag``)."""
+    try:
+        checked = opt.check(value, what)
+    except UsageError as exc:
+        message, bare = str(exc), f"{what}: {opt.flag} "
+        if message.startswith(bare):
+            message = f"--{opt.flag} {message[len(bare):]} ({what})"
+        raise UsageError(message) from None
+    if opt.kind in ("float", "floats") and checked is not None:
+        for v in (checked if opt.kind == "floats" else (checked,)):
+            if not (math.isfinite(v) and abs(v) <= MAX_COORDINATE):
+                raise UsageError(f"--{opt.flag} needs finite numbers of magnitude at most "
+                                 f"{MAX_COORDINATE:g}, got {value!r} ({what})")
+    return checked
+
 
