@@ -21,10 +21,13 @@ def batch(inputs, kind: str, out, executor: str = "local", *, workers: int | Non
           progress: bool = True, setup=None, **bake_options) -> BatchReport:
     """Bake every mesh ``inputs`` name (files, folders, glob patterns, manifests) as
     ``kind`` with ``bake_options`` into the folder ``out``; returns the `BatchReport`
-    (``exit_status`` 1 when any asset failed). ``setup`` runs once in each worker (the
-    public ``reliefkit.batch`` passes the registry's). Ctrl-C raises `BatchInterrupted`."""
+    (``exit_status`` 1 when any asset failed). ``setup`` fills the registry, here and once
+    in each worker (the public ``reliefkit.batch`` passes the composition root's
+    ``registry``). Ctrl-C raises `BatchInterrupted`."""
     if isinstance(inputs, str | bytes) or not hasattr(inputs, "__iter__"):
         inputs = [inputs]
+    if setup is not None:
+        setup()
     runner = executor_for(executor, workers=workers, timeout=timeout, max_memory=max_memory,
                           setup=setup, address=address)
     return run_batch(list(inputs), kind, out, runner, force=force, export=export,
