@@ -3,6 +3,8 @@ executor, write each result atomically in this process (the driver), report."""
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import time
 from pathlib import Path
 
@@ -54,7 +56,8 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
             by_output = {job.output: job for job in todo}
 
             def finished(task: Task, result: Result) -> None:
-                report.add(_committed(by_output[task.output], task, result, out))
+                with _uninterrupted():  # the files and their line, or neither
+                    report.add(_committed(by_output[task.output], task, result, out))
                 advance(len(report.records))
 
             executor.run(_tasks(todo, export, report, advance), len(todo), finished)
@@ -63,6 +66,21 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
         raise BatchInterrupted(report) from exc
     report.seconds = time.monotonic() - start
     return report
+
+
+@contextlib.contextmanager
+def _uninterrupted():
+    """Ctrl-C and SIGTERM wait until the block is done (POSIX; elsewhere they do not), so an
+    output committed is also recorded in batch.jsonl: a rerun then counts it once."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    held = {signal.SIGINT, signal.SIGTERM}
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def _plan(jobs: list[Job], out: Path, force: bool, export: str | None,
