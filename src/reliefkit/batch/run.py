@@ -16,6 +16,7 @@ from .jobs import Job, check_jobs, expand_inputs
 from .key import cache_key, read_sources
 from .local import LocalExecutor
 from .report import AssetRecord, BatchInterrupted, BatchReport
+from .sheet import THUMBNAIL_SIZE, thumbnail_paths, write_sheet
 from .task import Result, Task, make_task
 
 EXECUTORS = ("local", "ray")
@@ -39,7 +40,8 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
               export: str | None = None, sheet: bool = False, progress: bool = True,
               **bake_options) -> BatchReport:
     """Bake every asset ``inputs`` name (`jobs.expand_inputs`) into ``out`` on ``executor``
-    (an object with ``run(tasks, count, on_result)``: `local.LocalExecutor`)."""
+    (an object with ``run(tasks, count, on_result)``: `local.LocalExecutor`); with
+    ``sheet`` also each output's thumbnail beside its mesh's (`sheet.write_sheet`)."""
     if export is not None and export not in EXPORTS:
         raise UsageError(f"--export writes {', '.join(EXPORTS)}, got {export!r}")
     out = Path(out)
@@ -51,7 +53,7 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
     start = time.monotonic()
     try:
         with progress_bar("batch", len(jobs), enabled=progress, eta=True) as advance:
-            todo = _plan(jobs, out, force, export, report)
+            todo = _plan(jobs, out, force, export, sheet, report)
             advance(len(report.records))
             by_output = {job.output: job for job in todo}
 
@@ -60,11 +62,13 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
                     report.add(_committed(by_output[task.output], task, result, out))
                 advance(len(report.records))
 
-            executor.run(_tasks(todo, export, report, advance), len(todo), finished)
+            executor.run(_tasks(todo, export, sheet, report, advance), len(todo), finished)
     except KeyboardInterrupt as exc:
         report.seconds = time.monotonic() - start
         raise BatchInterrupted(report) from exc
     report.seconds = time.monotonic() - start
+    if sheet:
+        write_sheet(out, report)
     return report
 
 
@@ -83,7 +87,7 @@ def _uninterrupted():
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
-def _plan(jobs: list[Job], out: Path, force: bool, export: str | None,
+def _plan(jobs: list[Job], out: Path, force: bool, export: str | None, sheet: bool,
           report: BatchReport) -> list[Job]:
     """The jobs to bake; those whose outputs hold their key are recorded as skipped."""
     todo = []
@@ -96,16 +100,20 @@ def _plan(jobs: list[Job], out: Path, force: bool, export: str | None,
         except ReliefkitError:
             todo.append(job)  # its task fails with the one line (`_tasks`)
             continue
-        if _up_to_date(out / job.output, key, export):
+        if _up_to_date(out, job.output, key, export, sheet):
             report.add(AssetRecord(job.where, job.output, job.kind, "skipped", key=key))
         else:
             todo.append(job)
     return todo
 
 
-def _up_to_date(path: Path, key: str, export: str | None) -> bool:
-    """Whether the .rk at ``path`` holds ``key`` (and the export asked for is there)."""
+def _up_to_date(out: Path, output: str, key: str, export: str | None, sheet: bool) -> bool:
+    """Whether the .rk ``output`` holds ``key`` (and the export and thumbnails asked for
+    are there)."""
+    path = out / output
     if export is not None and not path.with_suffix(f".{export}").is_file():
+        return False
+    if sheet and not all(p.is_file() for p in thumbnail_paths(out, output)):
         return False
     try:
         return path.is_file() and read_manifest(path).get("cache_key") == key
@@ -113,12 +121,13 @@ def _up_to_date(path: Path, key: str, export: str | None) -> bool:
         return False  # a file that is no valid .rk is baked again
 
 
-def _tasks(jobs: list[Job], export: str | None, report: BatchReport, advance):
+def _tasks(jobs: list[Job], export: str | None, sheet: bool, report: BatchReport, advance):
     """Each job's task, its files read as it is handed out; one whose files cannot be read
     is failed here, with its line."""
     for job in jobs:
         try:
-            yield make_task(job, export_glb=export == "glb")
+            yield make_task(job, export_glb=export == "glb",
+                            thumbnails=THUMBNAIL_SIZE if sheet else 0)
         except ReliefkitError as exc:
             report.add(AssetRecord(job.where, job.output, job.kind, "failed",
                                    error=" ".join(str(exc).split())))
@@ -137,9 +146,13 @@ def _committed(job: Job, task: Task, result: Result, out: Path) -> AssetRecord:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         with written_together():
-            if result.glb is not None:  # written with the .rk, which holds the key
-                with atomic_path(path.with_suffix(".glb")) as tmp:
-                    tmp.write_bytes(result.glb)
+            extras = [(path.with_suffix(".glb"), result.glb)] if result.glb is not None else []
+            if result.thumbnails:
+                extras += zip(thumbnail_paths(out, job.output), result.thumbnails, strict=True)
+            for extra, data in extras:  # written with the .rk, which holds the key
+                extra.parent.mkdir(parents=True, exist_ok=True)
+                with atomic_path(extra) as tmp:
+                    tmp.write_bytes(data)
             with atomic_path(path) as tmp:
                 tmp.write_bytes(result.rk)
     except (ReliefkitError, OSError) as exc:

@@ -12,6 +12,7 @@ are set before its GL context exists, which it then makes once and keeps
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 import tempfile
 import time
@@ -19,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from ..bake import bake
+from ..demo import tile_image
 from ..errors import ReliefkitError, UsageError
 from ..gl import context as gl_context
 from ..io.rk import rk_bytes
@@ -40,6 +42,7 @@ class Task:
     files: dict = field(default_factory=dict)   # the files it references: {name: bytes}
     folder: str = ""                 # its folder, to name in messages instead of the worker's
     export_glb: bool = False         # also return the glTF export (`--export glb`)
+    thumbnails: int = 0              # also the mesh's and the output's PNG at this size
 
 
 @dataclass(frozen=True)
@@ -54,14 +57,15 @@ class Result:
     figures: tuple = ()              # the bake's report lines (`bake_report`)
     warnings: tuple = ()             # the loader's and the bake's warnings
     error: str | None = None
+    thumbnails: tuple = ()           # (the mesh's PNG, the output's PNG) when asked
 
 
-def make_task(job: Job, *, export_glb: bool = False) -> Task:
+def make_task(job: Job, *, export_glb: bool = False, thumbnails: int = 0) -> Task:
     """The task of ``job``: its files read now, its key computed from those very bytes."""
     source, files = read_sources(job.input)
     key = cache_key(job.kind, job.options, source, files, job.where)
     return Task(job.where, job.output, job.kind, job.options, key, job.input.name, source,
-                files, str(job.input.parent), export_glb)
+                files, str(job.input.parent), export_glb, thumbnails)
 
 
 def prepare_worker(setup=None, *, threads: int | None = None,
@@ -86,11 +90,12 @@ def run_task(task: Task) -> Result:
     folder = ""
     try:
         with tempfile.TemporaryDirectory(prefix="reliefkit-task-") as folder:
-            rep, warnings = _bake(task, Path(folder))
+            mesh, rep, warnings = _bake(task, Path(folder))
             source_hash = hashlib.sha256(task.source).hexdigest()
             data = rk_bytes(rep, source_hash=source_hash, cache_key=task.key)
             glb = _export(rep, source_hash) if task.export_glb else None
             figures = [str(line) for line in getattr(rep, "bake_report", lambda: [])()]
+            pictures = _thumbnails(mesh, rep, task.thumbnails) if task.thumbnails else ()
     except ReliefkitError as exc:
         return _failed(task, start, _in_words(str(exc), task, folder))
     except MemoryError:
@@ -102,7 +107,7 @@ def run_task(task: Task) -> Result:
     warnings += [line for line in figures if line.startswith("warning:")]
     return Result(task.output, "ok", time.perf_counter() - start, data, glb,
                   tuple(line for line in figures if not line.startswith("warning:")),
-                  tuple(_in_words(w, task, folder) for w in warnings))
+                  tuple(_in_words(w, task, folder) for w in warnings), thumbnails=pictures)
 
 
 def _bake(task: Task, folder: Path):
@@ -116,7 +121,19 @@ def _bake(task: Task, folder: Path):
     mesh = load_mesh(folder / task.name)
     warnings = [f"warning: {' '.join(str(w).split())}" for w in mesh.extra.get("warnings", ())]
     params, compression = split_options(task.kind, task.options, task.where)
-    return bake(mesh, task.kind, compress=compression, **params), warnings
+    return mesh, bake(mesh, task.kind, compress=compression, **params), warnings
+
+
+def _thumbnails(mesh, rep, size: int) -> tuple[bytes, bytes]:
+    """The mesh and what it was baked into from the default view, as PNG bytes."""
+    from PIL import Image
+
+    pictures = []
+    for obj in (mesh, rep):
+        buffer = io.BytesIO()
+        Image.fromarray(tile_image(obj, size=(size, size)), "RGBA").save(buffer, format="PNG")
+        pictures.append(buffer.getvalue())
+    return tuple(pictures)
 
 
 def _export(rep, source_hash: str) -> bytes:
