@@ -1,17 +1,19 @@
-"""Kinds that misbehave on purpose, for the batch tests: each worker registers them (and
-the toy technique) through `setup`, which the tests hand to `reliefkit.batch`."""
+"""Kinds that misbehave (or report on their worker) on purpose, for the batch tests: each
+worker registers them (and the toy technique) through `setup`, which the tests hand to
+`reliefkit.batch`."""
 
 from __future__ import annotations
 
 import os
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import toy_technique
 
 from reliefkit.builtins import registry
-from reliefkit.core.technique import Baker, Technique, register, techniques
+from reliefkit.core.technique import Baker, Technique, register, techniques, unregister
 
 HOG_STEP = 32 << 20  # bytes the hog kind touches at a time
 
@@ -37,12 +39,27 @@ def _hog(mesh, params, progress=None):
         time.sleep(0.02)
 
 
+def _threads(mesh, params, progress=None):
+    """A toy quad whose params say how many llvmpipe threads this worker's GL context
+    started and what ``LP_NUM_THREADS`` was."""
+    from reliefkit.gl.context import get_context
+
+    get_context()
+    names = [(Path("/proc/self/task") / t / "comm").read_text().strip()
+             for t in os.listdir("/proc/self/task")]
+    quad = toy_technique.bake_quad(mesh, toy_technique.ToyBakeParams())
+    quad.params = {"LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS"),
+                   "llvmpipe_threads": sum(n.startswith("llvmpipe-") for n in names)}
+    return quad
+
+
 MISBEHAVING = Technique(
     name="misbehaving", summary="kinds that crash, hang or hog memory (batch tests)",
     package=__name__,
     bakers=tuple(Baker(name, f"a baker that {what}", NoParams, bake) for name, what, bake in (
         ("crash", "exits its process", _crash), ("hang", "never returns", _hang),
-        ("hog", "takes memory without end", _hog))))
+        ("hog", "takes memory without end", _hog),
+        ("threads", "reports its worker's Mesa threads", _threads))))
 
 
 def setup() -> None:
@@ -52,3 +69,11 @@ def setup() -> None:
     for tech in (toy_technique.TECHNIQUE, MISBEHAVING):
         if tech.name not in known:
             register(tech)
+
+
+def teardown() -> None:
+    """This process's registry without them again (the driver's, after a test)."""
+    known = {tech.name for tech in techniques()}
+    for tech in (MISBEHAVING, toy_technique.TECHNIQUE):
+        if tech.name in known:
+            unregister(tech.name)

@@ -10,8 +10,18 @@ import batch_kinds
 import pytest
 from helpers import write_tetrahedron
 
+import reliefkit
 from reliefkit.batch import batch
+from reliefkit.batch.key import file_cache_key
+from reliefkit.batch.local import cores
 from reliefkit.io import rk
+
+
+@pytest.fixture(autouse=True)
+def _kinds_unregistered_after():
+    """The driver (this process) registers the test kinds through ``setup``: not for long."""
+    yield
+    batch_kinds.teardown()
 
 
 @pytest.fixture
@@ -54,11 +64,12 @@ def test_a_crashing_worker_is_replaced_and_only_its_asset_fails(library, tmp_pat
 
 
 def test_timeout_stops_the_asset_and_the_batch_goes_on(library, tmp_path):
-    spec = manifest(library, {"a.obj": "hang", "b.obj": "toy-quad"})
-    report = run([spec], "toy-quad", tmp_path / "out", workers=1, timeout=1.0)
+    spec = library / "m.csv"  # a CSV manifest this time
+    spec.write_text("input,kind\na.obj,hang\nb.obj,\n")
+    report = run([spec], "toy-quad", tmp_path / "out", workers=1, timeout=3.0)
     status = {r.output: (r.status, r.error) for r in report.records}
-    assert status["b.rk"] == ("ok", None)
-    assert status["a.rk"][0] == "failed" and "longer than --timeout 1 s" in status["a.rk"][1]
+    assert status["b.rk"] == ("ok", None)  # on the worker that replaced the stopped one
+    assert status["a.rk"][0] == "failed" and "longer than --timeout 3 s" in status["a.rk"][1]
 
 
 def test_max_memory_stops_the_worker_over_it(library, tmp_path):
@@ -91,3 +102,24 @@ def test_a_broken_mesh_fails_with_its_line_and_the_rest_succeed(library, tmp_pat
     assert "no triangle with a visible area" in errors["broken.rk"]
     assert "empty" in errors["empty.rk"]
     assert all("\n" not in e and "reliefkit-task-" not in e for e in errors.values())
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_workers_times_mesa_threads_stay_within_the_cores(library, tmp_path, workers):
+    report = run([library], "threads", tmp_path / "out", workers=workers)
+    expected = max(1, cores() // workers)
+    for record in report.ok:
+        params = rk.read_manifest(tmp_path / "out" / record.output)["params"]
+        assert params == {"LP_NUM_THREADS": str(expected), "llvmpipe_threads": expected}
+    assert len(report.ok) == 3
+
+
+def test_the_public_api_bakes_with_the_built_ins(library, tmp_path):
+    out = tmp_path / "out"
+    report = reliefkit.batch(library / "a.obj", "relief", out, workers=1, depth_res=10,
+                             progress=False)
+    assert [(r.output, r.status) for r in report.records] == [("a.rk", "ok")]
+    manifest = rk.read_manifest(out / "a.rk")
+    assert manifest["cache_key"] == file_cache_key(library / "a.obj", "relief",
+                                                   {"depth_res": 10})
+    assert manifest["source_hash"] == rk.file_sha256(library / "a.obj")

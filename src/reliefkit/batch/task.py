@@ -73,7 +73,8 @@ def prepare_worker(setup=None, *, threads: int | None = None,
     """Make this process a baker, once, before its GL context exists: ``threads`` Mesa
     rasterizer threads (``LP_NUM_THREADS``, so workers x threads stay within the cores),
     the EGL device ``device_index`` (EGL ignores ``CUDA_VISIBLE_DEVICES``), then
-    ``setup()`` (the composition root's ``registry``: the kinds a task may name)."""
+    ``setup()`` (the composition root's ``registry``: the kinds a task may name); the mesh
+    loader is imported now, so an asset's time (and ``--timeout``) is its own."""
     if gl_context.has_context():
         raise UsageError("prepare_worker must run before this process makes its GL context")
     if threads is not None:
@@ -82,6 +83,7 @@ def prepare_worker(setup=None, *, threads: int | None = None,
         os.environ["GLCONTEXT_DEVICE_INDEX"] = str(int(device_index))
     if setup is not None:
         setup()
+    from ..io.meshes import load_mesh  # noqa: F401 - trimesh now, not in the first asset's time
 
 
 def run_task(task: Task) -> Result:
