@@ -53,8 +53,7 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
     start = time.monotonic()
     try:
         with progress_bar("batch", len(jobs), enabled=progress, eta=True) as advance:
-            todo = _plan(jobs, out, force, export, sheet, report)
-            advance(len(report.records))
+            todo = _plan(jobs, out, force, export, sheet, report, advance)
             by_output = {job.output: job for job in todo}
 
             def finished(task: Task, result: Result) -> None:
@@ -88,8 +87,9 @@ def _uninterrupted():
 
 
 def _plan(jobs: list[Job], out: Path, force: bool, export: str | None, sheet: bool,
-          report: BatchReport) -> list[Job]:
-    """The jobs to bake; those whose outputs hold their key are recorded as skipped."""
+          report: BatchReport, advance) -> list[Job]:
+    """The jobs to bake; those whose outputs hold their key are recorded as skipped (each
+    read and hashed here: a library's plan takes a while, so it shows as progress)."""
     todo = []
     for job in jobs:
         if force:
@@ -102,6 +102,7 @@ def _plan(jobs: list[Job], out: Path, force: bool, export: str | None, sheet: bo
             continue
         if _up_to_date(out, job.output, key, export, sheet):
             report.add(AssetRecord(job.where, job.output, job.kind, "skipped", key=key))
+            advance(len(report.records))
         else:
             todo.append(job)
     return todo

@@ -38,9 +38,9 @@ def write_sheet(out: Path, report: BatchReport) -> tuple[Path, Path]:
                    key=lambda r: r.output)
     tiles = []
     for record in shown[:SHEET_MAX_ASSETS]:
+        stem = str(PurePosixPath(record.output).with_suffix(""))
         for path, caption in zip(thumbnail_paths(out, record.output),
-                                 (record.input, f"{record.output} ({record.kind})"),
-                                 strict=True):
+                                 (f"{stem}: mesh", f"{stem}: {record.kind}"), strict=True):
             with Image.open(path) as image:
                 tiles.append((caption, np.asarray(image.convert("RGBA"))))
     title = f"reliefkit batch: {len(shown)} outputs beside their meshes"
