@@ -51,37 +51,39 @@ class LocalExecutor:
     def run(self, tasks: Iterable[Task], count: int,
             on_result: Callable[[Task, Result], None]) -> None:
         """Run every task of ``tasks`` (``count`` of them), calling ``on_result`` in this
-        process as each finishes; on any exit (Ctrl-C too) every worker is stopped."""
+        process as each finishes; on any exit (Ctrl-C too) every worker is stopped. A lost
+        worker's slot gets a new one when there is a task for it."""
         threads = max(1, cores() // self.workers)
-        pool = [_Worker(self.setup, threads) for _ in range(min(self.workers, count))]
+        slots: list[_Worker | None] = [_Worker(self.setup, threads)
+                                       for _ in range(min(self.workers, count))]
         pending = iter(tasks)
         try:
-            more = True
             while True:
-                for worker in pool:
-                    if more and worker.task is None:
+                for k, worker in enumerate(slots):
+                    if worker is None or worker.task is None:
                         task = next(pending, None)
-                        more = task is not None
-                        if more:
-                            worker.start(task)
-                busy = [w for w in pool if w.task is not None]
+                        if task is None:
+                            break
+                        slots[k] = worker = worker or _Worker(self.setup, threads)
+                        worker.start(task)
+                busy = [w for w in slots if w is not None and w.task is not None]
                 if not busy:
                     return
                 wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
                      timeout=POLL_SECONDS)
-                for k, worker in enumerate(pool):
-                    if worker.task is None:
+                for k, worker in enumerate(slots):
+                    if worker is None or worker.task is None:
                         continue
                     task, result = worker.task, worker.poll(self.timeout, self.max_memory)
                     if result is None:
                         continue
                     if worker.broken:
-                        worker.stop()
-                        pool[k] = _Worker(self.setup, threads)
+                        slots[k] = None
                     on_result(task, result)
         finally:
-            for worker in pool:
-                worker.stop()
+            for worker in slots:
+                if worker is not None:
+                    worker.stop()
 
 
 class _Worker:
