@@ -117,7 +117,10 @@ def _bake(task: Task, folder: Path):
     from ..io.meshes import load_mesh  # trimesh: slow to import
 
     for name, data in {**task.files, task.name: task.source}.items():
-        path = folder.joinpath(*PurePosixPath(name).parts)
+        relative = PurePosixPath(name)
+        if relative.is_absolute() or ".." in relative.parts:  # never outside the folder
+            raise UsageError(f"the task names a file outside its folder: {name!r}")
+        path = folder.joinpath(*relative.parts)
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
     mesh = load_mesh(folder / task.name)
