@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,13 +54,20 @@ def _threads(mesh, params, progress=None):
     return quad
 
 
+def _warns(mesh, params, progress=None):
+    """A toy quad, after a Python warning (which the worker must not print)."""
+    warnings.warn("the toy quad is flat", UserWarning, stacklevel=1)
+    return toy_technique.bake_quad(mesh, toy_technique.ToyBakeParams())
+
+
 MISBEHAVING = Technique(
     name="misbehaving", summary="kinds that crash, hang or hog memory (batch tests)",
     package=__name__,
     bakers=tuple(Baker(name, f"a baker that {what}", NoParams, bake) for name, what, bake in (
         ("crash", "exits its process", _crash), ("hang", "never returns", _hang),
         ("hog", "takes memory without end", _hog),
-        ("threads", "reports its worker's Mesa threads", _threads))))
+        ("threads", "reports its worker's Mesa threads", _threads),
+        ("warns", "warns, then bakes a toy quad", _warns))))
 
 
 def setup() -> None:

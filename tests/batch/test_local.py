@@ -123,3 +123,10 @@ def test_the_public_api_bakes_with_the_built_ins(library, tmp_path):
     assert manifest["cache_key"] == file_cache_key(library / "a.obj", "relief",
                                                    {"depth_res": 10})
     assert manifest["source_hash"] == rk.file_sha256(library / "a.obj")
+
+
+def test_a_bake_s_python_warnings_go_to_its_record_not_the_terminal(library, tmp_path,
+                                                                     capfd):
+    report = run([library / "a.obj"], "warns", tmp_path / "out", workers=1)
+    assert [r.warnings for r in report.records] == [("warning: the toy quad is flat",)]
+    assert "toy quad is flat" not in capfd.readouterr().err  # the workers' stderr too

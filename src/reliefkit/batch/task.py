@@ -11,11 +11,13 @@ are set before its GL context exists, which it then makes once and keeps
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import os
 import tempfile
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -91,8 +93,9 @@ def run_task(task: Task) -> Result:
     start = time.perf_counter()
     folder = ""
     try:
-        with tempfile.TemporaryDirectory(prefix="reliefkit-task-") as folder:
-            mesh, rep, warnings = _bake(task, Path(folder))
+        with tempfile.TemporaryDirectory(prefix="reliefkit-task-") as folder, \
+                _recorded_warnings() as caught:
+            mesh, rep, notes = _bake(task, Path(folder))
             source_hash = hashlib.sha256(task.source).hexdigest()
             data = rk_bytes(rep, source_hash=source_hash, cache_key=task.key)
             glb = _export(rep, source_hash) if task.export_glb else None
@@ -106,10 +109,22 @@ def run_task(task: Task) -> Result:
         detail = " ".join(str(exc).split())[:200]
         return _failed(task, start, f"internal error ({type(exc).__name__}: "
                                     f"{_in_words(detail, task, folder)})")
-    warnings += [line for line in figures if line.startswith("warning:")]
+    notes += [f"warning: {w.message}" for w in caught]
+    notes += [line for line in figures if line.startswith("warning:")]
     return Result(task.output, "ok", time.perf_counter() - start, data, glb,
                   tuple(line for line in figures if not line.startswith("warning:")),
-                  tuple(_in_words(w, task, folder) for w in warnings), thumbnails=pictures)
+                  tuple(_in_words(w, task, folder) for w in notes), thumbnails=pictures)
+
+
+@contextlib.contextmanager
+def _recorded_warnings():
+    """Python warnings of the bake, kept for the asset's record instead of printed by the
+    worker (the CLI's policy: deprecations and numpy's floating-point notes are dropped)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        for category in (DeprecationWarning, PendingDeprecationWarning, RuntimeWarning):
+            warnings.filterwarnings("ignore", category=category)
+        yield caught
 
 
 def _bake(task: Task, folder: Path):
@@ -124,9 +139,9 @@ def _bake(task: Task, folder: Path):
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
     mesh = load_mesh(folder / task.name)
-    warnings = [f"warning: {' '.join(str(w).split())}" for w in mesh.extra.get("warnings", ())]
+    notes = [f"warning: {' '.join(str(w).split())}" for w in mesh.extra.get("warnings", ())]
     params, compression = split_options(task.kind, task.options, task.where)
-    return mesh, bake(mesh, task.kind, compress=compression, **params), warnings
+    return mesh, bake(mesh, task.kind, compress=compression, **params), notes
 
 
 def _thumbnails(mesh, rep, size: int) -> tuple[bytes, bytes]:
