@@ -6,6 +6,8 @@ from __future__ import annotations
 import hashlib
 import pickle
 import shutil
+import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -65,3 +67,21 @@ def test_a_file_name_outside_the_folder_is_refused(gl, tmp_path):
 def test_prepare_worker_comes_before_the_gl_context(gl):
     with pytest.raises(UsageError, match="before this process makes its GL context"):
         prepare_worker(threads=1)
+
+
+def test_prepare_worker_picks_the_egl_device_by_index():
+    """The device index reaches EGL (which ignores CUDA_VISIBLE_DEVICES): one that does not
+    exist is refused by it, the first one draws (a fresh interpreter: no context yet)."""
+    script = ("from reliefkit.batch.task import prepare_worker\n"
+              "from reliefkit.gl.context import get_context\n"
+              "import sys\n"
+              "prepare_worker(threads=1, device_index=int(sys.argv[1]))\n"
+              "try:\n"
+              "    print(get_context().info['GL_RENDERER'])\n"
+              "except Exception as exc:\n"
+              "    print(exc)\n")
+    first, missing = (subprocess.run([sys.executable, "-c", script, str(index)],
+                                     capture_output=True, text=True, timeout=120).stdout
+                      for index in (0, 999))
+    assert "could not create" not in first
+    assert "device index 999" in missing
