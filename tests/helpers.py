@@ -195,3 +195,20 @@ def fallback_ious(mesh, fallback, size: int = 128) -> list[float]:
     cameras = [orbit_bounds(mesh.bounds, az, el, size=(size, size))
                for az, el in FALLBACK_VIEWS]
     return [mask_iou(render(fallback, c), render(mesh, c)) for c in cameras]
+
+
+def write_tetrahedron(path, scale: float = 1.0, name_texture: str | None = None):
+    """A small OBJ tetrahedron (its x extent ``scale``) at ``path``, its folders made; with
+    ``name_texture`` it uses a material whose .mtl (beside it) names that texture."""
+    from pathlib import Path
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    head = ""
+    if name_texture is not None:
+        path.with_suffix(".mtl").write_text(f"newmtl m\nKd 1 1 1\nmap_Kd {name_texture}\n")
+        head = f"mtllib {path.with_suffix('.mtl').name}\nusemtl m\n"
+    path.write_text(head + f"v 0 0 0\nv {scale:g} 0 0\nv 0 1 0\nv 0 0 1\n"
+                    "vt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n"
+                    "f 1/1 3/3 2/2\nf 1/1 2/2 4/4\nf 1/1 4/4 3/3\nf 2/2 3/3 4/4\n")
+    return path

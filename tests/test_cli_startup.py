@@ -41,7 +41,8 @@ def heavy_modules_after(*commands: list[str]) -> list[str]:
 
 def test_help_imports_no_heavy_library():
     commands = [["--help"], *([name, "--help"] for name in
-                              ("render", "bake", "compare", "bench", "demo", "info"))]
+                              ("render", "bake", "batch", "compare", "bench", "demo",
+                               "info"))]
     assert heavy_modules_after(*commands) == []
 
 

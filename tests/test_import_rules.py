@@ -135,6 +135,27 @@ def test_nothing_imports_the_cli(path):
                 or m.startswith("reliefkit.cli.")}
 
 
+BATCH = PACKAGE / "batch"
+# what the batch package builds on: the layers below it (io, bake, export, render, ...);
+# never the CLI, the composition root (it is handed ``setup``) or a technique
+BATCH_MAY_NOT = ("reliefkit.cli", "reliefkit.builtins", "reliefkit.techniques")
+
+
+@pytest.mark.parametrize("path", modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_only_the_cli_and_the_root_import_the_batch_package(path):
+    if path.parent == BATCH or path.parent == PACKAGE / "cli" or path.name == "builtins.py" \
+            and path.parent == PACKAGE:
+        return
+    assert not {m for m in imported_modules(path) if m == "reliefkit.batch"
+                or m.startswith("reliefkit.batch.")}
+
+
+@pytest.mark.parametrize("path", sorted(BATCH.glob("*.py")), ids=lambda p: p.name)
+def test_the_batch_package_imports_only_the_layers_below(path):
+    assert not {m for m in imported_modules(path)
+                if any(m == n or m.startswith(n + ".") for n in BATCH_MAY_NOT)}
+
+
 # the draw path's users of GL: the GL layer, the one executor and its multi-pass kinds; and
 # outside the draw path the GPU bake passes and the frame-timing harness
 GL_USERS = (PACKAGE / "gl", PACKAGE / "render" / "executor.py", PACKAGE / "render" / "multipass",

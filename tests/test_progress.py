@@ -6,6 +6,7 @@ import io
 
 import pytest
 
+from reliefkit import progress
 from reliefkit.progress import activity, progress_bar
 
 
@@ -31,6 +32,23 @@ def test_plain_lines_are_rate_limited():
             advance(k + 1)
     lines = stream.getvalue().splitlines()
     assert len(lines) == 1 and lines[0].startswith("bake: 10/10, done in ")
+
+
+def test_plain_lines_can_say_the_time_left(monkeypatch):
+    clock = iter([0.0, 10.0, 20.0, 40.0])  # start; each advance; finish
+    monkeypatch.setattr(progress.time, "monotonic", lambda: next(clock))
+    stream = io.StringIO()
+    with progress_bar("batch", 4, stream=stream, interval=0.0, eta=True) as advance:
+        advance(1)  # 10 s for 1 of 4: 30 s left
+        advance(2)  # 20 s for 2: 20 s left
+    assert stream.getvalue().splitlines()[:2] == ["batch: 1/4, eta 30 s", "batch: 2/4, eta 20 s"]
+
+
+def test_a_terminal_bar_can_say_the_time_left():
+    stream = Terminal()
+    with progress_bar("batch", 4, stream=stream, eta=True) as advance:
+        advance(4)
+    assert "eta" in stream.getvalue()
 
 
 def test_a_total_given_while_running_is_used():

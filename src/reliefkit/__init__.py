@@ -16,7 +16,8 @@ import types
 # The functions that look things up in the registry come from the composition root, which
 # registers the built-ins before their first call.
 _EXPORTS = {
-    "metrics": "", **dict.fromkeys(("bake", "load", "render", "save", "export"), ".builtins"),
+    "metrics": "",
+    **dict.fromkeys(("bake", "load", "render", "save", "export", "batch"), ".builtins"),
     "Frame": ".render", "Camera": ".scene.camera",
     "DirectionalLight": ".scene.light", "load_mesh": ".io.inputs",
     "RenderMesh": ".scene.mesh",

@@ -28,7 +28,7 @@ from .render import render as _render
 from .render.mesh import MESH_DRAWABLE
 from .techniques import TECHNIQUES
 
-__all__ = ["registry", "bake", "load", "render", "save", "export"]
+__all__ = ["registry", "bake", "load", "render", "save", "export", "batch"]
 
 _lock = threading.Lock()
 _filled = False
@@ -71,7 +71,16 @@ def _export(rep, path, **kwargs):
     return export(rep, path, **kwargs)
 
 
+def _batch(inputs, kind, out, executor="local", **options):
+    """`reliefkit.batch.batch`, each worker given the built-ins (``setup``)."""
+    from .batch import batch  # the process pool's modules: imported when batching
+
+    options.setdefault("setup", registry)
+    return batch(inputs, kind, out, executor, **options)
+
+
 bake = _with_builtins(_bake)
+batch = _with_builtins(_batch)
 load = _with_builtins(_load)
 export = _with_builtins(_export)
 render = _with_builtins(_render)

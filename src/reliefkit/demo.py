@@ -13,7 +13,7 @@ from .pictures import TILE_BACKGROUND, contact_sheet, save_image
 from .progress import progress_bar
 from .render import render
 from .scene.assets import make_asset
-from .scene.views import framing_bounds, orbit_bounds
+from .scene.views import DEFAULT_VIEW, framing_bounds, orbit_bounds
 
 
 def _asset(name: str) -> Callable[[], object]:
@@ -44,6 +44,15 @@ def demo_tiles() -> list[DemoTile]:
     return tiles
 
 
+def tile_image(obj, view=DEFAULT_VIEW, size=(256, 256), options: dict | None = None
+               ) -> np.ndarray:
+    """``obj`` (a mesh or a representation) drawn from ``view`` (azimuth, elevation,
+    distance or None to fit) over the tiles' background: an (H, W, 4) uint8 image, as the
+    demo sheet and the batch's thumbnails show it."""
+    camera = orbit_bounds(framing_bounds(obj), *view, size=size)
+    return render(obj, camera, **(options or {})).rgba8(TILE_BACKGROUND)
+
+
 def build_demo(out_dir: Path, tile_size=(256, 256), columns: int = 4) -> Path:
     """Render every tile into ``out_dir/<slug>.png`` and the sheet into ``out_dir/demo.png``."""
     from PIL import Image
@@ -53,9 +62,7 @@ def build_demo(out_dir: Path, tile_size=(256, 256), columns: int = 4) -> Path:
     images: list[tuple[str, np.ndarray]] = []
     with progress_bar("demo", len(tiles)) as advance:
         for k, tile in enumerate(tiles):
-            obj = tile.make()
-            camera = orbit_bounds(framing_bounds(obj), *tile.view, size=tile_size)
-            rgba = render(obj, camera, **(tile.options or {})).rgba8(TILE_BACKGROUND)
+            rgba = tile_image(tile.make(), tile.view, tile_size, tile.options)
             with atomic_path(out_dir / f"{tile.slug}.png") as tmp:
                 Image.fromarray(rgba, "RGBA").save(tmp, format="PNG")
             images.append((tile.title, rgba))

@@ -26,17 +26,18 @@ def _is_terminal(stream) -> bool:
 
 @contextlib.contextmanager
 def progress_bar(description: str, total: int, *, enabled: bool = True, stream=None,
-                 interval: float = PLAIN_INTERVAL):
+                 interval: float = PLAIN_INTERVAL, eta: bool = False):
     """Yield ``advance(done, total=None)``, the callback long loops (and bakers) call; each
-    call also stops the work if Ctrl-C or SIGTERM came and was swallowed (`interrupts`)."""
+    call also stops the work if Ctrl-C or SIGTERM came and was swallowed (`interrupts`).
+    With ``eta`` the bar (or each plain line) also says the time left at the rate so far."""
     stream = stream if stream is not None else sys.stderr
     if not enabled:
         yield _checked(lambda done, total_=None: None)
     elif _is_terminal(stream):
-        with _rich_bar(description, total, stream) as advance:
+        with _rich_bar(description, total, stream, eta) as advance:
             yield _checked(advance)
     else:
-        lines = _PlainLines(description, total, stream, interval)
+        lines = _PlainLines(description, total, stream, interval, eta)
         yield _checked(lines.advance)
         lines.finish()
 
@@ -121,12 +122,19 @@ def waiting(description: str, *, stream=None, after: float | None = None,
 
 
 @contextlib.contextmanager
-def _rich_bar(description: str, total: int, stream):
+def _rich_bar(description: str, total: int, stream, eta: bool = False):
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-               TimeElapsedColumn())
+               TimeElapsedColumn(), *((TextColumn("eta"), TimeRemainingColumn()) if eta else ()))
     with Progress(*columns, console=Console(file=stream)) as bar:
         task = bar.add_task(description, total=total)
 
@@ -140,9 +148,10 @@ def _rich_bar(description: str, total: int, stream):
 class _PlainLines:
     """``description: done/total`` lines, rate-limited, and one final line on success."""
 
-    def __init__(self, description: str, total: int, stream, interval: float):
+    def __init__(self, description: str, total: int, stream, interval: float,
+                 eta: bool = False):
         self.description, self.total, self.stream = description, total, stream
-        self.interval = interval
+        self.interval, self.eta = interval, eta
         self.start = self.last = time.monotonic()
 
     def advance(self, done: int, total: int | None = None) -> None:
@@ -150,7 +159,9 @@ class _PlainLines:
         now = time.monotonic()
         if now - self.last >= self.interval and done < self.total:
             self.last = now
-            self._line(f"{done}/{self.total}")
+            left = (now - self.start) * (self.total - done) / done if done else None
+            shown = f", eta {left:.0f} s" if self.eta and left is not None else ""
+            self._line(f"{done}/{self.total}{shown}")
 
     def finish(self) -> None:
         self._line(f"{self.total}/{self.total}, done in {time.monotonic() - self.start:.1f} s")

@@ -250,6 +250,22 @@ def test_mesh_round_trip_is_bit_exact(tmp_path, textured):
     assert ("texture" in manifest["arrays"]) == textured
 
 
+@pytest.mark.parametrize("textured", [False, True])
+def test_rk_bytes_are_the_bytes_save_writes(tmp_path, textured):
+    mesh = make_mesh(textured)
+    key = hashlib.sha256(b"cache key").hexdigest()
+    path = formats.save(tmp_path / "m.rk", mesh, source_hash=SOURCE_HASH, cache_key=key)
+    assert formats.rk_bytes(mesh, source_hash=SOURCE_HASH, cache_key=key) == path.read_bytes()
+    assert formats.read_manifest(path)["cache_key"] == key
+
+
+def test_the_cache_key_is_written_only_when_given(tmp_path):
+    path = formats.save(tmp_path / "m.rk", make_mesh(False))
+    assert "cache_key" not in formats.read_manifest(path)
+    with pytest.raises(FormatError, match="cache_key must be"):
+        formats.rk_bytes(make_mesh(False), cache_key="not a digest")
+
+
 @pytest.mark.parametrize("ints", [np.uint8, np.uint16])
 def test_multi_dtype_round_trip_keeps_bits_params_and_hash(tmp_path, ints):
     bag = make_bag(ints)
@@ -486,6 +502,8 @@ def test_unknown_kind_lists_known_kinds(tmp_path):
     ("format", "numpy", "format is 'numpy', not 'reliefkit'"),
     ("params", [1], "params is not a JSON object"),
     ("source_hash", "abc", "source_hash must be"),
+    ("cache_key", "ABC", "cache_key must be"),
+    ("cache_key", 12, "cache_key must be"),
     ("arrays", {"positions": {"dtype": "<f4"}}, "manifest entry for array 'positions'"),
 ])
 def test_bad_manifest_fields(tmp_path, field_name, value, pattern):

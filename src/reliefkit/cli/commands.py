@@ -17,7 +17,10 @@ from ..animation import (
     save_animation,
 )
 from ..bake import bake
+from ..batch.key import file_cache_key
+from ..batch.report import JSONL_NAME, BatchInterrupted
 from ..bench import run_suite
+from ..builtins import batch
 from ..compact.compact import CompressOptions, gpu_bytes
 from ..compare import compare, metrics_markdown, write_comparison
 from ..core.params import ANIMATION_TIME, applicable, options_of
@@ -44,10 +47,11 @@ from ..scene.views import (
     turntable,
 )
 from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, shootout
-from ..units import format_bytes
+from ..units import format_bytes, parse_bytes
 from ..viewer import server as view_server
 from ..viewer import site as view_site
 from ..viewer.variants import Variants
+from .exits import EXIT_INTERRUPTED
 from .options import given_options
 
 MAX_FRAMES = 3600  # of --turntable and --animate (streamed: memory is one frame's)
@@ -119,8 +123,11 @@ def cmd_bake(args) -> int:
         raise UsageError(f"output must be an .rk file, got {args.output}")
     check_writable(args.output, "-o")
     rep = _bake_input(args)
-    source_hash = file_sha256(args.input) if Path(args.input).is_file() else None
-    save(args.output, rep, source_hash=source_hash)
+    source_hash = key = None
+    if Path(args.input).is_file():  # a batch over the same file writes the same bytes
+        source_hash = file_sha256(args.input)
+        key = file_cache_key(args.input, args.kind, given_options(args))
+    save(args.output, rep, source_hash=source_hash, cache_key=key)
     gpu = _gpu_summary(rep)
     print(f"wrote {args.output}: {_arrays_summary(array_bytes(rep), args.output)}, "
           f"{format_bytes(Path(args.output).stat().st_size)} on disk{gpu}")
@@ -130,6 +137,30 @@ def cmd_bake(args) -> int:
     for line in getattr(rep, "bake_report", lambda: [])():  # a technique's own figures
         print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     return 0
+
+
+def cmd_batch(args) -> int:
+    max_memory = None
+    if args.max_memory is not None:
+        max_memory = parse_bytes(args.max_memory)
+        if not max_memory:
+            raise UsageError(f"--max-memory takes a byte count such as 2GB or 512MB, got "
+                             f"{args.max_memory!r}")
+    try:
+        report = batch(args.inputs, args.kind, args.out, args.executor, workers=args.workers,
+                       force=args.force, export=args.export, timeout=args.timeout,
+                       max_memory=max_memory, address=args.address, sheet=args.sheet,
+                       **given_options(args))
+    except BatchInterrupted as stopped:
+        done = stopped.report
+        print(f"error: interrupted after {len(done.records)} of {done.total} assets "
+              f"({len(done.ok)} baked); every output written is whole: rerun the same "
+              "command to go on", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    for line in report.summary():
+        print(line)
+    print(f"wrote {Path(args.out) / JSONL_NAME}")
+    return report.exit_status
 
 
 def cmd_export(args) -> int:

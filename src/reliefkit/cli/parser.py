@@ -19,6 +19,7 @@ from ..shootout.sizing import candidates as shootout_candidates
 from ..viewer.browser import BACKENDS as BROWSER_BACKENDS
 from .commands import (
     cmd_bake,
+    cmd_batch,
     cmd_bench,
     cmd_compare,
     cmd_demo,
@@ -55,12 +56,18 @@ CORE_EXAMPLES = {
                  "256 px, 256 KB and 1 MB",
                  "reliefkit shootout car.glb tree.obj --budgets 256KB,1MB --sizes 128,512 "
                  "--out out/shootout"],
+    "batch": ["reliefkit batch assets/ --as octahedral-impostor --out baked/   every mesh, "
+              "resumable",
+              "reliefkit batch 'assets/**/*.glb' --as relief-cube --depth-res 128 --out baked "
+              "--export glb",
+              "reliefkit batch manifest.csv --out baked --workers 2 --timeout 600"],
     "info": ["reliefkit info --gl                               the OpenGL renderer and its "
              "limits",
              "reliefkit info model.obj                          counts and bounds of a mesh "
              "(or an .rk)"],
 }
-ORDER = ("demo", "render", "bake", "compare", "export", "view", "shootout", "bench", "info")
+ORDER = ("demo", "render", "bake", "batch", "compare", "export", "view", "shootout", "bench",
+         "info")
 
 
 def _examples(command: str | None = None) -> list[str]:
@@ -200,6 +207,42 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="output .rk file")
     p.set_defaults(run=cmd_bake)
 
+    p = _command(sub, "batch", "bake many meshes (folders, globs, a manifest), resumable",
+                 "Bake every mesh INPUT names into DIR, keeping each input's relative path "
+                 "(chairs/a.obj -> DIR/chairs/a.rk), on a pool of worker processes. An "
+                 "output whose cache key (the source and its textures, the kind, the "
+                 "options, reliefkit's version) matches is skipped, so a rerun goes on "
+                 "where one stopped. Each asset's result is appended to DIR/batch.jsonl; "
+                 "a summary table ends the run (exit 1 when any asset failed). "
+                 "docs/batch.md.")
+    p.add_argument("inputs", nargs="+", metavar="INPUT",
+                   help="mesh files, folders (searched recursively), glob patterns "
+                        "('assets/**/*.glb'), or a manifest (.csv: input,kind,options; "
+                        ".jsonl: {\"input\", \"kind\", \"options\"}) naming a kind and "
+                        "options per asset")
+    _add_bake_options(p, table)
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--workers", type=int, metavar="N",
+                   help="worker processes (default: the CPU cores; each gets cores/N Mesa "
+                        "threads)")
+    p.add_argument("--executor", default="local", choices=("local", "ray"),
+                   help="where the workers run (default: %(default)s)")
+    p.add_argument("--address", metavar="ADDR", help="the Ray cluster (--executor ray)")
+    p.add_argument("--force", action="store_true",
+                   help="bake every asset again, whatever is on disk")
+    p.add_argument("--export", choices=("glb",),
+                   help="also write each output's glTF export beside its .rk")
+    p.add_argument("--sheet", action="store_true",
+                   help="also write DIR/sheet.png and DIR/index.html: each output's "
+                        "thumbnail beside its mesh's")
+    p.add_argument("--timeout", type=float, metavar="S",
+                   help="seconds one asset may take; its worker is stopped and replaced, "
+                        "the asset failed")
+    p.add_argument("--max-memory", metavar="SIZE",
+                   help="memory one worker may hold (2GB, 512MB); past it the worker is "
+                        "stopped and replaced, the asset failed")
+    p.set_defaults(run=cmd_batch)
+
     p = _command(sub, "compare", "bake, then render the mesh and every variant side by side",
                  "Bake INPUT, render the mesh and each variant of the representation (its "
                  "methods or modes) from one view; write compare.png, metrics.md, metrics.json.")
@@ -316,6 +359,11 @@ def _add_render_options(p, core_drawables) -> None:
 def _add_bake_args(p: argparse.ArgumentParser, table: dict,
                    input_help: str = "mesh file, demo:NAME, or a heightmap (.png/.npy)") -> None:
     p.add_argument("input", help=input_help)
+    _add_bake_options(p, table)
+
+
+def _add_bake_options(p: argparse.ArgumentParser, table: dict) -> None:
+    """--as KIND and every bake and compression option (`bake`, `compare`, `batch`)."""
     kinds = tuple(table)
     p.add_argument("--as", dest="kind", default=kinds[0] if kinds else None, choices=kinds,
                    help="representation to bake (default: %(default)s)")

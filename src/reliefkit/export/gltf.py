@@ -132,12 +132,14 @@ def export(rep, path, *, fallback: bool = True,
 
 
 def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False,
-                 options: dict | None = None, instrumented: bool = False) -> bytes:
-    """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves),
-    its draw plans made with the render ``options`` it declares; ``instrumented`` adds the
-    iteration-counting plans (the page's heat map)."""
+                 options: dict | None = None, instrumented: bool = False,
+                 source_hash: str | None = None) -> bytes:
+    """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves,
+    what a batch worker returns), its draw plans made with the render ``options`` it
+    declares; ``instrumented`` adds the iteration-counting plans (the page's heat map)."""
     builder = _generated(GlbBuilder())
     _one_scene(builder, [representation_node(builder, rep, fallback=fallback,
                                              embed_shaders=embed_shaders, options=options,
-                                             instrumented=instrumented)])
+                                             instrumented=instrumented,
+                                             source_hash=source_hash)])
     return builder.glb()

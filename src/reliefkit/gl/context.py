@@ -46,6 +46,12 @@ def get_context():
         return _context
 
 
+def has_context() -> bool:
+    """Whether this process has made its shared context (a batch worker sets its EGL device
+    and thread count before)."""
+    return _context is not None
+
+
 def bind_home_framebuffer(ctx) -> None:
     """Bind a persistent 1x1 framebuffer. Call before releasing a bound framebuffer:
     moderngl rebinds the last used one when it creates the next, and a deleted one is

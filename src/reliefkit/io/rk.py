@@ -335,10 +335,13 @@ def _check_json(value, where: str = "params") -> None:
                       "it (float(), int(), .tolist()) or store it as an array")
 
 
-def _check_source_hash(value) -> None:
+def _check_source_hash(value, field: str = "source_hash") -> None:
+    """``source_hash`` and ``cache_key`` (the same check): None or a SHA-256 hex digest."""
     if value is not None and not (isinstance(value, str) and _SHA_RE.match(value)):
-        raise FormatError(f"source_hash must be None or 64 lower-case hex digits, got {value!r}"
-                          "; use reliefkit.io.rk.file_sha256")
+        how = ("use reliefkit.io.rk.file_sha256" if field == "source_hash" else
+               "use reliefkit.batch.key.cache_key")
+        raise FormatError(f"{field} must be None or 64 lower-case hex digits, got {value!r}"
+                          f"; {how}")
 
 
 # --------------------------------------------------------------------------- writing
@@ -354,7 +357,7 @@ def array_bytes(representation, *, codecs: CodecTable | None = None) -> dict[str
 
 
 def save(path, representation, *, source_hash: str | None = None,
-         codecs: CodecTable | None = None) -> Path:
+         cache_key: str | None = None, codecs: CodecTable | None = None) -> Path:
     """Write a representation to an .rk file atomically.
 
     Parameters
@@ -362,6 +365,8 @@ def save(path, representation, *, source_hash: str | None = None,
     path : destination file; its folder must exist.
     representation : an object whose type (or a base class) has a registered `Codec`.
     source_hash : SHA-256 hex of the mesh or heightmap it was baked from (`file_sha256`).
+    cache_key : SHA-256 hex of everything the bake depended on (`reliefkit.batch.key`);
+        written into the manifest only when given.
     codecs : the kinds known (default: the table handed to `use_codecs`).
 
     Returns
@@ -371,7 +376,22 @@ def save(path, representation, *, source_hash: str | None = None,
     codecs = _table(codecs)
     codec = codecs.for_object(representation)
     arrays, params = codec.to_arrays(representation)
-    return write_rk(path, codec.kind, arrays, params, source_hash=source_hash, codecs=codecs)
+    return write_rk(path, codec.kind, arrays, params, source_hash=source_hash,
+                    cache_key=cache_key, codecs=codecs)
+
+
+def rk_bytes(representation, *, source_hash: str | None = None, cache_key: str | None = None,
+             codecs: CodecTable | None = None) -> bytes:
+    """The bytes `save` writes, made in memory (a batch worker returns them to the driver,
+    which writes them atomically): the same writer, so the same bytes."""
+    codecs = _table(codecs)
+    codec = codecs.for_object(representation)
+    arrays, params = codec.to_arrays(representation)
+    head, arrays = _checked(codec.kind, arrays, params, source_hash, cache_key, codecs,
+                            "cannot write the .rk bytes")
+    buffer = io.BytesIO()
+    _write_zip(buffer, head, arrays)
+    return buffer.getvalue()
 
 
 def codec_of(representation, *, codecs: CodecTable | None = None) -> Codec:
@@ -380,7 +400,8 @@ def codec_of(representation, *, codecs: CodecTable | None = None) -> Codec:
 
 
 def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
-             source_hash: str | None = None, codecs: CodecTable | None = None) -> Path:
+             source_hash: str | None = None, cache_key: str | None = None,
+             codecs: CodecTable | None = None) -> Path:
     """Validate arrays and params against a registered kind, then write atomically.
 
     Arrays are stored C-contiguous and little-endian; values are kept bit for bit. An array
@@ -389,22 +410,33 @@ def write_rk(path, kind: str, arrays: Mapping[str, np.ndarray], params: dict, *,
     `path` is unchanged.
     """
     path = Path(path)
+    head, arrays = _checked(kind, arrays, params, source_hash, cache_key, _table(codecs),
+                            f"cannot write {path}")
+    with atomic_path(path, error=FormatError) as tmp, open(tmp, "wb") as fh:
+        _write_zip(fh, head, arrays)
+    return path
+
+
+def _checked(kind: str, arrays, params, source_hash, cache_key, codecs: CodecTable,
+             where: str) -> tuple[dict, dict[str, np.ndarray]]:
+    """The manifest's head and the arrays as stored, every value checked (else FormatError
+    prefixed with ``where``)."""
     try:
-        codec = _table(codecs).for_kind(kind)
+        codec = codecs.for_kind(kind)
         arrays = _prepare_arrays(codec, arrays)
         if not isinstance(params, dict):
             raise FormatError(f"params must be a dict, got {type(params).__name__}")
         _check_json(params)
         _check_source_hash(source_hash)
+        _check_source_hash(cache_key, "cache_key")
     except FormatError as exc:
-        raise FormatError(f"cannot write {path}: {exc}") from None
-
+        raise FormatError(f"{where}: {exc}") from None
     head = {"format": FORMAT_NAME, "format_version": FORMAT_VERSION, "kind": codec.kind,
             "kind_version": codec.version, "params": params, "source_hash": source_hash,
             "created_by": f"reliefkit {__version__}"}
-    with atomic_path(path, error=FormatError) as tmp, open(tmp, "wb") as fh:
-        _write_zip(fh, head, arrays)
-    return path
+    if cache_key is not None:  # optional: files baked without one keep their bytes
+        head["cache_key"] = cache_key
+    return head, arrays
 
 
 def _prepare_arrays(codec: Codec, arrays) -> dict[str, np.ndarray]:
@@ -878,6 +910,7 @@ def _check_manifest(manifest: dict, codecs: CodecTable) -> Codec:
     if not isinstance(manifest.get("params"), dict):
         raise FormatError("manifest params is not a JSON object; the file is corrupt")
     _check_source_hash(manifest.get("source_hash"))
+    _check_source_hash(manifest.get("cache_key"), "cache_key")
     entries = manifest.get("arrays")
     if not isinstance(entries, dict):
         raise FormatError("manifest arrays is not a JSON object; the file is corrupt")

@@ -16,7 +16,6 @@ of one run share them.
 from __future__ import annotations
 
 import math
-import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,13 +25,12 @@ from ..compact.compact import gpu_bytes
 from ..core.technique import bakers
 from ..errors import ReliefkitError, UsageError
 from ..io.rk import load, save
+from ..units import parse_bytes
 
 #: The options every shootout bake gets besides its knob (the one place to change them all):
 #: block-compressed textures and 16-bit heights, as an engine ships them.
 BAKE_OPTIONS: dict = {"compress": "bc"}
 
-UNITS = {"": 1, "B": 1, "KB": 2**10, "KIB": 2**10, "MB": 2**20, "MIB": 2**20,
-         "GB": 2**30, "GIB": 2**30}
 BUDGET_RANGE = (2**10, 2**28)  # 1 KiB .. 256 MiB: a larger bake would not fit this machine
 SIZE_RANGE = (16, 2048)        # screen sizes in pixels
 KNOB_TOLERANCE = 0.05          # the search stops when the bracket is within 5% of the knob
@@ -44,12 +42,10 @@ def parse_budgets(text: str) -> list[int]:
     1 MB = 2^20 bytes; KiB, MiB, GiB mean the same; a bare number is bytes)."""
     out = set()
     for item in str(text).split(","):
-        match = re.fullmatch(r"\s*(\d+(?:\.\d+)?)\s*([A-Za-z]*)\s*", item)
-        unit = match.group(2).upper() if match else None
-        if match is None or unit not in UNITS:
+        value = parse_bytes(item)
+        if value is None:
             raise UsageError(f"--budgets {text}: '{item.strip()}' is no byte count (give e.g. "
                              "64KB,1MB,16MB)")
-        value = int(float(match.group(1)) * UNITS[unit])
         lo, hi = BUDGET_RANGE
         if not lo <= value <= hi:
             raise UsageError(f"--budgets {text}: '{item.strip()}' is outside 1KB..256MB")

@@ -10,8 +10,11 @@ it into one `MeshError` that starts with the path.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import os
 import stat
+from pathlib import Path
 
 import numpy as np
 
@@ -22,6 +25,23 @@ MAX_FILE_BYTES = 4 * 1024**3
 
 class BadFile(Exception):
     """Internal: what is wrong with the file; `load_mesh` adds the path."""
+
+
+# inside `reads_recorded`: every file `read_regular` has read, in order
+_reads: contextvars.ContextVar[list | None] = contextvars.ContextVar("reads", default=None)
+
+
+@contextlib.contextmanager
+def reads_recorded():
+    """Yield the list of the paths `read_regular` reads inside the block: every file the
+    loader reads goes through it, so this says which files a mesh depends on
+    (`reliefkit.io.meshes.references`)."""
+    read: list[Path] = []
+    token = _reads.set(read)
+    try:
+        yield read
+    finally:
+        _reads.reset(token)
 
 
 def regular_file_size(path: str | os.PathLike) -> int:
@@ -61,6 +81,9 @@ def read_regular(path: str | os.PathLike) -> bytes:
         os.close(fd)
     if len(data) > MAX_FILE_BYTES:
         raise BadFile(_too_large(len(data)))
+    read = _reads.get()
+    if read is not None:
+        read.append(Path(path))
     return data
 
 

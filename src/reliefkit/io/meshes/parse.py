@@ -20,7 +20,7 @@ from .plain_obj import PlainObj
 from .stl import BinaryStl
 
 
-class _RecordingResolver(trimesh.resolvers.FilePathResolver):
+class RecordingResolver(trimesh.resolvers.FilePathResolver):
     """Find referenced files next to the mesh and remember the ones that are missing.
 
     trimesh skips a missing .mtl, texture or image silently, so `parse_file` asks this resolver
@@ -162,7 +162,7 @@ def parse_file(data: bytes | PlainObj | BinaryStl, file_type: str, path: Path,
     that still leave a usable mesh (a .mtl or a texture that is missing, outside the mesh's
     folder or not a regular file) are appended to `warnings_out`, one line per file.
     """
-    resolver = _RecordingResolver(path)
+    resolver = RecordingResolver(path)
     begin_warnings()  # a new load: notes a failed one may have left are forgotten
     try:
         with _quiet(resolver) as logged:

@@ -1,0 +1,34 @@
+"""`reliefkit batch`: bake whole asset libraries, resumable (docs/batch.md).
+
+`batch` expands INPUTs into jobs (`jobs`), skips those whose output already holds their
+cache key (`key`), runs the rest as plain-data tasks (`task.run_task`) on an executor
+(`local.LocalExecutor`: a process pool that survives its workers) and writes each result
+atomically in the driver, recording it in ``OUT/batch.jsonl`` (`report`). Only the CLI and
+the composition root import this package.
+"""
+
+from __future__ import annotations
+
+from .report import BatchInterrupted, BatchReport
+from .run import executor_for, run_batch
+
+__all__ = ["BatchInterrupted", "BatchReport", "batch"]
+
+
+def batch(inputs, kind: str, out, executor: str = "local", *, workers: int | None = None,
+          force: bool = False, export: str | None = None, timeout: float | None = None,
+          max_memory: int | None = None, address: str | None = None, sheet: bool = False,
+          progress: bool = True, setup=None, **bake_options) -> BatchReport:
+    """Bake every mesh ``inputs`` name (files, folders, glob patterns, manifests) as
+    ``kind`` with ``bake_options`` into the folder ``out``; returns the `BatchReport`
+    (``exit_status`` 1 when any asset failed). ``setup`` fills the registry, here and once
+    in each worker (the public ``reliefkit.batch`` passes the composition root's
+    ``registry``). Ctrl-C raises `BatchInterrupted`."""
+    if isinstance(inputs, str | bytes) or not hasattr(inputs, "__iter__"):
+        inputs = [inputs]
+    if setup is not None:
+        setup()
+    runner = executor_for(executor, workers=workers, timeout=timeout, max_memory=max_memory,
+                          setup=setup, address=address)
+    return run_batch(list(inputs), kind, out, runner, force=force, export=export,
+                     sheet=sheet, progress=progress, **bake_options)

@@ -1,0 +1,164 @@
+"""A batch from INPUTs to outputs: plan, skip what is up to date, bake the rest on an
+executor, write each result atomically in this process (the driver), report."""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import time
+from pathlib import Path
+
+from ..errors import FormatError, ReliefkitError, UsageError
+from ..io.atomic import atomic_path, check_writable, written_together
+from ..io.rk import read_manifest
+from ..progress import progress_bar
+from .jobs import Job, check_jobs, expand_inputs
+from .key import cache_key, read_sources
+from .local import LocalExecutor
+from .report import AssetRecord, BatchInterrupted, BatchReport
+from .sheet import THUMBNAIL_SIZE, thumbnail_paths, write_sheet
+from .task import Result, Task, make_task
+
+EXECUTORS = ("local", "ray")
+EXPORTS = ("glb",)
+
+
+def executor_for(name: str, *, workers=None, timeout=None, max_memory=None, setup=None,
+                 address=None):
+    """The executor ``name`` with its limits (checked now, before anything is planned)."""
+    if name not in EXECUTORS:
+        raise UsageError(f"--executor must be one of {', '.join(EXECUTORS)}, got {name!r}")
+    if name == "ray":
+        raise UsageError("--executor ray: the Ray executor is not there yet (issue 33); use "
+                         "--executor local")
+    if address is not None:
+        raise UsageError("--address names a Ray cluster: it goes with --executor ray")
+    return LocalExecutor(workers, timeout=timeout, max_memory=max_memory, setup=setup)
+
+
+def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
+              export: str | None = None, sheet: bool = False, progress: bool = True,
+              **bake_options) -> BatchReport:
+    """Bake every asset ``inputs`` name (`jobs.expand_inputs`) into ``out`` on ``executor``
+    (an object with ``run(tasks, count, on_result)``: `local.LocalExecutor`); with
+    ``sheet`` also each output's thumbnail beside its mesh's (`sheet.write_sheet`)."""
+    if export is not None and export not in EXPORTS:
+        raise UsageError(f"--export writes {', '.join(EXPORTS)}, got {export!r}")
+    out = Path(out)
+    check_writable(out, "--out", folder=True)
+    jobs = expand_inputs(inputs, kind, bake_options, out)
+    check_jobs(jobs)
+    out.mkdir(parents=True, exist_ok=True)
+    report = BatchReport(out, total=len(jobs))
+    start = time.monotonic()
+    try:
+        with progress_bar("batch", len(jobs), enabled=progress, eta=True) as advance:
+            todo = _plan(jobs, out, force, export, sheet, report, advance)
+            by_output = {job.output: job for job in todo}
+
+            def finished(task: Task, result: Result) -> None:
+                with _uninterrupted():  # the files and their line, or neither
+                    report.add(_committed(by_output[task.output], task, result, out))
+                advance(len(report.records))
+
+            executor.run(_tasks(todo, export, sheet, report, advance), len(todo), finished)
+    except KeyboardInterrupt as exc:
+        report.seconds = time.monotonic() - start
+        raise BatchInterrupted(report) from exc
+    report.seconds = time.monotonic() - start
+    if sheet:
+        write_sheet(out, report)
+    return report
+
+
+@contextlib.contextmanager
+def _uninterrupted():
+    """Ctrl-C and SIGTERM wait until the block is done (POSIX; elsewhere they do not), so an
+    output committed is also recorded in batch.jsonl: a rerun then counts it once."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    held = {signal.SIGINT, signal.SIGTERM}
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def _plan(jobs: list[Job], out: Path, force: bool, export: str | None, sheet: bool,
+          report: BatchReport, advance) -> list[Job]:
+    """The jobs to bake; those whose outputs hold their key are recorded as skipped (each
+    read and hashed here: a library's plan takes a while, so it shows as progress)."""
+    todo = []
+    for job in jobs:
+        if force:
+            todo.append(job)
+            continue
+        try:
+            key = cache_key(job.kind, job.options, *read_sources(job.input), job.where)
+        except ReliefkitError:
+            todo.append(job)  # its task fails with the one line (`_tasks`)
+            continue
+        if _up_to_date(out, job.output, key, export, sheet):
+            report.add(AssetRecord(job.where, job.output, job.kind, "skipped", key=key))
+            advance(len(report.records))
+        else:
+            todo.append(job)
+    return todo
+
+
+def _up_to_date(out: Path, output: str, key: str, export: str | None, sheet: bool) -> bool:
+    """Whether the .rk ``output`` holds ``key`` (and the export and thumbnails asked for
+    are there)."""
+    path = out / output
+    if export is not None and not path.with_suffix(f".{export}").is_file():
+        return False
+    if sheet and not all(p.is_file() for p in thumbnail_paths(out, output)):
+        return False
+    try:
+        return path.is_file() and read_manifest(path).get("cache_key") == key
+    except FormatError:
+        return False  # a file that is no valid .rk is baked again
+
+
+def _tasks(jobs: list[Job], export: str | None, sheet: bool, report: BatchReport, advance):
+    """Each job's task, its files read as it is handed out; one whose files cannot be read
+    is failed here, with its line."""
+    for job in jobs:
+        try:
+            yield make_task(job, export_glb=export == "glb",
+                            thumbnails=THUMBNAIL_SIZE if sheet else 0)
+        except ReliefkitError as exc:
+            report.add(AssetRecord(job.where, job.output, job.kind, "failed",
+                                   error=" ".join(str(exc).split())))
+            advance(len(report.records))
+
+
+def _committed(job: Job, task: Task, result: Result, out: Path) -> AssetRecord:
+    """``result`` written under ``out`` (the .rk and its export together, atomically), as
+    its record; a write that fails fails the asset."""
+    record = AssetRecord(job.where, job.output, job.kind, result.status, result.seconds,
+                         figures=result.figures, warnings=result.warnings,
+                         error=result.error, key=task.key)
+    if result.status != "ok":
+        return record
+    path = out / job.output
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with written_together():
+            extras = [(path.with_suffix(".glb"), result.glb)] if result.glb is not None else []
+            if result.thumbnails:
+                extras += zip(thumbnail_paths(out, job.output), result.thumbnails, strict=True)
+            for extra, data in extras:  # written with the .rk, which holds the key
+                extra.parent.mkdir(parents=True, exist_ok=True)
+                with atomic_path(extra) as tmp:
+                    tmp.write_bytes(data)
+            with atomic_path(path) as tmp:
+                tmp.write_bytes(result.rk)
+    except (ReliefkitError, OSError) as exc:
+        return AssetRecord(job.where, job.output, job.kind, "failed", result.seconds,
+                           error=f"{job.where}: {exc}", key=task.key)
+    written = len(result.rk) + len(result.glb or b"")
+    return AssetRecord(job.where, job.output, job.kind, "ok", result.seconds, written,
+                       result.figures, result.warnings, key=task.key)
