@@ -14,10 +14,8 @@ from browser import (
     SIZE,
     agreement,
     canvas_rgba,
-    launch,
     messages,
     open_page,
-    playwright,
     rendered,
     served,
     state,
@@ -52,14 +50,6 @@ COUNT_GL_OBJECTS = """
   }
 })();
 """
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright() as p:
-        b = launch(p)
-        yield b
-        b.close()
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 import pytest
-from browser import canvas_rgba, launch, open_page, playwright, served, state
+from browser import canvas_rgba, open_page, served, state
 from helpers import sample
 
 from reliefkit import save
@@ -24,14 +24,6 @@ from reliefkit.viewer.site import load_inputs, site_files
 SIZE = (128, 128)
 VIEW = "30,25"
 MESH = "demo:vehicle"
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright() as p:
-        b = launch(p)
-        yield b
-        b.close()
 
 
 @pytest.fixture(scope="module")

@@ -15,10 +15,8 @@ from browser import (
     SIZE,
     agreement,
     canvas_rgba,
-    launch,
     messages,
     open_page,
-    playwright,
     rendered,
     served,
     state,
@@ -57,26 +55,6 @@ DRAWN = (("mesh", "swiftshader"), ("mesh-materials", "swiftshader"),
          ("visual-hull", "swiftshader"), ("displacement", "mesa"),
          ("octahedral-impostor", "swiftshader"),
          ("octahedral-impostor-bc", "swiftshader"), ("relief-object-bc", "swiftshader"))
-
-
-@pytest.fixture(scope="module")
-def pw():
-    with playwright() as p:
-        yield p
-
-
-@pytest.fixture(scope="module")
-def browser(pw):
-    b = launch(pw)
-    yield b
-    b.close()
-
-
-@pytest.fixture(scope="module")
-def mesa_browser(pw):
-    b = launch(pw, "mesa")
-    yield b
-    b.close()
 
 
 @pytest.fixture(scope="module")
