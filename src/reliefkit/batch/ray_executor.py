@@ -18,7 +18,6 @@ its asset (``max_retries=0``), and on Ctrl-C the tasks in flight are cancelled.
 
 from __future__ import annotations
 
-import importlib.util
 import logging
 import time
 from collections.abc import Callable, Iterable
@@ -43,8 +42,10 @@ class RayExecutor:
     def __init__(self, workers: int | None = None, *, timeout: float | None = None,
                  max_memory: int | None = None, setup: Callable | None = None,
                  address: str | None = None) -> None:
-        if importlib.util.find_spec("ray") is None:
-            raise UsageError(RAY_NEEDED)
+        try:
+            import ray  # noqa: F401 - here, so a missing Ray is one line before any work
+        except ImportError:
+            raise UsageError(RAY_NEEDED) from None
         if max_memory is not None:
             raise UsageError(MAX_MEMORY_REFUSED)
         check_limits(workers, timeout)
