@@ -1,7 +1,8 @@
 """Benchmarks: ``reliefkit bench NAME`` runs a suite registered by a technique, or one of the
 core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering;
 `compact`: compressed textures' bytes and error; `scene`: instancing; `export`: glTF
-exports' bytes, time and fallbacks).
+exports' bytes, time and fallbacks; `batch`: assets per hour of `reliefkit batch`, local
+and on Ray).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
@@ -15,7 +16,7 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import compact, export, loading, platform, scene
+from . import batch, compact, export, loading, platform, scene
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -56,7 +57,10 @@ def suites() -> dict:
                                 scene.run_suite, takes_mesh=True),
             "export": BenchSuite("export", "glTF export per demo asset and kind: .rk against "
                                  ".glb bytes, export time, the fallback's triangles and "
-                                 "coverage against the mesh", export.run_suite)}
+                                 "coverage against the mesh", export.run_suite),
+            "batch": BenchSuite("batch", "assets per hour of reliefkit batch on 10k-triangle "
+                                "meshes, local and Ray, 1 and 2 workers; Ray's overhead",
+                                batch.run_suite)}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 
