@@ -1,9 +1,10 @@
-"""The Ray executor on a real local Ray cluster (2 CPUs) that this module starts once and
-shares: the same bytes as the local executor and single `reliefkit bake` runs, a broken
-mesh and a crashing worker failing only their assets, --timeout, skips on a rerun, a CLI
-run that starts its own cluster stopped by Ctrl-C and finished on this one (--address).
-Without Ray they skip saying why; on CI (``CI=true``) that is a failure: `./run test` and
-`.ci/run` install the ``ray`` extra."""
+"""The Ray executor on a real local Ray cluster (2 CPUs, 1 GPU as Ray counts them) that this
+module starts once and shares: each worker's EGL device is its task's GPU, with its share
+of the cores; the same bytes as the local executor and single `reliefkit bake` runs, a
+broken mesh and a crashing worker failing only their assets, --timeout, skips on a rerun,
+a CLI run that starts its own cluster stopped by Ctrl-C and finished on this one
+(--address). Without Ray they skip saying why; on CI (``CI=true``) that is a failure:
+`./run test` and `.ci/run` install the ``ray`` extra."""
 
 from __future__ import annotations
 
@@ -16,12 +17,13 @@ import sys
 import time
 from pathlib import Path
 
-import batch_kinds
 import pytest
+import ray_kinds
 from helpers import write_tetrahedron
 
 from reliefkit import cli
 from reliefkit.batch import batch
+from reliefkit.batch.local import cores
 from reliefkit.io import rk
 
 TESTS = Path(__file__).resolve().parents[1]
@@ -39,7 +41,9 @@ def cluster():
             pytest.fail(f"CI=true but the Ray tests cannot run: {reason}")
         pytest.skip(reason)
     path = os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")])
-    ray.init(num_cpus=2, include_dashboard=False, logging_level=logging.ERROR,
+    # one GPU as Ray counts them (none is needed: EGL device 0 is Mesa's llvmpipe here), so
+    # the tasks ask for a share of it and their workers make their context on its device
+    ray.init(num_cpus=2, num_gpus=1, include_dashboard=False, logging_level=logging.ERROR,
              log_to_driver=False, runtime_env={"env_vars": {"PYTHONPATH": path}})
     yield ray.get_runtime_context().gcs_address
     ray.shutdown()
@@ -48,7 +52,7 @@ def cluster():
 @pytest.fixture(autouse=True)
 def _kinds_unregistered_after():
     yield
-    batch_kinds.teardown()
+    ray_kinds.teardown()
 
 
 @pytest.fixture
@@ -63,7 +67,7 @@ def library(tmp_path):
 
 
 def on_ray(inputs, kind, out, **options):
-    return batch(inputs, kind, out, "ray", setup=batch_kinds.setup, progress=False, **options)
+    return batch(inputs, kind, out, "ray", setup=ray_kinds.setup, progress=False, **options)
 
 
 def statuses(out) -> list[tuple[str, str]]:
@@ -89,7 +93,7 @@ def test_the_bytes_of_the_local_executor_and_of_single_bakes(cluster, library, t
     assert broken.error.startswith(f"{library / 'broken.obj'}: has no triangle with a "
                                    "visible area")
     assert batch([library], "relief", local, workers=2, depth_res=10,
-                 setup=batch_kinds.setup, progress=False).exit_status == 1
+                 setup=ray_kinds.setup, progress=False).exit_status == 1
     for name in ("chairs/a", "b", "c"):
         single = tmp_path / "single.rk"
         assert cli.main(["bake", str(library / f"{name}.obj"), *RELIEF, "-o", str(single)]) == 0
@@ -174,3 +178,16 @@ def test_ctrl_c_on_its_own_cluster_then_the_rest_on_an_address(cluster, tmp_path
     assert f"{len(names)} of {len(names)} assets" in rerun.stdout
     baked = [output for output, status in statuses(out) if status == "ok"]
     assert sorted(baked) == sorted(n.replace(".obj", ".rk") for n in names)  # once each
+
+
+def test_a_worker_makes_its_context_on_its_ray_gpu_with_its_share_of_the_cores(
+        cluster, library, tmp_path):
+    out = tmp_path / "out"
+    report = on_ray([library], "gpu", out, workers=2)
+    assert len(report.ok) == 3
+    for record in report.ok:
+        params = rk.read_manifest(out / record.output)["params"]
+        assert params["ray_gpu_ids"] == [0]  # asked for a share of the cluster's one GPU
+        assert params["GLCONTEXT_DEVICE_INDEX"] == "0"
+        assert params["LP_NUM_THREADS"] == str(max(1, cores() // 2))  # 2 CPU slots
+        assert params["renderer"].startswith("llvmpipe")
