@@ -13,7 +13,9 @@ and ``timeout`` are its own, as with the local executor. Tasks ask Ray for GPUs 
 when the cluster has some (a GPU request on a cluster without one waits forever); the
 worker's EGL device is then its first GPU by index (EGL ignores ``CUDA_VISIBLE_DEVICES``).
 A task over ``timeout`` is cancelled (its worker killed), a worker that dies fails only
-its asset (``max_retries=0``), and on Ctrl-C the tasks in flight are cancelled.
+its asset (``max_retries=0``), and on Ctrl-C the run's connection is closed, which ends
+its job and the tasks in flight (cancelled one by one where the connection is the
+caller's).
 """
 
 from __future__ import annotations
@@ -54,22 +56,29 @@ class RayExecutor:
     def run(self, tasks: Iterable[Task], count: int,
             on_result: Callable[[Task, Result], None]) -> None:
         """Run every task of ``tasks`` (``count`` of them) on Ray, calling ``on_result`` in
-        this process as each finishes; on any exit (Ctrl-C too) the tasks in flight are
-        cancelled, and a cluster started here is shut down."""
+        this process as each finishes; on any exit (Ctrl-C too) nothing of this batch runs
+        on: the connection made here is closed (and a cluster started here shut down),
+        which ends the job and its tasks; on a caller's connection they are cancelled."""
         if count == 0:
             return
         import ray
 
-        started_here = self._connect(ray)
+        owned = self._connect(ray)
         try:
             slots = _Slots(ray, min(count, self._in_flight(ray)), self.setup, self.timeout)
-            slots.run(tasks, on_result)
+            try:
+                slots.run(tasks, on_result)
+            except BaseException:  # Ctrl-C too
+                if not owned:  # the caller's connection stays open: stop this batch's tasks
+                    slots.cancel()
+                raise
         finally:
-            if started_here:
+            if owned:  # ends this job: Ray stops its tasks, and a cluster started here
                 ray.shutdown()
 
     def _connect(self, ray) -> bool:
-        """Connected to Ray; whether the cluster was started here (to shut down after)."""
+        """Connected to Ray; whether the connection is this run's (to close after it: a
+        process already connected keeps its own)."""
         if ray.is_initialized():
             return False
         quiet = {"logging_level": RAY_LOGGING, "log_to_driver": False}
@@ -82,7 +91,7 @@ class RayExecutor:
             where = f"the Ray cluster at {self.address}" if self.address else "a local Ray cluster"
             raise ReliefkitError(f"--executor ray: could not start or reach {where} "
                                  f"({' '.join(str(exc).split())[:300]})") from None
-        return self.address is None
+        return True
 
     def _in_flight(self, ray) -> int:
         return self.workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
@@ -105,31 +114,32 @@ class _Slots:
     def run(self, tasks: Iterable[Task], on_result) -> None:
         pending = iter(tasks)
         waiting: Task | None = None
-        try:
-            while True:
-                for k, slot in enumerate(self.slots):
-                    if slot is not None and slot["ref"] is not None:
-                        continue
-                    waiting = waiting or next(pending, None)
-                    if waiting is None:
-                        break
-                    if slot is None:  # a worker for it first (start-up outside the limit)
-                        self.slots[k] = {"ref": self.prepare.remote(self.setup), "task": None}
-                    else:
-                        self.slots[k] = {"ref": self.bake.remote(self.setup, waiting),
-                                         "task": waiting, "since": time.monotonic()}
-                        waiting = None
-                busy = [s["ref"] for s in self.slots if s is not None and s["ref"] is not None]
-                if not busy:
-                    return
-                self.ray.wait(busy, num_returns=1, timeout=POLL_SECONDS)
-                for k, slot in enumerate(self.slots):
-                    if slot is not None and slot["ref"] is not None:
-                        self._poll(k, slot, on_result)
-        finally:
-            for slot in self.slots:
+        while True:
+            for k, slot in enumerate(self.slots):
                 if slot is not None and slot["ref"] is not None:
-                    self.ray.cancel(slot["ref"], force=True)
+                    continue
+                waiting = waiting or next(pending, None)
+                if waiting is None:
+                    break
+                if slot is None:  # a worker for it first (start-up outside the limit)
+                    self.slots[k] = {"ref": self.prepare.remote(self.setup), "task": None}
+                else:
+                    self.slots[k] = {"ref": self.bake.remote(self.setup, waiting),
+                                     "task": waiting, "since": time.monotonic()}
+                    waiting = None
+            busy = [s["ref"] for s in self.slots if s is not None and s["ref"] is not None]
+            if not busy:
+                return
+            self.ray.wait(busy, num_returns=1, timeout=POLL_SECONDS)
+            for k, slot in enumerate(self.slots):
+                if slot is not None and slot["ref"] is not None:
+                    self._poll(k, slot, on_result)
+
+    def cancel(self) -> None:
+        """Cancel the tasks in flight (their workers killed)."""
+        for slot in self.slots:
+            if slot is not None and slot["ref"] is not None:
+                self.ray.cancel(slot["ref"], force=True)
 
     def _poll(self, k: int, slot: dict, on_result) -> None:
         """The slot's bake or preparation, once done (or over the time limit)."""
