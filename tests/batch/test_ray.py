@@ -130,12 +130,19 @@ def test_timeout_cancels_the_task_and_the_batch_goes_on(cluster, library, tmp_pa
     assert time.monotonic() - started < 300  # not the hang's 600 s
 
 
-def test_max_memory_and_a_missing_ray_are_one_line(library, tmp_path, capsys, monkeypatch):
+def test_max_memory_an_unreachable_address_and_a_missing_ray_are_one_line(
+        library, tmp_path, capsys, monkeypatch):
     args = ["batch", str(library), *RELIEF, "--out", str(tmp_path / "out"), "--executor", "ray"]
     assert cli.main([*args, "--max-memory", "1GB"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: --max-memory is not available with --executor ray: ")
     assert err.count("\n") == 1
+    assert cli.main([*args, "--address", "127.0.0.1:1"]) == 1  # nothing listens there
+    assert capsys.readouterr().err == "error: --executor ray: nothing answers at 127.0.0.1:1 " \
+                                      "(Connection refused); is the Ray cluster running?\n"
+    assert cli.main([*args, "--address", "head"]) == 2
+    assert capsys.readouterr().err == "error: --address takes auto, HOST:PORT or " \
+                                      "ray://HOST:PORT, got 'head'\n"
     monkeypatch.setitem(sys.modules, "ray", None)  # as where Ray is not installed
     assert cli.main(args) == 2
     assert capsys.readouterr().err == \

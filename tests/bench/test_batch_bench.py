@@ -11,10 +11,12 @@ from reliefkit.bench import batch, suites
 
 
 def test_every_executor_and_worker_count_bakes_n_then_2n_assets(tmp_path, gl):
-    markdown, paths = batch.run_suite(True, tmp_path, lambda line: None, faces=400)
+    markdown, paths = batch.run_suite(True, tmp_path, lambda line: None, faces=400,
+                                      kind=("--as", "relief", "--depth-res", "16"))
     assert [p.name for p in paths] == ["batch.json", "batch.md"]
     data = json.loads((tmp_path / "batch.json").read_text())
     assert data["faces"] == 400 and data["count"] == batch.QUICK_COUNT == 1
+    assert data["kind"] == "--as relief --depth-res 16"
     rows = data["rows"]
     assert [(r["executor"], r["workers"]) for r in rows] == [
         (executor, workers) for executor in batch.EXECUTORS for workers in batch.WORKERS]

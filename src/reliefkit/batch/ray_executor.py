@@ -21,6 +21,7 @@ caller's).
 from __future__ import annotations
 
 import logging
+import socket
 import time
 from collections.abc import Callable, Iterable
 
@@ -32,6 +33,7 @@ RAY_NEEDED = "--executor ray needs Ray: pip install 'reliefkit[ray]'"
 MAX_MEMORY_REFUSED = ("--max-memory is not available with --executor ray: the driver cannot "
                       "watch a Ray worker's memory (Ray's memory monitor stops tasks when a "
                       "node runs short); leave it out or use --executor local")
+CONNECT_SECONDS = 10  # to reach an --address before Ray tries (for minutes)
 RAY_LOGGING = logging.ERROR  # Ray's own log lines stay in its session folder
 _prepared = False  # this worker process has been made a baker (`_prepare`)
 
@@ -51,6 +53,8 @@ class RayExecutor:
         if max_memory is not None:
             raise UsageError(MAX_MEMORY_REFUSED)
         check_limits(workers, timeout)
+        if address not in (None, "auto"):
+            _check_reachable(address)
         self.workers, self.timeout, self.setup, self.address = workers, timeout, setup, address
 
     def run(self, tasks: Iterable[Task], count: int,
@@ -166,6 +170,19 @@ class _Slots:
         slot["ref"] = None
         if task is not None:
             on_result(task, result)
+
+
+def _check_reachable(address: str) -> None:
+    """Refuse an address nothing answers at, in seconds: Ray itself retries for minutes,
+    printing its own lines."""
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        raise UsageError(f"--address takes auto, HOST:PORT or ray://HOST:PORT, got {address!r}")
+    try:
+        socket.create_connection((host, int(port)), timeout=CONNECT_SECONDS).close()
+    except OSError as exc:
+        raise ReliefkitError(f"--executor ray: nothing answers at {address} "
+                             f"({exc.strerror or exc}); is the Ray cluster running?") from None
 
 
 def _prepare(setup) -> None:

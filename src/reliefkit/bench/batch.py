@@ -1,7 +1,7 @@
 """``reliefkit bench batch``: assets per hour of `reliefkit batch`, local and on Ray.
 
 The assets are generated tori of 10,000 triangles (100 x 50 sections, each with its own
-radii, so no two share a cache key), baked as ``relief --depth-res 64``. Each executor
+radii, so no two share a cache key), baked as ``relief`` with its defaults. Each executor
 (local, ray) and worker count (1, 2) runs `reliefkit batch` as the user does (a fresh
 process; Ray: a local cluster started for the run) on the first N assets and then on 2N,
 into empty folders. The difference of the two wall times is N assets' steady-state time
@@ -10,7 +10,7 @@ per asset and assets per hour come from it, the start-up is what is left of the 
 Ray's per-asset overhead is Ray's seconds per asset minus local's at the same worker
 count. A first run (discarded) warms the caches. The load average before and after says
 how busy the machine was (timings on a shared machine are only as quiet as it is).
-``--quick``: N = 1 instead of 6.
+``--quick``: N = 1 instead of 4.
 """
 
 from __future__ import annotations
@@ -28,24 +28,24 @@ from .report import machine, machine_line, write_report
 
 FACES = 10_000
 MINOR_SECTIONS = 50
-KIND = ("--as", "relief", "--depth-res", "64")
+KIND = ("--as", "relief")  # its defaults: about 7 s a torus here, most of it the safety radii
 EXECUTORS = ("local", "ray")
 WORKERS = (1, 2)
-COUNT, QUICK_COUNT = 6, 1
+COUNT, QUICK_COUNT = 4, 1
 RUN_LIMIT_S = 1800  # one batch run; a hung one fails the row instead of the bench
 
 
-def run_suite(quick: bool, out: Path, log, *, faces: int = FACES,
-              count: int | None = None) -> tuple[str, list[Path]]:
+def run_suite(quick: bool, out: Path, log, *, faces: int = FACES, count: int | None = None,
+              kind: tuple = KIND) -> tuple[str, list[Path]]:
     """The table of ``EXECUTORS`` x ``WORKERS`` on ``count`` and 2 x ``count`` tori of
-    about ``faces`` triangles (tests pass small ones)."""
+    about ``faces`` triangles baked with the ``kind`` arguments (tests pass small ones)."""
     count = count or (QUICK_COUNT if quick else COUNT)
     load_before = os.getloadavg()
     rows = []
     with tempfile.TemporaryDirectory(prefix="reliefkit-bench-batch-") as folder:
         libraries = _libraries(Path(folder), faces, count)
         log("warming up (a first run compiles and caches what later runs reuse)")
-        _timed(libraries[0], Path(folder) / "warm-up", "local", 1)
+        _timed(libraries[0], Path(folder) / "warm-up", "local", 1, kind)
         for executor in EXECUTORS:
             for workers in WORKERS:
                 if executor == "ray" and importlib.util.find_spec("ray") is None:
@@ -54,9 +54,9 @@ def run_suite(quick: bool, out: Path, log, *, faces: int = FACES,
                                             "'reliefkit[ray]'"})
                     continue
                 log(f"{executor}, {workers} worker(s): {count} then {2 * count} assets")
-                rows.append(_row(libraries, Path(folder), executor, workers, count))
+                rows.append(_row(libraries, Path(folder), executor, workers, count, kind))
     data = {"faces": 2 * max(3, faces // (2 * MINOR_SECTIONS)) * MINOR_SECTIONS,
-            "kind": " ".join(KIND), "count": count, "machine": machine(),
+            "kind": " ".join(kind), "count": count, "machine": machine(),
             "load_average": {"before": load_before, "after": os.getloadavg()},
             "rows": rows, "speedup": _speedups(rows), "ray_overhead_s": _overheads(rows)}
     return _markdown(data), write_report(out, "batch", data, _markdown)
@@ -78,8 +78,9 @@ def _libraries(folder: Path, faces: int, count: int) -> list[Path]:
     return libraries
 
 
-def _row(libraries: list[Path], folder: Path, executor: str, workers: int, count: int) -> dict:
-    runs = [_timed(library, folder / f"out-{executor}-{workers}-{k}", executor, workers)
+def _row(libraries: list[Path], folder: Path, executor: str, workers: int, count: int,
+         kind: tuple) -> dict:
+    runs = [_timed(library, folder / f"out-{executor}-{workers}-{k}", executor, workers, kind)
             for k, library in enumerate(libraries)]
     row = {"executor": executor, "workers": workers, "assets": [count, 2 * count],
            "seconds": [r["seconds"] for r in runs], "ok": [r["ok"] for r in runs]}
@@ -92,9 +93,9 @@ def _row(libraries: list[Path], folder: Path, executor: str, workers: int, count
                   "startup_seconds": runs[0]["seconds"] - count * per_asset}
 
 
-def _timed(library: Path, out: Path, executor: str, workers: int) -> dict:
+def _timed(library: Path, out: Path, executor: str, workers: int, kind: tuple) -> dict:
     """One `reliefkit batch` run in a fresh process: its wall time and ok assets."""
-    command = [sys.executable, "-m", "reliefkit.cli", "batch", str(library), *KIND, "--out",
+    command = [sys.executable, "-m", "reliefkit.cli", "batch", str(library), *kind, "--out",
                str(out), "--workers", str(workers), "--executor", executor]
     start = time.perf_counter()
     try:
