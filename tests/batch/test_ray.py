@@ -190,11 +190,12 @@ def test_ctrl_c_on_its_own_cluster_then_the_rest_on_an_address(cluster, tmp_path
 def test_a_worker_makes_its_context_on_its_ray_gpu_with_its_share_of_the_cores(
         cluster, library, tmp_path):
     out = tmp_path / "out"
-    report = on_ray([library], "gpu", out, workers=2)
+    report = on_ray([library], "worker", out, workers=2)
     assert len(report.ok) == 3
+    share = max(1, cores() // 2)  # the node's 2 CPU slots
     for record in report.ok:
         params = rk.read_manifest(out / record.output)["params"]
         assert params["ray_gpu_ids"] == [0]  # asked for a share of the cluster's one GPU
         assert params["GLCONTEXT_DEVICE_INDEX"] == "0"
-        assert params["LP_NUM_THREADS"] == str(max(1, cores() // 2))  # 2 CPU slots
         assert params["renderer"].startswith("llvmpipe")
+        assert (params["LP_NUM_THREADS"], params["numba_threads"]) == (str(share), share)
