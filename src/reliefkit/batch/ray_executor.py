@@ -7,7 +7,7 @@ existing one, and a process already connected to Ray uses its connection. At mos
 `Result` (the .rk bytes): nothing needs a shared file system, and the driver writes.
 
 Each Ray worker process is prepared once (`task.prepare_worker`, module-level here: Mesa
-threads, then the EGL device, then its kinds) and keeps its GL context for the tasks that
+and numba threads, then the EGL device, then its kinds) and keeps its GL context for the tasks that
 follow. A slot whose worker is new first runs `_prepare` on its own, so an asset's time
 and ``timeout`` are its own, as with the local executor. Tasks ask Ray for GPUs only
 when the cluster has some (a GPU request on a cluster without one waits forever); the
@@ -21,6 +21,7 @@ caller's).
 from __future__ import annotations
 
 import logging
+import math
 import socket
 import time
 from collections.abc import Callable, Iterable
@@ -110,7 +111,7 @@ class _Slots:
         gpus = ray.cluster_resources().get("GPU", 0)
         options = {"num_cpus": 1, "max_retries": 0}
         if gpus:  # fractional: several bakers share a GPU when there are more than GPUs
-            options["num_gpus"] = min(1.0, gpus / count)
+            options["num_gpus"] = min(1.0, math.floor(gpus / count * 1e4) / 1e4)  # Ray's 4 places
         self.prepare = ray.remote(_prepare).options(**options)
         self.bake = ray.remote(_bake).options(**options)
         self.slots: list[dict | None] = [None] * count  # None: no worker ready for it
