@@ -3,8 +3,9 @@ module starts once and shares: each worker's EGL device is its task's GPU, with 
 of the cores; the same bytes as the local executor and single `reliefkit bake` runs, a
 broken mesh and a crashing worker failing only their assets, --timeout, skips on a rerun,
 a CLI run that starts its own cluster stopped by Ctrl-C and finished on this one
-(--address). Without Ray they skip saying why; on CI (``CI=true``) that is a failure:
-`./run test` and `.ci/run` install the ``ray`` extra."""
+(--address HOST:PORT), and ray://HOST:PORT through a Ray Client server. Without Ray they
+skip saying why; on CI (``CI=true``) that is a failure: `./run test` and `.ci/run` install
+the ``ray`` extra."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import json
 import logging
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -185,6 +187,36 @@ def test_ctrl_c_on_its_own_cluster_then_the_rest_on_an_address(cluster, tmp_path
     assert f"{len(names)} of {len(names)} assets" in rerun.stdout
     baked = [output for output, status in statuses(out) if status == "ok"]
     assert sorted(baked) == sorted(n.replace(".obj", ".rk") for n in names)  # once each
+
+
+def test_ray_client_address(cluster, library, tmp_path):
+    """--address ray://HOST:PORT: through a Ray Client server in front of this cluster."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    server = subprocess.Popen([sys.executable, "-m", "ray.util.client.server", "--address",
+                               cluster, "--host", "127.0.0.1", "--port", str(port), "--mode",
+                               "legacy"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:  # until the server listens
+            with socket.socket() as probe:
+                if probe.connect_ex(("127.0.0.1", port)) == 0:
+                    break
+            time.sleep(0.2)
+        out = tmp_path / "out"
+        done = subprocess.run([sys.executable, "-m", "reliefkit.cli", "batch", str(library),
+                               *RELIEF, "--out", str(out), "--executor", "ray", "--address",
+                               f"ray://127.0.0.1:{port}"], capture_output=True, text=True,
+                              timeout=180)
+    finally:
+        server.kill()
+        server.wait()
+    assert done.returncode == 0, done.stderr
+    for name in ("chairs/a", "b"):
+        single = tmp_path / "single.rk"
+        assert cli.main(["bake", str(library / f"{name}.obj"), *RELIEF, "-o", str(single)]) == 0
+        assert (out / f"{name}.rk").read_bytes() == single.read_bytes(), name
 
 
 def test_a_worker_makes_its_context_on_its_ray_gpu_with_its_share_of_the_cores(
