@@ -2,16 +2,16 @@
 
 The assets are generated tori of 10,000 triangles (100 x 50 sections), one shape each
 turned by its own angle about its axis (so no two share a cache key, and each is the same
-work), baked as ``relief`` with its defaults. Each executor (local, ray) and worker count
-(1, 2) runs `reliefkit batch` on the same N assets as the user does (a fresh process;
-Ray: a local cluster started for the run), and the bench notes when each asset's line
-reaches ``batch.jsonl``. The steady-state time per asset is the span from the first
-asset's line to the last over the N - 1 assets between (the start-up: the interpreter, the
-workers and Ray's cluster, then the first asset, falls outside it); assets per hour come
-from it. Ray's per-asset overhead is Ray's seconds per asset minus local's at the same
-worker count. A first run (discarded) warms the caches. The load average before and after
-says how busy the machine was (timings on a shared machine are only as quiet as it is).
-``--quick``: N = 3 instead of 10.
+work), baked as the first registered baker that takes a mesh (the relief) with its
+defaults. Each executor (local, ray) and worker count (1, 2) runs `reliefkit batch` on the
+same N assets as the user does (a fresh process; Ray: a local cluster started for the
+run), and the bench notes when each asset's line reaches ``batch.jsonl``. The steady-state
+time per asset is the span from the first asset's line to the last over the N - 1 assets
+between (the start-up: the interpreter, the workers and Ray's cluster, then the first
+asset, falls outside it); assets per hour come from it. Ray's per-asset overhead is Ray's
+seconds per asset minus local's at the same worker count. A first run (discarded) warms
+the caches. The load average before and after says how busy the machine was (timings on a
+shared machine are only as quiet as it is). ``--quick``: N = 3 instead of 10.
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..core.technique import bakers
 from .report import machine, machine_line, write_report
 
 FACES = 10_000
 MINOR_SECTIONS = 50
-KIND = ("--as", "relief")  # its defaults: about 2.5 s a torus on a quiet machine here
 EXECUTORS = ("local", "ray")
 WORKERS = (1, 2)
 COUNT, QUICK_COUNT = 10, 3
@@ -38,10 +38,14 @@ POLL_S = 0.05
 
 
 def run_suite(quick: bool, out: Path, log, *, faces: int = FACES, count: int | None = None,
-              kind: tuple = KIND) -> tuple[str, list[Path]]:
+              kind: tuple | None = None) -> tuple[str, list[Path]]:
     """The table of ``EXECUTORS`` x ``WORKERS`` on ``count`` tori of about ``faces``
-    triangles baked with the ``kind`` arguments (tests pass small ones)."""
+    triangles baked with the ``kind`` arguments (default: the first registered baker that
+    takes a mesh, the relief, with its defaults: about 2.5 s a torus on a quiet machine
+    here; tests pass small ones)."""
     count = count or (QUICK_COUNT if quick else COUNT)
+    kind = kind or ("--as", next(name for name, (_, b) in bakers().items()
+                                 if "mesh" in b.sources))
     load_before = os.getloadavg()
     rows = []
     with tempfile.TemporaryDirectory(prefix="reliefkit-bench-batch-") as folder:
