@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 import pytest
-import ray_kinds
+import worker_kinds
 from helpers import write_tetrahedron
 
 from reliefkit import cli
@@ -54,7 +54,7 @@ def cluster():
 @pytest.fixture(autouse=True)
 def _kinds_unregistered_after():
     yield
-    ray_kinds.teardown()
+    worker_kinds.teardown()
 
 
 @pytest.fixture
@@ -69,7 +69,7 @@ def library(tmp_path):
 
 
 def on_ray(inputs, kind, out, **options):
-    return batch(inputs, kind, out, "ray", setup=ray_kinds.setup, progress=False, **options)
+    return batch(inputs, kind, out, "ray", setup=worker_kinds.setup, progress=False, **options)
 
 
 def statuses(out) -> list[tuple[str, str]]:
@@ -95,7 +95,7 @@ def test_the_bytes_of_the_local_executor_and_of_single_bakes(cluster, library, t
     assert broken.error.startswith(f"{library / 'broken.obj'}: has no triangle with a "
                                    "visible area")
     assert batch([library], "relief", local, workers=2, depth_res=10,
-                 setup=ray_kinds.setup, progress=False).exit_status == 1
+                 setup=worker_kinds.setup, progress=False).exit_status == 1
     for name in ("chairs/a", "b", "c"):
         single = tmp_path / "single.rk"
         assert cli.main(["bake", str(library / f"{name}.obj"), *RELIEF, "-o", str(single)]) == 0

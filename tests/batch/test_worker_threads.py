@@ -4,7 +4,7 @@ workers' parallel loops do not fight over the cores (`task.prepare_worker`)."""
 from __future__ import annotations
 
 import pytest
-import ray_kinds
+import worker_kinds
 from helpers import write_tetrahedron
 
 from reliefkit.batch import batch
@@ -16,7 +16,7 @@ from reliefkit.io import rk
 def _kinds_unregistered_after():
     """The driver (this process) registers the test kinds through ``setup``: not for long."""
     yield
-    ray_kinds.teardown()
+    worker_kinds.teardown()
 
 
 @pytest.mark.parametrize("workers", [1, 2])
@@ -24,7 +24,7 @@ def test_numba_and_mesa_threads_are_the_cores_over_the_workers(tmp_path, workers
     for k in range(2):
         write_tetrahedron(tmp_path / "lib" / f"t{k}.obj", scale=1.0 + k)
     report = batch([tmp_path / "lib"], "worker", tmp_path / "out", workers=workers,
-                   setup=ray_kinds.setup, progress=False)
+                   setup=worker_kinds.setup, progress=False)
     assert len(report.ok) == 2
     share = max(1, cores() // workers)
     for record in report.ok:
