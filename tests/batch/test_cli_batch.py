@@ -109,7 +109,7 @@ def test_force_rebakes_what_is_up_to_date(library, tmp_path):
 
 
 @pytest.mark.parametrize("extra, words", [
-    (["--executor", "ray"], "Ray executor is not there yet"),
+    (["--executor", "ray", "--max-memory", "1GB"], "--max-memory is not available with"),
     (["--max-memory", "lots"], "--max-memory takes a byte count"),
     (["--workers", "0"], "--workers must be at least 1"),
     (["--timeout", "0"], "--timeout must be a positive"),

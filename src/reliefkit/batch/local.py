@@ -33,6 +33,14 @@ def cores() -> int:
         return os.cpu_count() or 1
 
 
+def check_limits(workers: int | None, timeout: float | None) -> None:
+    """Refuse a worker count or time limit no executor can honour."""
+    if workers is not None and workers < 1:
+        raise UsageError(f"--workers must be at least 1, got {workers}")
+    if timeout is not None and not timeout > 0:
+        raise UsageError(f"--timeout must be a positive number of seconds, got {timeout}")
+
+
 class LocalExecutor:
     """Runs tasks in ``workers`` processes (default: the cores) on this machine.
 
@@ -41,10 +49,7 @@ class LocalExecutor:
 
     def __init__(self, workers: int | None = None, *, timeout: float | None = None,
                  max_memory: int | None = None, setup: Callable | None = None) -> None:
-        if workers is not None and workers < 1:
-            raise UsageError(f"--workers must be at least 1, got {workers}")
-        if timeout is not None and not timeout > 0:
-            raise UsageError(f"--timeout must be a positive number of seconds, got {timeout}")
+        check_limits(workers, timeout)
         self.workers = workers or cores()
         self.timeout, self.max_memory, self.setup = timeout, max_memory, setup
 

@@ -29,8 +29,10 @@ def executor_for(name: str, *, workers=None, timeout=None, max_memory=None, setu
     if name not in EXECUTORS:
         raise UsageError(f"--executor must be one of {', '.join(EXECUTORS)}, got {name!r}")
     if name == "ray":
-        raise UsageError("--executor ray: the Ray executor is not there yet (issue 33); use "
-                         "--executor local")
+        from .ray_executor import RayExecutor  # imports Ray only when it runs
+
+        return RayExecutor(workers, timeout=timeout, max_memory=max_memory, setup=setup,
+                           address=address)
     if address is not None:
         raise UsageError("--address names a Ray cluster: it goes with --executor ray")
     return LocalExecutor(workers, timeout=timeout, max_memory=max_memory, setup=setup)

@@ -2,7 +2,8 @@
 core's own (`loading`: the memory of loading meshes; `platform`: multi-view rendering;
 `compact`: compressed textures' bytes and error; `scene`: instancing; `export`: glTF
 exports' bytes, time and fallbacks; `viewer`: the viewer page's frame time per kind in
-headless Chromium).
+headless Chromium; `batch`: assets per hour of `reliefkit batch`, local
+and on Ray).
 
 Suites measure side by side in one run (ratios) and report device-independent counts;
 `timing` has the shared frame-timing helper. Techniques' suites use `report` and `timing`,
@@ -16,7 +17,7 @@ from pathlib import Path
 from ..core.technique import REGISTRY, BenchSuite
 from ..errors import UsageError
 from ..progress import activity
-from . import compact, export, loading, platform, scene, viewer
+from . import batch, compact, export, loading, platform, scene, viewer
 
 
 def run_suite(name: str, *, quick: bool = False, out: Path = Path("out/bench"),
@@ -68,7 +69,10 @@ def suites() -> dict:
                                  "coverage against the mesh", export.run_suite),
             "viewer": BenchSuite("viewer", "the viewer page's frame time per kind in headless "
                                  "Chromium against the mesh's, with its draw calls and texture "
-                                 "bytes", viewer.run_suite, options=("size", "browser"))}
+                                 "bytes", viewer.run_suite, options=("size", "browser")),
+            "batch": BenchSuite("batch", "assets per hour of reliefkit batch on 10k-triangle "
+                                "meshes, local and Ray, 1 and 2 workers; Ray's overhead",
+                                batch.run_suite)}
     return core | {s.name: s for t in REGISTRY.techniques() for s in t.bench_suites}
 
 

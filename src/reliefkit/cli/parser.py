@@ -223,11 +223,14 @@ def build_parser() -> argparse.ArgumentParser:
     _add_bake_options(p, table)
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--workers", type=int, metavar="N",
-                   help="worker processes (default: the CPU cores; each gets cores/N Mesa "
-                        "threads)")
+                   help="worker processes, or Ray tasks in flight (default: the CPU cores, "
+                        "or a Ray cluster's CPUs; each gets cores/N Mesa and numba threads)")
     p.add_argument("--executor", default="local", choices=("local", "ray"),
-                   help="where the workers run (default: %(default)s)")
-    p.add_argument("--address", metavar="ADDR", help="the Ray cluster (--executor ray)")
+                   help="where the workers run: local processes or Ray tasks (pip install "
+                        "'reliefkit[ray]') (default: %(default)s)")
+    p.add_argument("--address", metavar="ADDR",
+                   help="with --executor ray: the cluster, auto, HOST:PORT or ray://HOST:PORT "
+                        "(default: a local one started for the run)")
     p.add_argument("--force", action="store_true",
                    help="bake every asset again, whatever is on disk")
     p.add_argument("--export", choices=("glb",),
