@@ -125,6 +125,20 @@ def test_bad_arguments_are_one_line(library, tmp_path, capsys, extra, words):
     assert not (tmp_path / "o").exists()  # refused before anything was made
 
 
+def test_an_output_over_an_input_is_refused(library, tmp_path, capsys):
+    """--export glb of a .glb baked into its own folder replaced the user's mesh."""
+    import trimesh
+
+    source = library / "c.glb"
+    trimesh.load(library / "b.obj", force="mesh").export(source)
+    before = source.read_bytes()
+    status = cli.main(["batch", str(source), *RELIEF, "--out", str(library), "--export", "glb"])
+    err = capsys.readouterr().err
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"{library / 'c.glb'} would be written over the input {source}" in err
+    assert source.read_bytes() == before and not (library / "c.rk").exists()
+
+
 def test_an_input_that_names_nothing_is_one_line(tmp_path, capsys):
     status = cli.main(["batch", str(tmp_path / "nothing"), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err

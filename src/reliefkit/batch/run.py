@@ -50,6 +50,7 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
     check_writable(out, "--out", folder=True)
     jobs = expand_inputs(inputs, kind, bake_options, out)
     check_jobs(jobs)
+    _check_no_input_overwritten(jobs, out, export)
     out.mkdir(parents=True, exist_ok=True)
     report = BatchReport(out, total=len(jobs))
     start = time.monotonic()
@@ -86,6 +87,19 @@ def _uninterrupted():
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def _check_no_input_overwritten(jobs: list[Job], out: Path, export: str | None) -> None:
+    """Refuse, before anything is written, a batch whose outputs would replace one of its
+    inputs (``--export glb`` beside a .glb source baked into its own folder replaced it)."""
+    sources = {job.input.resolve(): job for job in jobs}
+    for job in jobs:
+        rk_path = out / job.output
+        for path in [rk_path] + ([rk_path.with_suffix(f".{export}")] if export else []):
+            source = sources.get(path.resolve())
+            if source is not None:
+                raise UsageError(f"{path} would be written over the input {source.input}: "
+                                 "give an --out outside the inputs' folders")
 
 
 def _plan(jobs: list[Job], out: Path, force: bool, export: str | None, sheet: bool,
