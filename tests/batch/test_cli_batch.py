@@ -143,3 +143,25 @@ def test_an_input_that_names_nothing_is_one_line(tmp_path, capsys):
     status = cli.main(["batch", str(tmp_path / "nothing"), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert status == 2 and err.count("\n") == 1 and "nothing: no such file or folder" in err
+
+
+def test_a_stale_export_or_thumbnail_is_made_again(library, tmp_path):
+    """A .glb and thumbnails left from a bake of other options, beside an .rk rebaked without
+    them, were counted as up to date: a rerun with --export glb --sheet skipped forever."""
+    from reliefkit.batch.sheet import thumbnail_key
+    from reliefkit.io.gltf import representation as gltf
+
+    out, source = tmp_path / "out", str(library / "b.obj")
+    assert cli.main(["batch", source, *RELIEF, "--out", str(out), "--export", "glb",
+                     "--sheet"]) == 0
+    assert cli.main(["batch", source, "--as", "relief", "--depth-res", "12",
+                     "--out", str(out)]) == 0
+    key = rk.read_manifest(out / "b.rk")["cache_key"]
+    assert gltf.stored_cache_key(out / "b.glb") != key  # the earlier bake's export
+    assert cli.main(["batch", source, "--as", "relief", "--depth-res", "12", "--out", str(out),
+                     "--export", "glb", "--sheet"]) == 0
+    assert cli.main(["batch", source, "--as", "relief", "--depth-res", "12", "--out", str(out),
+                     "--export", "glb", "--sheet"]) == 0
+    assert statuses(out) == [("b.rk", "ok")] * 3 + [("b.rk", "skipped")]
+    assert gltf.read_manifest(out / "b.glb")["cache_key"] == key
+    assert [thumbnail_key(p) for p in sorted((out / "thumbnails").glob("b*.png"))] == [key] * 2

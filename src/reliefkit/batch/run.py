@@ -10,13 +10,14 @@ from pathlib import Path
 
 from ..errors import FormatError, ReliefkitError, UsageError
 from ..io.atomic import atomic_path, check_writable, written_together
+from ..io.gltf.representation import stored_cache_key
 from ..io.rk import read_manifest
 from ..progress import progress_bar
 from .jobs import Job, check_jobs, expand_inputs
 from .key import cache_key, read_sources
 from .local import LocalExecutor
 from .report import AssetRecord, BatchInterrupted, BatchReport
-from .sheet import THUMBNAIL_SIZE, thumbnail_paths, write_sheet
+from .sheet import THUMBNAIL_SIZE, thumbnail_key, thumbnail_paths, write_sheet
 from .task import Result, Task, make_task
 
 EXECUTORS = ("local", "ray")
@@ -125,12 +126,12 @@ def _plan(jobs: list[Job], out: Path, force: bool, export: str | None, sheet: bo
 
 
 def _up_to_date(out: Path, output: str, key: str, export: str | None, sheet: bool) -> bool:
-    """Whether the .rk ``output`` holds ``key`` (and the export and thumbnails asked for
-    are there)."""
+    """Whether the .rk ``output`` holds ``key``, and so do the export and the thumbnails
+    asked for (one left from an earlier bake is stale: the asset is baked again)."""
     path = out / output
-    if export is not None and not path.with_suffix(f".{export}").is_file():
+    if export is not None and stored_cache_key(path.with_suffix(f".{export}")) != key:
         return False
-    if sheet and not all(p.is_file() for p in thumbnail_paths(out, output)):
+    if sheet and any(thumbnail_key(p) != key for p in thumbnail_paths(out, output)):
         return False
     try:
         return path.is_file() and read_manifest(path).get("cache_key") == key

@@ -19,6 +19,7 @@ THUMBNAIL_FOLDER = "thumbnails"
 SHEET_NAME, INDEX_NAME = "sheet.png", "index.html"
 SHEET_MAX_ASSETS = 200   # the PNG shows the first ones by output; index.html lists all
 SHEET_COLUMNS = 8        # four assets a row: mesh, then output
+KEY_CHUNK = "reliefkit:cache_key"  # a thumbnail's PNG text chunk: the bake it shows
 
 
 def thumbnail_paths(out: Path, output: str) -> tuple[Path, Path]:
@@ -27,6 +28,28 @@ def thumbnail_paths(out: Path, output: str) -> tuple[Path, Path]:
     stem = PurePosixPath(output).with_suffix("")
     base = out / THUMBNAIL_FOLDER / Path(*stem.parts)
     return base.with_name(base.name + ".mesh.png"), base.with_name(base.name + ".png")
+
+
+def keyed_png_info(key: str):
+    """PNG text chunks that record the cache key of the bake a thumbnail shows."""
+    from PIL.PngImagePlugin import PngInfo
+
+    info = PngInfo()
+    info.add_text(KEY_CHUNK, key)
+    return info
+
+
+def thumbnail_key(path: Path) -> str | None:
+    """The cache key a thumbnail records; None when it has none or cannot be read (its
+    text chunks come before the pixels: the image data is not decoded)."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as image:
+            key = getattr(image, "text", {}).get(KEY_CHUNK)
+    except (OSError, UnidentifiedImageError, ValueError):
+        return None
+    return key if isinstance(key, str) else None
 
 
 def write_sheet(out: Path, report: BatchReport) -> tuple[Path, Path]:

@@ -102,9 +102,10 @@ def run_task(task: Task) -> Result:
             mesh, rep, notes = _bake(task, Path(folder))
             source_hash = hashlib.sha256(task.source).hexdigest()
             data = rk_bytes(rep, source_hash=source_hash, cache_key=task.key)
-            glb = _export(rep, source_hash) if task.export_glb else None
+            glb = _export(rep, source_hash, task.key) if task.export_glb else None
             figures = [str(line) for line in getattr(rep, "bake_report", lambda: [])()]
-            pictures = _thumbnails(mesh, rep, task.thumbnails) if task.thumbnails else ()
+            pictures = _thumbnails(mesh, rep, task.thumbnails, task.key) if task.thumbnails \
+                else ()
     except ReliefkitError as exc:
         return _failed(task, start, _in_words(str(exc), task, folder))
     except MemoryError:
@@ -148,22 +149,26 @@ def _bake(task: Task, folder: Path):
     return mesh, bake(mesh, task.kind, compress=compression, **params), notes
 
 
-def _thumbnails(mesh, rep, size: int) -> tuple[bytes, bytes]:
-    """The mesh and what it was baked into from the default view, as PNG bytes."""
+def _thumbnails(mesh, rep, size: int, key: str) -> tuple[bytes, bytes]:
+    """The mesh and what it was baked into from the default view, as PNG bytes that carry
+    the bake's ``key`` (`sheet.thumbnail_key`: a rerun tells a stale one)."""
     from PIL import Image
+
+    from .sheet import keyed_png_info
 
     pictures = []
     for obj in (mesh, rep):
         buffer = io.BytesIO()
-        Image.fromarray(tile_image(obj, size=(size, size)), "RGBA").save(buffer, format="PNG")
+        Image.fromarray(tile_image(obj, size=(size, size)), "RGBA").save(
+            buffer, format="PNG", pnginfo=keyed_png_info(key))
         pictures.append(buffer.getvalue())
     return tuple(pictures)
 
 
-def _export(rep, source_hash: str) -> bytes:
+def _export(rep, source_hash: str, key: str) -> bytes:
     from ..export.gltf import export_bytes  # the draw plans' modules: imported when asked
 
-    return export_bytes(rep, source_hash=source_hash)
+    return export_bytes(rep, source_hash=source_hash, cache_key=key)
 
 
 def _failed(task: Task, start: float, error: str) -> Result:

@@ -197,22 +197,25 @@ def cmd_export(args) -> int:
             raise UsageError(f"bake options ({flags}) need --lod and a mesh; to export an "
                              ".rk baked with them, bake it with them first")
         rep = _load(args.input)
-        source_hash = _source_hash_of(args.input)
+        source_hash, key = _provenance_of(args.input)
         with waiting(f"exporting {what_it_is(args.input, rep)}"):
             path = export(rep, out, fallback=not args.no_fallback, source_hash=source_hash,
-                          **common)
+                          cache_key=key, **common)
     print(f"wrote {path}: {format_bytes(_written_bytes(path))}")
     return 0
 
 
-def _source_hash_of(spec: str) -> str | None:
-    """The source hash an .rk (or a glTF reliefkit exported) records; None for others."""
+def _provenance_of(spec: str) -> tuple[str | None, str | None]:
+    """The source hash and cache key an .rk (or a glTF reliefkit exported) records, so its
+    export records them too; None for what it lacks."""
     suffix = Path(spec).suffix.lower()
     if suffix == ".rk":
-        return read_manifest(spec).get("source_hash")
-    if suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec):
-        return gltf_representation.read_manifest(spec).get("source_hash")
-    return None
+        manifest = read_manifest(spec)
+    elif suffix in (".glb", ".gltf") and gltf_representation.exported_by_reliefkit(spec):
+        manifest = gltf_representation.read_manifest(spec)
+    else:
+        return None, None
+    return manifest.get("source_hash"), manifest.get("cache_key")
 
 
 def _bake_lods(args, given: dict):

@@ -61,10 +61,11 @@ def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
                         fallback_triangles: int = DEFAULT_FALLBACK_TRIANGLES,
                         embed_shaders: bool = False, source_hash: str | None = None,
                         name: str | None = None, options: dict | None = None,
-                        instrumented: bool = False) -> int:
+                        instrumented: bool = False, cache_key: str | None = None) -> int:
     """Add ``rep``'s node (extension, extras, the fallback as its child) to the builder's
     document; the node's index. ``options``: render options its draw plans are made with;
-    ``instrumented``: add the iteration-counting plans (`draw_extension`)."""
+    ``instrumented``: add the iteration-counting plans (`draw_extension`); ``cache_key``:
+    the bake's (`batch.key`), kept in the extras so a batch can tell a stale export."""
     codec, arrays, params = rk.prepare(rep)
     extension = representation_extension(builder, codec, arrays, params)
     extension["draw"] = draw_extension(builder, rep, embed_shaders=embed_shaders,
@@ -75,6 +76,8 @@ def representation_node(builder: GlbBuilder, rep, *, fallback: bool = True,
             "extras": {"reliefkit": {"kind": codec.kind, "kindVersion": codec.version,
                                      "params": params, "sourceHash": source_hash,
                                      "report": list(report), "generator": GENERATOR}}}
+    if cache_key is not None:  # optional: exports of bakes without one keep their bytes
+        node["extras"]["reliefkit"]["cacheKey"] = cache_key
     document = builder.document
     if fallback:
         mesh = fallback_of(rep, fallback_triangles)
@@ -107,7 +110,7 @@ def write_document(path, builder: GlbBuilder, roots: list[int]) -> Path:
 
 def export(rep, path, *, fallback: bool = True,
            fallback_triangles: int = DEFAULT_FALLBACK_TRIANGLES, embed_shaders: bool = False,
-           source_hash: str | None = None) -> Path:
+           source_hash: str | None = None, cache_key: str | None = None) -> Path:
     """Write ``rep`` as a glTF file (see the module); `reliefkit.load` reads it back.
 
     Parameters
@@ -118,6 +121,7 @@ def export(rep, path, *, fallback: bool = True,
     fallback_triangles : the fallback's triangle budget where its kind has one.
     embed_shaders : add the GLSL ES sources of the draw plans' programs.
     source_hash : SHA-256 of the source file (as in .rk files).
+    cache_key : the bake's cache key (as in .rk files), when it has one.
     """
     if type(fallback_triangles) is not int or fallback_triangles < 2:
         raise UsageError(f"fallback_triangles must be an integer >= 2, got {fallback_triangles!r}")
@@ -125,7 +129,8 @@ def export(rep, path, *, fallback: bool = True,
     try:
         root = representation_node(builder, rep, fallback=fallback,
                                    fallback_triangles=fallback_triangles,
-                                   embed_shaders=embed_shaders, source_hash=source_hash)
+                                   embed_shaders=embed_shaders, source_hash=source_hash,
+                                   cache_key=cache_key)
     except FormatError as exc:
         raise FormatError(f"cannot export to {path}: {exc}") from None
     return write_document(path, builder, [root])
@@ -133,7 +138,7 @@ def export(rep, path, *, fallback: bool = True,
 
 def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False,
                  options: dict | None = None, instrumented: bool = False,
-                 source_hash: str | None = None) -> bytes:
+                 source_hash: str | None = None, cache_key: str | None = None) -> bytes:
     """``rep`` as the bytes of a .glb file, made in memory (what `reliefkit view` serves,
     what a batch worker returns), its draw plans made with the render ``options`` it
     declares; ``instrumented`` adds the iteration-counting plans (the page's heat map)."""
@@ -141,5 +146,6 @@ def export_bytes(rep, *, fallback: bool = True, embed_shaders: bool = False,
     _one_scene(builder, [representation_node(builder, rep, fallback=fallback,
                                              embed_shaders=embed_shaders, options=options,
                                              instrumented=instrumented,
-                                             source_hash=source_hash)])
+                                             source_hash=source_hash,
+                                             cache_key=cache_key)])
     return builder.glb()

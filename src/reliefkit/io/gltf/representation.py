@@ -30,7 +30,7 @@ from .files import read_gltf
 from .glb import DEFAULT_MAX_BYTES, MAGIC, MAX_JSON_BYTES, Glb, GlbBuilder, read_glb
 
 __all__ = ["PREFIX", "extension_name", "representation_extension", "is_gltf", "read_document",
-           "exported_by_reliefkit",
+           "exported_by_reliefkit", "stored_cache_key",
            "reliefkit_nodes", "GltfRepresentation", "read_representation", "load",
            "read_manifest"]
 
@@ -73,6 +73,29 @@ def is_gltf(path) -> bool:
 def exported_by_reliefkit(path) -> bool:
     """Whether a glTF file declares one of reliefkit's extensions (its JSON alone is read;
     a file that cannot be read says False, and the mesh loader then says why)."""
+    used = (_document_json(path) or {}).get("extensionsUsed", [])
+    return isinstance(used, list) and any(isinstance(u, str) and u.startswith(PREFIX)
+                                          for u in used)
+
+
+def stored_cache_key(path) -> str | None:
+    """The cache key (`reliefkit.batch.key`) in the extras of a reliefkit export's first
+    representation, from its JSON alone (cheap for any file size); None when it has none or
+    cannot be read (a batch then exports it again)."""
+    document = _document_json(path)
+    if document is None:
+        return None
+    try:
+        found = reliefkit_nodes(document)
+        key = document["nodes"][found[0][0]]["extras"]["reliefkit"]["cacheKey"] if found else None
+    except (KeyError, TypeError):
+        return None
+    return key if isinstance(key, str) else None
+
+
+def _document_json(path) -> dict | None:
+    """The JSON of a .glb or .gltf file, without its binary chunk; None when it cannot be
+    read as one."""
     path = Path(path)
     try:
         with open(path, "rb") as fh:
@@ -83,12 +106,11 @@ def exported_by_reliefkit(path) -> bool:
             elif path.suffix.lower() == ".gltf":
                 text = head + fh.read(MAX_JSON_BYTES)
             else:
-                return False
-        used = json.loads(text.decode("utf-8")).get("extensionsUsed", [])
-    except (OSError, ValueError, AttributeError, RecursionError):
-        return False
-    return isinstance(used, list) and any(isinstance(u, str) and u.startswith(PREFIX)
-                                          for u in used)
+                return None
+        document = json.loads(text.decode("utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    return document if isinstance(document, dict) else None
 
 
 def read_document(path, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Glb:
@@ -211,4 +233,5 @@ def read_manifest(path) -> dict:
     return {"format": "glTF 2.0", **others, "extension": name, "kind": extension.get("kind"),
             "kind_version": extension.get("kindVersion"), "params": extension.get("params"),
             "source_hash": extras.get("sourceHash"),
+            **({"cache_key": extras["cacheKey"]} if "cacheKey" in extras else {}),
             "created_by": glb.document["asset"].get("generator"), "arrays": arrays}
