@@ -12,10 +12,12 @@ from __future__ import annotations
 import json
 import logging
 import os
+import shutil
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -33,8 +35,8 @@ RELIEF = ["--as", "relief", "--depth-res", "10"]
 
 
 @pytest.fixture(scope="module")
-def cluster():
-    """A local Ray cluster for this module; its workers import the tests' kinds."""
+def ray_module():
+    """Ray, imported; without it the test skips saying why (on CI it fails)."""
     try:
         import ray
     except ImportError:
@@ -42,6 +44,13 @@ def cluster():
         if os.environ.get("CI", "").lower() == "true":
             pytest.fail(f"CI=true but the Ray tests cannot run: {reason}")
         pytest.skip(reason)
+    return ray
+
+
+@pytest.fixture(scope="module")
+def cluster(ray_module):
+    """A local Ray cluster for this module; its workers import the tests' kinds."""
+    ray = ray_module
     path = os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")])
     # one GPU as Ray counts them (none is needed: EGL device 0 is Mesa's llvmpipe here), so
     # the tasks ask for a share of it and their workers make their context on its device
@@ -217,6 +226,48 @@ def test_ray_client_address(cluster, library, tmp_path):
         single = tmp_path / "single.rk"
         assert cli.main(["bake", str(library / f"{name}.obj"), *RELIEF, "-o", str(single)]) == 0
         assert (out / f"{name}.rk").read_bytes() == single.read_bytes(), name
+
+
+TOKEN_CLUSTER = """
+import sys, ray
+ray.init(num_cpus=1, include_dashboard=False, _temp_dir=sys.argv[1])
+print(ray.get_runtime_context().gcs_address, flush=True)
+sys.stdin.read()
+ray.shutdown()
+"""
+
+
+def test_a_cluster_with_token_authentication_is_one_line_that_says_so(
+        ray_module, library, tmp_path):
+    """A cluster started with Ray's token authentication, reached without the token: Ray's
+    core logged 21 lines of retries and then an error that did not name the cause."""
+    token = "7f" * 32
+    plain = {k: v for k, v in os.environ.items() if not k.startswith("RAY_AUTH")}
+    plain["HOME"] = str(tmp_path)  # no ~/.ray/auth_token
+    secured = {**plain, "RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": token}
+    temp = tempfile.mkdtemp(prefix="rk-ray-", dir="/tmp")  # its sockets: short paths
+    head = subprocess.Popen([sys.executable, "-c", TOKEN_CLUSTER, temp], env=secured,
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=True)
+    try:
+        address = head.stdout.readline().strip()
+        assert address, "the token cluster did not start"
+        args = [sys.executable, "-m", "reliefkit.cli", "batch", str(library / "b.obj"), *RELIEF,
+                "--out", str(tmp_path / "out"), "--executor", "ray", "--address", address]
+        refused = subprocess.run(args, env=plain, capture_output=True, text=True, timeout=180)
+        assert refused.returncode == 1
+        assert refused.stderr == (f"error: --executor ray: the Ray cluster at {address} asks "
+                                  "for Ray's token authentication and this process has no "
+                                  "token it accepts: run with RAY_AUTH_MODE=token and the "
+                                  "cluster's token in ~/.ray/auth_token (or "
+                                  "RAY_AUTH_TOKEN_PATH, or RAY_AUTH_TOKEN)\n")
+        accepted = subprocess.run(args, env=secured, capture_output=True, text=True,
+                                  timeout=180)
+        assert accepted.returncode == 0, accepted.stderr
+        assert statuses(tmp_path / "out") == [("b.rk", "ok")]
+    finally:
+        head.communicate(input="", timeout=60)
+        shutil.rmtree(temp, ignore_errors=True)
 
 
 def test_a_worker_makes_its_context_on_its_ray_gpu_with_its_share_of_the_cores(

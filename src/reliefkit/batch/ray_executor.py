@@ -20,9 +20,13 @@ caller's).
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import os
 import socket
+import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterable
 
@@ -35,6 +39,10 @@ MAX_MEMORY_REFUSED = ("--max-memory is not available with --executor ray: the dr
                       "watch a Ray worker's memory (Ray's memory monitor stops tasks when a "
                       "node runs short); leave it out or use --executor local")
 CONNECT_SECONDS = 10  # to reach an --address before Ray tries (for minutes)
+AUTH_REFUSED = ("InvalidAuthToken", "Unauthenticated")  # Ray's core: a token is missing or wrong
+AUTH_ADVICE = ("asks for Ray's token authentication and this process has no token it accepts: "
+               "run with RAY_AUTH_MODE=token and the cluster's token in ~/.ray/auth_token "
+               "(or RAY_AUTH_TOKEN_PATH, or RAY_AUTH_TOKEN)")
 RAY_LOGGING = logging.ERROR  # Ray's own log lines stay in its session folder
 _prepared = False  # this worker process has been made a baker (`_prepare`)
 
@@ -87,15 +95,25 @@ class RayExecutor:
         if ray.is_initialized():
             return False
         quiet = {"logging_level": RAY_LOGGING, "log_to_driver": False}
-        try:
-            if self.address is None:
+        if self.address is None:
+            try:
                 ray.init(num_cpus=self.workers or cores(), include_dashboard=False, **quiet)
-            else:
-                ray.init(address=self.address, **quiet)
-        except (ConnectionError, RuntimeError, ValueError) as exc:
-            where = f"the Ray cluster at {self.address}" if self.address else "a local Ray cluster"
-            raise ReliefkitError(f"--executor ray: could not start or reach {where} "
-                                 f"({' '.join(str(exc).split())[:300]})") from None
+            except (ConnectionError, RuntimeError, ValueError) as exc:
+                raise ReliefkitError(f"--executor ray: could not start a local Ray cluster "
+                                     f"({_one_line(exc)})") from None
+            return True
+        where = f"the Ray cluster at {self.address}"
+        with tempfile.TemporaryFile("w+b") as core_log:
+            try:
+                with _native_stderr_to(core_log):
+                    ray.init(address=self.address, **quiet)
+            except (ConnectionError, RuntimeError, ValueError, ray.exceptions.RayError) as exc:
+                core_log.seek(0)
+                said = core_log.read().decode("utf-8", "replace") + str(exc)
+                if any(word in said for word in AUTH_REFUSED):
+                    raise ReliefkitError(f"--executor ray: {where} {AUTH_ADVICE}") from None
+                raise ReliefkitError(f"--executor ray: could not reach {where} "
+                                     f"({_one_line(exc)})") from None
         return True
 
     def _in_flight(self, ray) -> int:
@@ -171,6 +189,25 @@ class _Slots:
         slot["ref"] = None
         if task is not None:
             on_result(task, result)
+
+
+@contextlib.contextmanager
+def _native_stderr_to(sink):
+    """The process's stderr (file descriptor 2) into ``sink`` while Ray's C++ core connects:
+    it logs each retry there, a line a second for about 20 s (a cluster that refuses the
+    token: 21 lines before Ray's own error, which does not say why); read afterwards."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        os.dup2(sink.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def _one_line(exc: Exception) -> str:
+    return " ".join(str(exc).split())[:300]
 
 
 def _check_reachable(address: str) -> None:
