@@ -51,6 +51,14 @@ def test_files_under_the_output_folder_are_never_inputs(library):
     assert outputs(jobs) == ["chairs/a.rk", "chairs/old/b.rk", "tables/c.rk"]
 
 
+@pytest.mark.parametrize("spec, count", [("chairs", 2), ("chairs/*.obj", 1)])
+def test_an_out_that_holds_every_input_says_so(library, spec, count):
+    """--out the input folder itself said "no mesh files in this folder": they are there."""
+    with pytest.raises(UsageError, match=rf"its {count} mesh file\(s\) are all inside --out .*chairs, "
+                                         "whose files a batch never takes as inputs"):
+        expand_inputs([f"{library}/{spec}"], "relief", {}, library / "chairs")
+
+
 def test_the_same_asset_twice_is_one_job(library, tmp_path):
     jobs = expand_inputs([library / "tables/c.obj", library / "tables/../tables/c.obj"],
                          "relief", {}, tmp_path / "out")

@@ -92,15 +92,15 @@ def _jobs_of(spec: str, kind: str, options: dict, out: Path):
     if path.suffix.lower() in MANIFEST_SUFFIXES and path.is_file():
         yield from _manifest_jobs(path, kind, options, suffixes)
     elif path.is_dir():
-        found = [p for p in sorted(path.rglob("*")) if p.suffix.lower() in suffixes
-                 and p.is_file() and not _inside(p, out)]
+        found = _outside(out, spec, [p for p in sorted(path.rglob("*"))
+                                     if p.suffix.lower() in suffixes and p.is_file()])
         if not found:
             raise UsageError(f"{spec}: no mesh files ({' '.join(suffixes)}) in this folder")
         yield from (_job(p, path, kind, options, str(p)) for p in found)
     elif glob.has_magic(spec):
-        found = [Path(p) for p in sorted(glob.glob(spec, recursive=True))
-                 if Path(p).suffix.lower() in suffixes and Path(p).is_file()
-                 and not _inside(Path(p), out)]
+        found = _outside(out, spec, [Path(p) for p in sorted(glob.glob(spec, recursive=True))
+                                     if Path(p).suffix.lower() in suffixes
+                                     and Path(p).is_file()])
         if not found:
             raise UsageError(f"{spec}: the pattern matches no mesh file ({' '.join(suffixes)})")
         root = _glob_root(spec)
@@ -118,6 +118,17 @@ def _jobs_of(spec: str, kind: str, options: dict, out: Path):
 def _job(path: Path, root: Path, kind: str, options: dict, where: str) -> Job:
     relative = PurePosixPath(*Path(os.path.relpath(path, root)).parts)
     return Job(path, str(relative.with_suffix(".rk")), kind, dict(options), where)
+
+
+def _outside(out: Path, spec: str, paths: list[Path]) -> list[Path]:
+    """``paths`` less those under ``out``; when that leaves none, a UsageError that says so
+    ("no mesh files" would be wrong: they are there)."""
+    kept = [p for p in paths if not _inside(p, out)]
+    if paths and not kept:
+        raise UsageError(f"{spec}: its {len(paths)} mesh file(s) are all inside --out {out}, "
+                         "whose files a batch never takes as inputs (they may be an earlier "
+                         "run's exports): give an --out outside the inputs' folders")
+    return kept
 
 
 def _inside(path: Path, folder: Path) -> bool:
