@@ -5,6 +5,8 @@ runs past --timeout or over --max-memory is replaced and only its asset fails.""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 
 import batch_kinds
 import pytest
@@ -123,6 +125,24 @@ def test_the_public_api_bakes_with_the_built_ins(library, tmp_path):
     assert manifest["cache_key"] == file_cache_key(library / "a.obj", "relief",
                                                    {"depth_res": 10})
     assert manifest["source_hash"] == rk.file_sha256(library / "a.obj")
+
+
+def test_a_script_without_the_main_guard_is_told_so(library, tmp_path):
+    """Workers are spawned: each imports the script, which called batch again there; every
+    worker died in ~450 lines of Python's error, and each asset was failed as "died"."""
+    script = tmp_path / "bake_all.py"
+    script.write_text("import reliefkit\n"
+                      f"reliefkit.batch({str(library)!r}, 'relief', {str(tmp_path / 'out')!r}, "
+                      "workers=2, depth_res=10, progress=False)\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr.splitlines()[-1] == (
+        "reliefkit.errors.UsageError: batch ran again in each worker process as it started: a "
+        "worker imports the script that calls it, so call batch under `if __name__ == "
+        "\"__main__\":` (Python's rule for scripts that start processes)")
+    assert "died" not in done.stderr and "bootstrapping" not in done.stderr
+    assert not (tmp_path / "out" / "batch.jsonl").exists()  # no asset recorded
 
 
 def test_a_bake_s_python_warnings_go_to_its_record_not_the_terminal(library, tmp_path,

@@ -9,6 +9,7 @@ the composition root import this package.
 
 from __future__ import annotations
 
+from .local import end_if_worker_importing_script
 from .report import BatchInterrupted, BatchReport
 from .run import executor_for, run_batch
 
@@ -24,6 +25,7 @@ def batch(inputs, kind: str, out, executor: str = "local", *, workers: int | Non
     (``exit_status`` 1 when any asset failed). ``setup`` fills the registry, here and once
     in each worker (the public ``reliefkit.batch`` passes the composition root's
     ``registry``). Ctrl-C raises `BatchInterrupted`."""
+    end_if_worker_importing_script()  # before anything is read or written
     if isinstance(inputs, str | bytes) or not hasattr(inputs, "__iter__"):
         inputs = [inputs]
     if setup is not None:

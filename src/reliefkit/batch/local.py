@@ -23,6 +23,10 @@ from ..errors import UsageError
 from .task import Result, Task, failed, prepare_worker, run_task
 
 POLL_SECONDS = 0.2
+UNGUARDED_EXIT = 87  # a worker that found its parent's script calling batch as it started
+UNGUARDED_SCRIPT = ("batch ran again in each worker process as it started: a worker imports the "
+                    "script that calls it, so call batch under `if __name__ == \"__main__\":` "
+                    "(Python's rule for scripts that start processes)")
 
 
 def cores() -> int:
@@ -31,6 +35,16 @@ def cores() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not Linux
         return os.cpu_count() or 1
+
+
+def end_if_worker_importing_script() -> None:
+    """End this process at once (`UNGUARDED_EXIT`) when it is a worker still importing its
+    parent's script: a spawned process re-runs the script's top level, so a script without
+    the ``__main__`` guard calls batch again there. Before, every worker died of Python's
+    own error in ~450 lines and each asset was failed as "worker died"; now the driver sees
+    the exit status and says what to fix (`UNGUARDED_SCRIPT`)."""
+    if getattr(multiprocessing.current_process(), "_inheriting", False):  # spawn's own test
+        os._exit(UNGUARDED_EXIT)
 
 
 def check_limits(workers: int | None, timeout: float | None) -> None:
@@ -124,6 +138,8 @@ class _Worker:
                 return message
             self.started = time.monotonic()  # the worker took the task
         if not self.process.is_alive():
+            if self.process.exitcode == UNGUARDED_EXIT:
+                raise UsageError(UNGUARDED_SCRIPT)
             return self._lost(f"the worker baking it died ({_exit_reason(self.process)}); "
                               "it was replaced")
         if timeout is not None and self.started is not None and \
