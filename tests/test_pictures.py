@@ -25,3 +25,20 @@ def test_long_captions_wrap_within_their_tile():
     for k, rgb in enumerate(colours):  # each tile whole, at the bottom of its cell
         block = sheet[-PAD - TILE:-PAD, PAD + k * cell:PAD + k * cell + TILE]
         assert np.all(block == rgb), k
+
+
+def test_a_long_path_breaks_after_its_separators():
+    """A batch sheet's caption (an output's path) broke mid-name: 'glTF2/2CylinderEng' +
+    'ine-glTF-Binary/...'; every piece now ends at a '/', '-', '_' or '.' where one fits,
+    and the pieces put together are the text."""
+    from PIL import ImageFont
+
+    from reliefkit.pictures import wrap_text
+
+    font = ImageFont.load_default()
+    text = "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine: relief-cube"
+    width = TILE * 1.3
+    lines = wrap_text(text, font, width)
+    assert len(lines) > 2 and all(font.getlength(line) <= width for line in lines)
+    assert " ".join(lines).replace("/ ", "/").replace("- ", "-") == text
+    assert all(line[-1] in "/-_.:" or line == lines[-1] for line in lines), lines

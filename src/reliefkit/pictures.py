@@ -60,9 +60,13 @@ def contact_sheet(tiles: list[tuple[str, np.ndarray]], columns: int = 4, *,
     return sheet
 
 
+BREAK_AFTER = "/-_."  # where a word wider than a line (a path, a kind) breaks first
+
+
 def wrap_text(text: str, font, width: float) -> list[str]:
     """``text`` in lines of at most ``width`` pixels in ``font``: broken at spaces, and a
-    word wider than a line broken where it must be."""
+    word wider than a line after its last `BREAK_AFTER` character that fits (a batch's
+    ``chairs/old/armchair``: after a ``/``, not mid-name), else where it must be."""
     lines: list[str] = []
     for word in text.split():
         joined = f"{lines[-1]} {word}" if lines else word
@@ -70,8 +74,10 @@ def wrap_text(text: str, font, width: float) -> list[str]:
             lines[-1] = joined
             continue
         while font.getlength(word) > width and len(word) > 1:
-            cut = max(k for k in range(1, len(word)) if font.getlength(word[:k]) <= width
-                      or k == 1)
+            fits = max(k for k in range(1, len(word)) if font.getlength(word[:k]) <= width
+                       or k == 1)
+            soft = [k for k in range(1, fits + 1) if word[k - 1] in BREAK_AFTER]
+            cut = soft[-1] if soft else fits
             lines.append(word[:cut])
             word = word[cut:]
         lines.append(word)

@@ -165,3 +165,10 @@ def test_a_stale_export_or_thumbnail_is_made_again(library, tmp_path):
     assert statuses(out) == [("b.rk", "ok")] * 3 + [("b.rk", "skipped")]
     assert gltf.read_manifest(out / "b.glb")["cache_key"] == key
     assert [thumbnail_key(p) for p in sorted((out / "thumbnails").glob("b*.png"))] == [key] * 2
+
+
+def test_an_out_that_cannot_be_made_is_a_usage_error(library, capsys):
+    """Root passes the access check under /proc, and making the folder failed with exit 1."""
+    status = cli.main(["batch", str(library), *RELIEF, "--out", "/proc/reliefkit-batch-out"])
+    err = capsys.readouterr().err
+    assert status == 2 and err.count("\n") == 1 and "/proc/reliefkit-batch-out" in err, err

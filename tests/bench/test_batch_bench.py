@@ -35,4 +35,6 @@ def test_every_executor_and_worker_count_bakes_the_n_assets(tmp_path, gl):
     for row in rows:
         assert f"| {row['executor']} | {row['workers']} |" in markdown
     assert (tmp_path / "batch.md").read_text() == markdown
+    # 3 assets measure no rate: the figures are not set beside the targets
+    assert "A smoke run (3 assets, --quick)" in markdown and "(target" not in markdown
     assert "batch" in suites()

@@ -155,7 +155,8 @@ class _Worker:
     def _lost(self, why: str) -> Result:
         task, self.task, self.broken = self.task, None, True
         self.stop()
-        return failed(task, why, time.monotonic() - (self.started or time.monotonic()))
+        seconds = 0.0 if self.started is None else time.monotonic() - self.started
+        return failed(task, why, seconds)  # (now - now read in that order was -0.0 s)
 
     def stop(self) -> None:
         if self.process.is_alive():

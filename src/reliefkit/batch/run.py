@@ -52,7 +52,7 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
     jobs = expand_inputs(inputs, kind, bake_options, out)
     check_jobs(jobs)
     _check_no_input_overwritten(jobs, out, export)
-    out.mkdir(parents=True, exist_ok=True)
+    _make_folder(out)
     report = BatchReport(out, total=len(jobs))
     start = time.monotonic()
     try:
@@ -73,6 +73,16 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
     if sheet:
         write_sheet(out, report)
     return report
+
+
+def _make_folder(out: Path) -> None:
+    """``out`` made, or a UsageError (exit status 2, as for any output refused before work):
+    a folder the access check lets through can still fail (root under /proc: exit 1 before)."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError(f"--out {out}: cannot make the folder ({exc.strerror or exc})") \
+            from None
 
 
 @contextlib.contextmanager

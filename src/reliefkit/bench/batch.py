@@ -162,9 +162,16 @@ def _markdown(data: dict) -> str:
         lines.append(f"| {r['executor']} | {r['workers']} | {r['seconds']:.1f} | "
                      f"{r['first_asset_seconds']:.1f} | {_figure(r['seconds_per_asset'])} | "
                      f"{_figure(r['assets_per_hour'], digits=0)} |")
+    smoke = n < COUNT  # two workers finish 2 of 3 assets together: the gaps say nothing
     lines += ["", "Speedup 1 -> 2 workers: " + ", ".join(
-        f"{ex} {_figure(s, 'x')}" for ex, s in data["speedup"].items()) + " (target >= 1.7x).",
+        f"{ex} {_figure(s, 'x')}" for ex, s in data["speedup"].items())
+              + (" (smoke run)." if smoke else " (target >= 1.7x)."),
               "Ray's overhead per asset (Ray's s/asset - local's): " + ", ".join(
         f"{w} worker(s) {_figure(s, ' s')}" for w, s in data["ray_overhead_s"].items())
-              + " (target <= 0.5 s).", ""]
+              + (" (smoke run)." if smoke else " (target <= 0.5 s)."), ""]
+    if smoke:
+        lines += [f"A smoke run ({n} assets, --quick): it checks that every executor bakes, "
+                  f"but {n - 1} gaps between assets measure no rate; the figures above are not "
+                  f"to be held against the targets (>= 1.7x, <= 0.5 s). Run without --quick "
+                  f"({COUNT} assets) for those.", ""]
     return "\n".join(lines)
