@@ -5,8 +5,9 @@ bytes and those of the files it references by relative name, so a worker needs n
 file system (it unpacks them into a private temporary folder and loads the mesh from
 there). A bad asset is a failed `Result` with its one-line error, never an exception.
 A worker process is prepared once (`prepare_worker`): its Mesa thread count and EGL device
-are set before its GL context exists, which it then makes once and keeps
-(`reliefkit.gl.context.get_context`).
+are set before its GL context exists, which it then makes on its first task and keeps; every
+task bakes on it explicitly (`reliefkit.gl.context.using`), the process-wide context is
+never made.
 """
 
 from __future__ import annotations
@@ -28,6 +29,8 @@ from ..gl import context as gl_context
 from ..io.rk import rk_bytes
 from .jobs import Job
 from .key import cache_key, read_sources, split_options
+
+_context = None  # this worker's GL context (`_worker_context`)
 
 
 @dataclass(frozen=True)
@@ -80,7 +83,7 @@ def prepare_worker(setup=None, *, threads: int | None = None,
     ``CUDA_VISIBLE_DEVICES``); then ``setup()`` (the composition root's ``registry``: the
     kinds a task may name); the mesh loader is imported now, so an asset's time (and
     ``--timeout``) is its own."""
-    if gl_context.has_context():
+    if gl_context.has_context() or _context is not None:
         raise UsageError("prepare_worker must run before this process makes its GL context")
     if threads is not None:
         count = str(max(1, int(threads)))
@@ -98,7 +101,7 @@ def run_task(task: Task) -> Result:
     folder = ""
     try:
         with tempfile.TemporaryDirectory(prefix="reliefkit-task-") as folder, \
-                _recorded_warnings() as caught:
+                _recorded_warnings() as caught, gl_context.using(_worker_context()):
             mesh, rep, notes = _bake(task, Path(folder))
             source_hash = hashlib.sha256(task.source).hexdigest()
             data = rk_bytes(rep, source_hash=source_hash, cache_key=task.key)
@@ -118,6 +121,15 @@ def run_task(task: Task) -> Result:
     return Result(task.output, "ok", time.perf_counter() - start, data, glb,
                   tuple(line for line in figures if not line.startswith("warning:")),
                   tuple(_in_words(w, task, folder) for w in notes), thumbnails=pictures)
+
+
+def _worker_context():
+    """This worker's own GL context: made on its first task (after `prepare_worker` set its
+    EGL device and threads; one that cannot be made fails that task in one line) and kept."""
+    global _context
+    if _context is None:
+        _context = gl_context.create_context()
+    return _context
 
 
 @contextlib.contextmanager
