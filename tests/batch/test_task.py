@@ -52,7 +52,7 @@ def test_a_bad_asset_is_a_failed_result_with_one_line(gl, tmp_path, source, word
     result = run_task(task)
     assert result.status == "failed" and result.rk is None
     assert words in result.error and "\n" not in result.error
-    assert "reliefkit-task-" not in result.error  # the worker's folder is not named
+    assert "reliefkit-mesh-" not in result.error  # the worker's folder is not named
 
 
 def test_a_file_name_outside_the_folder_is_refused(gl, tmp_path):
