@@ -212,3 +212,57 @@ def write_tetrahedron(path, scale: float = 1.0, name_texture: str | None = None)
                     "vt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n"
                     "f 1/1 3/3 2/2\nf 1/1 2/2 4/4\nf 1/1 4/4 3/3\nf 2/2 3/3 4/4\n")
     return path
+
+
+MESH_ARRAYS = ("positions", "origin", "indices", "normals", "colors", "uvs", "material")
+
+
+def assert_same_mesh(mesh, reference) -> None:
+    """The same arrays bit for bit (dtype too), materials and name."""
+    for name in MESH_ARRAYS:
+        got, want = getattr(mesh, name), getattr(reference, name)
+        if want is None:
+            assert got is None, name
+            continue
+        assert got is not None and got.dtype == want.dtype, name
+        assert got.shape == want.shape and got.tobytes() == want.tobytes(), name
+    assert mesh.name == reference.name and len(mesh.materials) == len(reference.materials)
+    for m, n in zip(mesh.materials, reference.materials, strict=True):
+        assert m == n and m.color.tobytes() == n.color.tobytes()
+
+
+def write_png(path, rgb=(200, 40, 40)):
+    """A 4x4 PNG of one colour at ``path``, its folders made."""
+    from PIL import Image
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(np.full((4, 4, 3), rgb, np.uint8)).save(path)
+
+
+def write_gltf_triangle(folder):
+    """``folder``/m.gltf (its folders made): one textured triangle whose buffer (data.bin)
+    and image (images/base colour.png, URL-encoded in the file) are files beside it."""
+    import json
+
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4")
+    uvs = np.array([[0, 0], [1, 0], [0, 1]], "<f4")
+    blob = positions.tobytes() + uvs.tobytes()
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "data.bin").write_bytes(blob)
+    write_png(folder / "images" / "base colour.png")
+    tree = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+                                    "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0}], "images": [{"uri": "images/base%20colour.png"}],
+        "buffers": [{"uri": "data.bin", "byteLength": len(blob)}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36},
+                        {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}]}
+    path = folder / "m.gltf"
+    path.write_text(json.dumps(tree))
+    return path

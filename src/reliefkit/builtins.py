@@ -16,6 +16,7 @@ are called (`tests/test_cli_startup.py`).
 from __future__ import annotations
 
 import functools
+import os
 import threading
 
 from .bake import bake as _bake
@@ -58,11 +59,12 @@ def _with_builtins(function):
     return public
 
 
-def _load(path, **kwargs):
-    """An .rk file, or a glTF file reliefkit exported (`io.gltf.representation.load`)."""
-    if gltf_representation.is_gltf(path):
-        return gltf_representation.load(path, **kwargs)
-    return rk.load(path, **kwargs)
+def _load(source, **kwargs):
+    """An .rk file, or a glTF file reliefkit exported (`io.gltf.representation.load`); bytes
+    (or a binary file object) are an .rk's (`io.rk.load`)."""
+    if isinstance(source, str | os.PathLike) and gltf_representation.is_gltf(source):
+        return gltf_representation.load(source, **kwargs)
+    return rk.load(source, **kwargs)
 
 
 def _export(rep, path, **kwargs):

@@ -104,7 +104,7 @@ def test_a_broken_mesh_fails_with_its_line_and_the_rest_succeed(library, tmp_pat
     assert errors["broken.rk"].startswith(str(library / "broken.obj") + ": ")
     assert "no triangle with a visible area" in errors["broken.rk"]
     assert "empty" in errors["empty.rk"]
-    assert all("\n" not in e and "reliefkit-task-" not in e for e in errors.values())
+    assert all("\n" not in e and "reliefkit-mesh-" not in e for e in errors.values())
 
 
 @pytest.mark.parametrize("workers", [1, 2])

@@ -20,6 +20,7 @@ from reliefkit.batch.task import Result, make_task, prepare_worker, run_task
 from reliefkit.builtins import bake, save
 from reliefkit.errors import UsageError
 from reliefkit.io.meshes import load_mesh
+from reliefkit.io.rk import rk_bytes
 
 
 def test_a_task_carries_its_files_and_bakes_without_them_on_disk(gl, tmp_path):
@@ -51,7 +52,7 @@ def test_a_bad_asset_is_a_failed_result_with_one_line(gl, tmp_path, source, word
     result = run_task(task)
     assert result.status == "failed" and result.rk is None
     assert words in result.error and "\n" not in result.error
-    assert "reliefkit-task-" not in result.error  # the worker's folder is not named
+    assert "reliefkit-mesh-" not in result.error  # the worker's folder is not named
 
 
 def test_a_file_name_outside_the_folder_is_refused(gl, tmp_path):
@@ -67,6 +68,39 @@ def test_a_file_name_outside_the_folder_is_refused(gl, tmp_path):
 def test_prepare_worker_comes_before_the_gl_context(gl):
     with pytest.raises(UsageError, match="before this process makes its GL context"):
         prepare_worker(threads=1)
+
+
+WORKER = """
+import pickle, sys
+from reliefkit.batch.task import prepare_worker, run_task
+from reliefkit.builtins import registry
+from reliefkit.errors import UsageError
+from reliefkit.gl.context import has_context
+prepare_worker(registry, threads=1)
+result = run_task(pickle.loads(sys.stdin.buffer.read()))
+assert not has_context(), "the task made the process-wide context"
+try:
+    prepare_worker(threads=1)
+    raise AssertionError("prepared again after its context was made")
+except UsageError:
+    pass
+sys.stdout.buffer.write(pickle.dumps(result))
+"""
+
+
+def test_a_worker_bakes_on_its_own_context(gl, tmp_path):
+    """A worker's tasks bake on the context it made once (`using`), never the process-wide
+    one, to the bytes a bake on that one gives; a fresh interpreter: no context yet."""
+    mesh = write_tetrahedron(tmp_path / "t.obj")
+    task = make_task(Job(mesh, "t.rk", "relief", {"depth_res": 10}, "t.obj"))
+    out = subprocess.run([sys.executable, "-c", WORKER], input=pickle.dumps(task),
+                         capture_output=True, timeout=300)
+    assert out.returncode == 0, out.stderr.decode()[-2000:]
+    result = pickle.loads(out.stdout)
+    assert result.status == "ok", result.error
+    assert result.rk == rk_bytes(bake(load_mesh(mesh), "relief", depth_res=10),
+                                 source_hash=hashlib.sha256(mesh.read_bytes()).hexdigest(),
+                                 cache_key=task.key)
 
 
 def test_prepare_worker_picks_the_egl_device_by_index():

@@ -18,6 +18,7 @@ import tracemalloc
 import numpy as np
 import pytest
 import trimesh
+from helpers import assert_same_mesh
 
 import reliefkit.io.meshes as loader_package
 from reliefkit.errors import MeshError
@@ -25,8 +26,6 @@ from reliefkit.io.meshes import badfile, load_mesh, plain_obj
 from reliefkit.io.meshes.plain_obj import read_plain_obj
 
 # ------------------------------------------------------------------------------ helpers
-
-ARRAYS = ("positions", "origin", "indices", "normals", "colors", "uvs", "material")
 
 
 def _general(path):
@@ -44,17 +43,8 @@ def outcome(load, path):
         return f"MeshError: {exc}"
 
 
-def assert_same_mesh(mesh, reference) -> None:
-    for name in ARRAYS:
-        got, want = getattr(mesh, name), getattr(reference, name)
-        if want is None:
-            assert got is None, name
-            continue
-        assert got is not None, name
-        assert got.dtype == want.dtype, name
-        np.testing.assert_array_equal(got, want, err_msg=name)
-    assert mesh.materials == reference.materials
-    assert mesh.name == reference.name
+def assert_same_load(mesh, reference) -> None:
+    assert_same_mesh(mesh, reference)
     assert mesh.extra == reference.extra  # the same path both times: its source is the same
 
 
@@ -64,7 +54,7 @@ def assert_same_outcome(path) -> None:
     if isinstance(want, str) or isinstance(got, str):
         assert got == want
     else:
-        assert_same_mesh(got, want)
+        assert_same_load(got, want)
 
 
 @pytest.fixture
@@ -174,7 +164,7 @@ def test_plain_file_gives_the_general_paths_mesh(tmp_path, case, plain_spy):
     assert plain_spy == ["plain"]  # and load_mesh took the plain way
     reference = _general(path)
     assert plain_spy == ["plain"]  # (the general load never called the reader)
-    assert_same_mesh(mesh, reference)
+    assert_same_load(mesh, reference)
     assert mesh.triangle_count == PLAIN[case].count("\nf ") + PLAIN[case].startswith("f ")
 
 
@@ -188,7 +178,7 @@ def test_plain_file_read_in_small_chunks_gives_the_same_mesh(tmp_path, monkeypat
     the general path's mesh."""
     monkeypatch.setattr(plain_obj, "CHUNK_BYTES", chunk, raising=False)
     path = write(tmp_path, PLAIN[case])
-    assert_same_mesh(load_mesh(path), _general(path))
+    assert_same_load(load_mesh(path), _general(path))
 
 
 def test_mixed_corner_forms_in_different_chunks_are_not_plain(tmp_path, monkeypatch):

@@ -10,6 +10,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from helpers import assert_same_mesh
 from numpy.lib import format as npy
 
 from reliefkit.builtins import registry
@@ -40,15 +41,6 @@ def three_materials() -> RenderMesh:
                  uv_transform=[[2.0, 0, 0.5], [0, 2.0, 0.25], [0, 0, 1]]),
     ]
     return RenderMesh(**quads(3), name="three", materials=materials, material=[0, 0, 1, 1, 2, 0])
-
-
-def assert_same_mesh(a: RenderMesh, b: RenderMesh) -> None:
-    for name in ("positions", "indices", "normals", "colors", "uvs", "material"):
-        x, y = getattr(a, name), getattr(b, name)
-        assert x.dtype == y.dtype and x.tobytes() == y.tobytes(), name
-    assert a.name == b.name and len(a.materials) == len(b.materials)
-    for m, n in zip(a.materials, b.materials, strict=True):
-        assert m == n and m.color.tobytes() == n.color.tobytes()
 
 
 def test_several_materials_round_trip_bit_exact(tmp_path):

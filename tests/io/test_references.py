@@ -3,11 +3,9 @@
 
 from __future__ import annotations
 
-import json
 import struct
 
-import numpy as np
-from PIL import Image
+from helpers import write_gltf_triangle, write_png
 
 from reliefkit.io.meshes import load_mesh
 from reliefkit.io.meshes.badfile import reads_recorded
@@ -20,15 +18,10 @@ def _read_by_load(path) -> set:
     return {p.resolve() for p in read} - {path.resolve()}
 
 
-def _png(path, rgb=(200, 40, 40)):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(np.full((4, 4, 3), rgb, np.uint8)).save(path)
-
-
 def test_obj_with_mtl_and_texture_in_a_subfolder(tmp_path):
     (tmp_path / "m.mtl").write_text("newmtl a\nKd 1 1 1\nmap_Kd tex/Wood.png\n")
-    _png(tmp_path / "tex" / "Wood.png")
-    _png(tmp_path / "unused.png")
+    write_png(tmp_path / "tex" / "Wood.png")
+    write_png(tmp_path / "unused.png")
     mesh = tmp_path / "m.obj"
     mesh.write_text("mtllib m.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\n"
                     "vt 0 1\nf 1/1 2/2 3/3\n")
@@ -39,7 +32,7 @@ def test_obj_with_mtl_and_texture_in_a_subfolder(tmp_path):
 
 def test_a_texture_named_in_another_case_is_found_as_the_loader_finds_it(tmp_path):
     (tmp_path / "m.mtl").write_text("newmtl a\nKd 1 1 1\nmap_Kd WOOD.PNG\n")
-    _png(tmp_path / "wood.png")
+    write_png(tmp_path / "wood.png")
     mesh = tmp_path / "m.obj"
     mesh.write_text("mtllib m.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\n"
                     "vt 0 1\nf 1/1 2/2 3/3\n")
@@ -57,26 +50,7 @@ def test_a_missing_texture_is_left_out_as_the_load_leaves_it(tmp_path):
 
 
 def test_gltf_buffer_and_image_files(tmp_path):
-    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4")
-    uvs = np.array([[0, 0], [1, 0], [0, 1]], "<f4")
-    blob = positions.tobytes() + uvs.tobytes()
-    (tmp_path / "data.bin").write_bytes(blob)
-    _png(tmp_path / "images" / "base colour.png")
-    tree = {
-        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
-                                    "material": 0}]}],
-        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
-        "textures": [{"source": 0}], "images": [{"uri": "images/base%20colour.png"}],
-        "buffers": [{"uri": "data.bin", "byteLength": len(blob)}],
-        "bufferViews": [{"buffer": 0, "byteLength": 36},
-                        {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                       "min": [0, 0, 0], "max": [1, 1, 0]},
-                      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}]}
-    mesh = tmp_path / "m.gltf"
-    mesh.write_text(json.dumps(tree))
+    mesh = write_gltf_triangle(tmp_path)
     found = referenced_files(mesh)
     assert sorted(found) == ["data.bin", "images/base colour.png"]
     assert {p.resolve() for p in found.values()} == _read_by_load(mesh)

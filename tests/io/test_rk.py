@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from numpy.lib import format as npy
 
+import reliefkit
 from reliefkit.builtins import registry
 from reliefkit.errors import FormatError
 from reliefkit.io import rk as formats
@@ -212,14 +213,22 @@ def consistent_array(path: Path, name: str, arr: np.ndarray) -> None:
 
 
 def fails(path, *patterns: str, **kw) -> str:
-    """Assert that loading raises FormatError naming the file and matching every pattern."""
-    with pytest.raises(FormatError) as info:
-        formats.load(path, **kw)
-    msg = str(info.value)
+    """Assert that loading raises FormatError naming the file and matching every pattern,
+    and that loading the file's bytes raises the same one line naming "the .rk bytes"."""
+    msg = load_error(path, **kw)
     assert str(path) in msg and "\n" not in msg
     for pattern in patterns:
         assert re.search(pattern, msg), msg
+    if Path(path).is_file():
+        in_memory = load_error(Path(path).read_bytes(), **kw)
+        assert in_memory == msg.replace(str(path), "the .rk bytes")
     return msg
+
+
+def load_error(source, **kw) -> str:
+    with pytest.raises(FormatError) as info:
+        formats.load(source, **kw)
+    return str(info.value)
 
 
 def assert_same_arrays(a: dict, b: dict) -> None:
@@ -257,6 +266,40 @@ def test_rk_bytes_are_the_bytes_save_writes(tmp_path, textured):
     path = formats.save(tmp_path / "m.rk", mesh, source_hash=SOURCE_HASH, cache_key=key)
     assert formats.rk_bytes(mesh, source_hash=SOURCE_HASH, cache_key=key) == path.read_bytes()
     assert formats.read_manifest(path)["cache_key"] == key
+
+
+@pytest.mark.parametrize("rep", [make_mesh(textured=True), make_bag()], ids=["mesh", "bag"])
+def test_the_bytes_load_as_the_file_does(tmp_path, rep):
+    """What a batch worker returns reads back without a file: bytes, bytearray, memoryview
+    or a binary file object, through every reader and the public load."""
+    data = formats.rk_bytes(rep, source_hash=SOURCE_HASH)
+    path = formats.save(tmp_path / "x.rk", rep, source_hash=SOURCE_HASH)
+    from_file = formats.read_rk(path)
+    for source in (data, bytearray(data), memoryview(data), io.BytesIO(data)):
+        assert formats.read_manifest(source) == formats.read_manifest(path)
+        in_memory = formats.read_rk(source)
+        assert in_memory.manifest == from_file.manifest
+        assert_same_arrays(in_memory.arrays, from_file.arrays)
+    for back in (formats.load(data), reliefkit.load(data)):
+        assert type(back) is type(rep)
+        assert_same_arrays(arrays_of(back), arrays_of(formats.load(path)))
+
+
+def test_a_file_object_is_named_by_its_path_and_left_open(tmp_path):
+    path = rk_file(tmp_path)
+    rewrite(path, manifest=lambda man: man.update(kind="hologram"))
+    with open(path, "rb") as fh:
+        with pytest.raises(FormatError, match=f"^{re.escape(str(path))}: .*unknown kind"):
+            formats.load(fh)
+        assert not fh.closed
+    with open(path) as text, pytest.raises(FormatError, match="opened in binary mode"):
+        formats.load(text)
+
+
+def arrays_of(rep) -> dict:
+    """A representation's arrays as its codec saves them."""
+    arrays, _ = formats.codec_of(rep).to_arrays(rep)
+    return {name: np.asarray(a) for name, a in arrays.items() if a is not None}
 
 
 def test_the_cache_key_is_written_only_when_given(tmp_path):

@@ -7,13 +7,16 @@ from __future__ import annotations
 from ..core import params as options
 from ..core.technique import baker
 from ..errors import UsageError
+from ..gl.context import using
 
 
-def bake(source, kind: str, *, progress=None, compress=None, **params):
+def bake(source, kind: str, *, ctx=None, progress=None, compress=None, **params):
     """Bake a RenderMesh (or a 2D height array) into the representation ``kind``.
 
     ``params`` are the baker's typed parameters (``reliefkit bake --help`` lists them per
-    kind); an unknown or invalid one is a UsageError. ``compress``: a
+    kind); an unknown or invalid one is a UsageError. ``ctx``: a moderngl context
+    (`reliefkit.gl.context.create_context`) every GL call of the bake runs on, instead of
+    the process-wide one (which is then never made): a batch worker's own. ``compress``: a
     `reliefkit.compact.compact.CompressOptions` (or its fields as a dict); with
     ``compress="bc"`` the result is `compress`-ed, whatever the kind.
     """
@@ -29,7 +32,8 @@ def bake(source, kind: str, *, progress=None, compress=None, **params):
                          f"{source_kind}")
     values = options.make(chosen.params, params, f"bake --as {kind}")
     how = bake_compression(compress)
-    rep = chosen.bake(source, values, progress)
+    with using(ctx):  # the bakers' GL users all ask `get_context()` (see `using`)
+        rep = chosen.bake(source, values, progress)
     return compressed(rep, how) if how.compress == "bc" else rep
 
 

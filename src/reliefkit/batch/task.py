@@ -2,11 +2,12 @@
 
 `run_task(task)` takes and returns plain picklable data: the task carries the mesh file's
 bytes and those of the files it references by relative name, so a worker needs no shared
-file system (it unpacks them into a private temporary folder and loads the mesh from
-there). A bad asset is a failed `Result` with its one-line error, never an exception.
+file system (`reliefkit.io.meshes.load_mesh_bytes` loads them). A bad asset is a failed
+`Result` with its one-line error, never an exception.
 A worker process is prepared once (`prepare_worker`): its Mesa thread count and EGL device
-are set before its GL context exists, which it then makes once and keeps
-(`reliefkit.gl.context.get_context`).
+are set before its GL context exists, which it then makes on its first task and keeps; every
+task bakes on it explicitly (`reliefkit.gl.context.using`), the process-wide context is
+never made.
 """
 
 from __future__ import annotations
@@ -15,11 +16,10 @@ import contextlib
 import hashlib
 import io
 import os
-import tempfile
 import time
 import warnings
 from dataclasses import dataclass, field
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 
 from ..bake import bake
 from ..demo import tile_image
@@ -28,6 +28,8 @@ from ..gl import context as gl_context
 from ..io.rk import rk_bytes
 from .jobs import Job
 from .key import cache_key, read_sources, split_options
+
+_context = None  # this worker's GL context (`_worker_context`)
 
 
 @dataclass(frozen=True)
@@ -80,7 +82,7 @@ def prepare_worker(setup=None, *, threads: int | None = None,
     ``CUDA_VISIBLE_DEVICES``); then ``setup()`` (the composition root's ``registry``: the
     kinds a task may name); the mesh loader is imported now, so an asset's time (and
     ``--timeout``) is its own."""
-    if gl_context.has_context():
+    if gl_context.has_context() or _context is not None:
         raise UsageError("prepare_worker must run before this process makes its GL context")
     if threads is not None:
         count = str(max(1, int(threads)))
@@ -95,11 +97,9 @@ def prepare_worker(setup=None, *, threads: int | None = None,
 def run_task(task: Task) -> Result:
     """Bake ``task`` in this (prepared) process; never raises for a bad asset."""
     start = time.perf_counter()
-    folder = ""
     try:
-        with tempfile.TemporaryDirectory(prefix="reliefkit-task-") as folder, \
-                _recorded_warnings() as caught:
-            mesh, rep, notes = _bake(task, Path(folder))
+        with _recorded_warnings() as caught, gl_context.using(_worker_context()):
+            mesh, rep, notes = _bake(task)
             source_hash = hashlib.sha256(task.source).hexdigest()
             data = rk_bytes(rep, source_hash=source_hash, cache_key=task.key)
             glb = _export(rep, source_hash, task.key) if task.export_glb else None
@@ -107,18 +107,26 @@ def run_task(task: Task) -> Result:
             pictures = _thumbnails(mesh, rep, task.thumbnails, task.key) if task.thumbnails \
                 else ()
     except ReliefkitError as exc:
-        return _failed(task, start, _in_words(str(exc), task, folder))
+        return _failed(task, start, str(exc))
     except MemoryError:
         return _failed(task, start, "ran out of memory while baking it")
     except Exception as exc:  # noqa: BLE001 - a bug meets one asset: the batch goes on
         detail = " ".join(str(exc).split())[:200]
-        return _failed(task, start, f"internal error ({type(exc).__name__}: "
-                                    f"{_in_words(detail, task, folder)})")
+        return _failed(task, start, f"internal error ({type(exc).__name__}: {detail})")
     notes += [f"warning: {w.message}" for w in caught]
     notes += [line for line in figures if line.startswith("warning:")]
     return Result(task.output, "ok", time.perf_counter() - start, data, glb,
                   tuple(line for line in figures if not line.startswith("warning:")),
-                  tuple(_in_words(w, task, folder) for w in notes), thumbnails=pictures)
+                  tuple(" ".join(w.split()) for w in notes), thumbnails=pictures)
+
+
+def _worker_context():
+    """This worker's own GL context: made on its first task (after `prepare_worker` set its
+    EGL device and threads; one that cannot be made fails that task in one line) and kept."""
+    global _context
+    if _context is None:
+        _context = gl_context.create_context()
+    return _context
 
 
 @contextlib.contextmanager
@@ -132,18 +140,12 @@ def _recorded_warnings():
         yield caught
 
 
-def _bake(task: Task, folder: Path):
-    """The mesh unpacked into ``folder`` under its own names, loaded and baked."""
-    from ..io.meshes import load_mesh  # trimesh: slow to import
+def _bake(task: Task):
+    """The task's mesh loaded from its bytes (messages name it in the user's folder) and
+    baked."""
+    from ..io.meshes import load_mesh_bytes  # trimesh: slow to import
 
-    for name, data in {**task.files, task.name: task.source}.items():
-        relative = PurePosixPath(name)
-        if relative.is_absolute() or ".." in relative.parts:  # never outside the folder
-            raise UsageError(f"the task names a file outside its folder: {name!r}")
-        path = folder.joinpath(*relative.parts)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(data)
-    mesh = load_mesh(folder / task.name)
+    mesh = load_mesh_bytes(str(Path(task.folder, task.name)), task.source, task.files)
     notes = [f"warning: {' '.join(str(w).split())}" for w in mesh.extra.get("warnings", ())]
     params, compression = split_options(task.kind, task.options, task.where)
     return mesh, bake(mesh, task.kind, compress=compression, **params), notes
@@ -179,12 +181,3 @@ def failed(task: Task, error: str, seconds: float = 0.0) -> Result:
     """A failed result whose one line names the asset (a loader's message already does)."""
     named = error if task.name in error else f"{task.where}: {error}"
     return Result(task.output, "failed", seconds, error=" ".join(named.split()))
-
-
-def _in_words(text: str, task: Task, folder: str) -> str:
-    """A message with the worker's temporary folder replaced by the asset's own, on one
-    line."""
-    if folder:
-        own = "" if task.folder in ("", ".") else task.folder + os.sep
-        text = text.replace(folder + os.sep, own).replace(folder, task.folder or ".")
-    return " ".join(text.split())

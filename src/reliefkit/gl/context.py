@@ -1,12 +1,14 @@
 """The one place an OpenGL context is made: headless EGL by default, probed and cached.
 
-``get_context()`` returns a process-wide moderngl context (GL >= 4.3 core). Set
-``RELIEFKIT_GL_BACKEND`` to another glcontext backend name (for example ``x11``) to use a
-window system instead of EGL.
+``get_context()`` returns the context GL work runs on: a process-wide moderngl context
+(GL >= 4.3 core), made on first use, unless a caller's own context is in force in this
+thread (`using`). Set ``RELIEFKIT_GL_BACKEND`` to another glcontext backend name (for
+example ``x11``) to use a window system instead of EGL.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 
@@ -15,13 +17,18 @@ from ..errors import GPUError
 REQUIRED_VERSION = 430
 _lock = threading.Lock()
 _context = None
+_local = threading.local()  # .stack: the contexts `using` put in force in this thread
 
 # Debian packages that provide EGL + Mesa's software rasterizer (llvmpipe).
 EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri"
 
 
 def create_context(backend: str | None = None):
-    """Create a new standalone moderngl context, raising GPUError with advice on failure."""
+    """Create a new standalone moderngl context, raising GPUError with advice on failure.
+
+    The driver makes a new context current; the context in force (`get_context`), if there
+    is one, is made current again, so making a context for later (`using`, ``bake(ctx=)``)
+    never moves the process-wide one's GL calls onto it."""
     import moderngl
 
     backend = backend or os.environ.get("RELIEFKIT_GL_BACKEND", "egl")
@@ -34,11 +41,18 @@ def create_context(backend: str | None = None):
             f"context through {backend} ({detail}); on Debian install: "
             f"sudo apt-get install -y {EGL_PACKAGES}"
         ) from None
+    in_force = _in_force()
+    if in_force is not None:
+        in_force.__enter__()
     return ctx
 
 
 def get_context():
-    """The shared process-wide context, created on first use."""
+    """The context of the innermost `using` in this thread, else the shared process-wide
+    one, created on first use."""
+    in_force = _in_force()
+    if in_force is not None:
+        return in_force
     global _context
     with _lock:
         if _context is None:
@@ -46,9 +60,51 @@ def get_context():
         return _context
 
 
+@contextlib.contextmanager
+def using(ctx):
+    """Run the GL work inside on ``ctx``: `get_context()` returns it in this thread and it
+    is made current; on exit (on error too) the context in force before is current again.
+    ``ctx=None`` changes nothing (the context in force stays, or is made when first asked).
+
+    Every GL user (bakers, the voxelizer, `Scene`) gets its context from `get_context()`
+    unless handed one, so this one override reaches all of them without a parameter
+    threaded through each baker; nestable, and thread-local as a current GL context is.
+    Nothing caches GL objects outside their context (programs and helpers live in
+    ``ctx.extra``), so contexts never share them.
+    """
+    if ctx is None:
+        yield None
+        return
+    stack = _local.__dict__.setdefault("stack", [])
+    stack.append(ctx)
+    try:
+        ctx.__enter__()  # GL calls go to the current context, whichever object makes them
+        yield ctx
+    finally:
+        stack.pop()
+        _make_current_again(ctx)
+
+
+def _make_current_again(left) -> None:
+    """After ``left``'s `using`: the context in force before it is current again; with none
+    (no outer `using`, no process-wide context yet) nothing is."""
+    outer = _in_force()
+    if outer is None:
+        left.__exit__(None, None, None)
+    else:
+        outer.__enter__()
+
+
+def _in_force():
+    """What `get_context` returns in this thread without making anything: the innermost
+    `using` context, else the process-wide one, else None."""
+    stack = getattr(_local, "stack", None)
+    return stack[-1] if stack else _context
+
+
 def has_context() -> bool:
     """Whether this process has made its shared context (a batch worker sets its EGL device
-    and thread count before)."""
+    and thread count before; work inside `using` never makes it)."""
     return _context is not None
 
 

@@ -26,7 +26,6 @@ import io
 import itertools
 import json
 import math
-import os
 import re
 import struct
 import zipfile
@@ -559,10 +558,11 @@ def check_finite_arrays(codec: Codec, arrays: Mapping[str, np.ndarray]) -> None:
 
 @dataclass(frozen=True)
 class _Archive:
-    """An open .rk: its zip directory, the file it was read from and that file's size."""
+    """An open .rk: its zip directory, the binary file (or bytes) it was read from and that
+    file's size."""
 
     zf: zipfile.ZipFile
-    fh: io.BufferedReader
+    fh: io.BufferedIOBase
     size: int
 
 
@@ -603,12 +603,14 @@ class _Member:
         return math.prod(self.array_shape) * dtype.itemsize
 
 
-def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None = None):
-    """Read an .rk file and rebuild its representation.
+def load(source, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None = None):
+    """Read an .rk file (or its bytes) and rebuild its representation.
 
     Parameters
     ----------
-    path : the .rk file.
+    source : the .rk file's path; or the bytes `rk_bytes` returns (bytes, bytearray,
+        memoryview) or a seekable binary file object holding them, read with the same
+        checks (a batch worker's result needs no file system).
     max_bytes : refuse files whose arrays declare more bytes than this in total
         (uncompressed, as the arrays will be in memory).
     codecs : the kinds known (default: the table handed to `use_codecs`).
@@ -616,12 +618,12 @@ def load(path, *, max_bytes: int = DEFAULT_MAX_BYTES, codecs: CodecTable | None 
     Raises
     ------
     FormatError : the file is missing, malformed, forged, corrupt or of an unknown kind, or
-        the representation rejects its data (the message names the file).
+        the representation rejects its data (the message names the file, or "the .rk
+        bytes").
     """
-    path = Path(path)
     codecs = _table(codecs)
-    rk = read_rk(path, max_bytes=max_bytes, codecs=codecs)
-    return build(codecs.for_kind(rk.kind), rk.arrays, rk.params, path)
+    rk = read_rk(source, max_bytes=max_bytes, codecs=codecs)
+    return build(codecs.for_kind(rk.kind), rk.arrays, rk.params, _named(source))
 
 
 def build(codec: Codec, arrays: Mapping[str, np.ndarray], params: dict, where):
@@ -636,28 +638,30 @@ def build(codec: Codec, arrays: Mapping[str, np.ndarray], params: dict, where):
                           "forged") from exc
 
 
-def read_manifest(path, *, codecs: CodecTable | None = None) -> dict:
-    """The manifest of an .rk file, after every check that needs no array data.
+def read_manifest(source, *, codecs: CodecTable | None = None) -> dict:
+    """The manifest of an .rk file (or its bytes, as `load` takes them), after every check
+    that needs no array data.
 
     The manifest, the zip directory and every ``.npy`` header are validated; array data and
     checksums are not read (beyond the first few KiB of each member), so this is cheap for
     any file size.
     """
-    with _open_rk(path) as archive:
+    with _open_rk(source) as archive:
         manifest, _, _ = _inspect(archive, None, _table(codecs))
     return manifest
 
 
-def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES,
+def read_rk(source, *, max_bytes: int = DEFAULT_MAX_BYTES,
             codecs: CodecTable | None = None) -> RkFile:
-    """Validate an .rk file completely and return its arrays without building the object.
+    """Validate an .rk file (or its bytes, as `load` takes them) completely and return its
+    arrays without building the object.
 
     Checks run before any array is allocated: zip directory and local headers, manifest,
     kind, member set, compression method, ``.npy`` headers, declared sizes against the zip
     directory's sizes and `max_bytes`. Then each member is streamed into its array with its
     SHA-256 and CRC-32 verified and its length exact, and finite-required arrays are checked.
     """
-    with _open_rk(path) as archive:
+    with _open_rk(source) as archive:
         manifest, codec, members = _inspect(archive, max_bytes, _table(codecs))
         arrays = {name: _decoded(_read_member(archive, name, m), m.encoding)
                   for name, m in members.items()}
@@ -666,32 +670,58 @@ def read_rk(path, *, max_bytes: int = DEFAULT_MAX_BYTES,
 
 
 @contextlib.contextmanager
-def _open_rk(path):
-    """Open the file and its zip directory; prefix every FormatError with the path and map
-    zip/IO errors. Members are read from the same open file as the directory."""
-    path = Path(path)
-    if not path.is_file():
-        why = "is not a file" if path.exists() else "no such file"
-        raise FormatError(f"{path}: {why}")  # as the mesh and heightmap loaders say it
+def _open_rk(source):
+    """Open the file (or wrap the bytes) and its zip directory; prefix every FormatError
+    with what `_named` calls it and map zip/IO errors. Members are read from the same open
+    file as the directory."""
+    where = _named(source)
     try:
-        fh = open(path, "rb")  # noqa: SIM115 - closed below, after the yield
-    except OSError as exc:
-        raise FormatError(f"{path}: cannot read ({exc.strerror or exc}); check the path and "
-                          "its permissions") from None
-    try:
-        with fh:
+        with _binary(source) as fh:
             if not zipfile.is_zipfile(fh):
                 raise FormatError("not a .rk file (not a zip archive, or truncated); "
                                   "re-create it with reliefkit")
-            size = os.fstat(fh.fileno()).st_size
+            size = fh.seek(0, io.SEEK_END)
             with zipfile.ZipFile(fh) as zf:
                 yield _Archive(zf, fh, size)
     except FormatError as exc:
-        raise FormatError(f"{path}: {exc}") from None
+        raise FormatError(f"{where}: {exc}") from None
     except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError,
             NotImplementedError) as exc:
-        raise FormatError(f"{path}: the zip is corrupt or truncated ({exc}); re-create it "
+        raise FormatError(f"{where}: the zip is corrupt or truncated ({exc}); re-create it "
                           "with reliefkit") from exc
+
+
+def _named(source) -> str:
+    """What messages call ``source``: its path, or the bytes or stream (never their
+    content)."""
+    if isinstance(source, bytes | bytearray | memoryview):
+        return "the .rk bytes"
+    if hasattr(source, "read"):
+        name = getattr(source, "name", None)  # an open file says its own path
+        return name if isinstance(name, str) else "the .rk stream"
+    return str(Path(source))
+
+
+def _binary(source):
+    """A context manager of a seekable binary file holding the .rk: the bytes wrapped, a
+    caller's file object as it is (left open), a path opened (closed on exit). What cannot
+    be read is a FormatError without the prefix `_open_rk` adds."""
+    if isinstance(source, bytes | bytearray | memoryview):
+        return contextlib.nullcontext(io.BytesIO(source))
+    if hasattr(source, "read"):
+        seekable = getattr(source, "seekable", None)
+        if isinstance(source, io.TextIOBase) or seekable is None or not seekable():
+            raise FormatError("needs the bytes or a seekable file object opened in binary "
+                              "mode ('rb')")
+        return contextlib.nullcontext(source)
+    path = Path(source)
+    if not path.is_file():
+        raise FormatError("is not a file" if path.exists() else "no such file")
+    try:
+        return open(path, "rb")  # noqa: SIM115 - the caller's with closes it
+    except OSError as exc:
+        raise FormatError(f"cannot read ({exc.strerror or exc}); check the path and its "
+                          "permissions") from None
 
 
 def _inspect(archive: _Archive, max_bytes: int | None, codecs: CodecTable):

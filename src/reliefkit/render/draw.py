@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import UsageError
-from ..gl.context import get_context
+from ..gl.context import get_context, using
 from ..gl.targets import check_msaa, draw_passes
 from ..scene.light import DirectionalLight
 from .executor import Executor
@@ -26,7 +26,9 @@ from .registry import make_drawables
 
 
 class Scene:
-    """``objects`` as drawables with ``options`` routed by name, uploaded once into ``ctx``;
+    """``objects`` as drawables with ``options`` routed by name, uploaded once into ``ctx``
+    (default: the context in force, `get_context`; one handed in must be current while the
+    scene uploads and draws: inside `reliefkit.gl.context.using`, as `render` does);
     `frame(camera)` draws them. With ``instances`` ((N, 5) placements, `render.instancing`)
     each object is drawn at every placement, one draw call per plan. Use it as a context
     manager (or call `release`)."""
@@ -122,7 +124,9 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
     edge pixels get the covered fraction as alpha, every AOV stays single-sample, and
     transparent objects are composited single-sample over it. ``instances`` ((N, 5)
     placements) draws each object at every placement in one draw call per plan
-    (`render.instancing`; `NotInstanceable` says why an object cannot be).
+    (`render.instancing`; `NotInstanceable` says why an object cannot be). ``ctx``: a
+    moderngl context to draw on instead of the process-wide one (made current for the
+    draw, `reliefkit.gl.context.using`).
     """
     several = not hasattr(camera, "size")  # a list, tuple or any iterable of cameras
     try:
@@ -132,11 +136,12 @@ def render(obj, camera, *, light=None, ctx=None, count_iterations: bool = False,
                          f"{type(camera).__name__}") from None
     if not cameras or not all(hasattr(c, "size") for c in cameras):
         raise UsageError("render needs a camera or a non-empty list of cameras")
-    ctx = ctx or get_context()
-    check_msaa(ctx, msaa)
-    with Scene(obj, ctx=ctx, count_iterations=count_iterations, instances=instances,
-               **options) as scene:
-        frames = [scene.frame(cam, light, msaa=msaa) for cam in cameras]
+    with using(ctx):  # a given context made current for the draw, the one before after
+        ctx = get_context()
+        check_msaa(ctx, msaa)
+        with Scene(obj, ctx=ctx, count_iterations=count_iterations, instances=instances,
+                   **options) as scene:
+            frames = [scene.frame(cam, light, msaa=msaa) for cam in cameras]
     return frames if several else frames[0]
 
 

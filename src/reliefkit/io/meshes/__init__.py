@@ -1,4 +1,5 @@
-"""`load_mesh`: read OBJ, PLY, STL, OFF, glTF and GLB files into one `RenderMesh`.
+"""`load_mesh`: read OBJ, PLY, STL, OFF, glTF and GLB files into one `RenderMesh`;
+`load_mesh_bytes`: the same from their bytes (unpacked privately by :mod:`.unpack`).
 
 Parsing is trimesh's, quietly (:mod:`.parse`); this package adds what a renderer needs on top
 of it: a structural check per format before parsing (:mod:`.obj`, which also triangulates
@@ -17,6 +18,7 @@ import gc
 import logging
 import os
 import warnings
+from collections.abc import Mapping
 from pathlib import Path
 
 from ...errors import MeshError
@@ -34,8 +36,10 @@ from .ply import check_ply
 from .scene import MAX_COORDINATE, check_visible, scene_parts
 from .stl import binary_stl, check_stl
 from .texture_transform import uv_transforms
+from .unpack import renamed, unpacked
 
-__all__ = ["MAX_COORDINATE", "MAX_FILE_BYTES", "SUPPORTED_EXTENSIONS", "load_mesh"]
+__all__ = ["MAX_COORDINATE", "MAX_FILE_BYTES", "SUPPORTED_EXTENSIONS", "load_mesh",
+           "load_mesh_bytes"]
 
 #: File name extensions `load_mesh` reads (lower case, with the dot).
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".gltf", ".glb")
@@ -113,6 +117,50 @@ def load_mesh(path: str | os.PathLike, *, name: str | None = None) -> RenderMesh
         raise MeshError(
             f"{path}: could not be read ({type(exc).__name__}: {detail}); is it corrupt?"
         ) from exc  # the cause kept for a traceback (RELIEFKIT_DEBUG)
+
+
+def load_mesh_bytes(file_name: str, data, files: Mapping[str, bytes] | None = None, *,
+                    name: str | None = None) -> RenderMesh:
+    """`load_mesh` of a file given as bytes: what a worker without the caller's file system
+    (a batch task) loads.
+
+    Parameters
+    ----------
+    file_name : str
+        The mesh file's name: its suffix picks the format, and every message and warning
+        names it (with the folder it may carry, as "lib/chair.obj": then the referenced
+        files' too), never the private folder the bytes are unpacked into.
+    data : bytes, bytearray or memoryview
+        The file's bytes.
+    files : mapping, optional
+        The files it references (.mtl, textures, glTF buffers and images) by their name
+        relative to its folder, POSIX separators ("textures/wood.png"), with their bytes:
+        what `referenced_files` lists. One named outside the folder (absolute, ``..``) is
+        refused.
+    name : str, optional
+        As `load_mesh`'s (default: the file name without its extension).
+
+    Returns
+    -------
+    RenderMesh
+        The mesh `load_mesh` reads from those files on disk, the same arrays and warnings
+        (``extra["source"]`` is ``file_name``).
+
+    Raises
+    ------
+    MeshError
+        What `load_mesh` raises for those files, naming ``file_name``; a name in ``files``
+        outside the folder; a file that cannot be unpacked (a full disk).
+    """
+    with unpacked(file_name, data, files or {}) as path:
+        try:
+            mesh = load_mesh(path, name=name or Path(file_name).stem)
+        except MeshError as exc:
+            raise MeshError(renamed(str(exc), path, file_name)) from exc
+        mesh.extra["source"] = str(file_name)
+        if "warnings" in mesh.extra:
+            mesh.extra["warnings"] = [renamed(w, path, file_name) for w in mesh.extra["warnings"]]
+    return mesh
 
 
 @contextlib.contextmanager
