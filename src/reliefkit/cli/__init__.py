@@ -80,8 +80,10 @@ def _parse_and_run(argv: list[str] | None) -> int:
 def _one_line_warnings():
     """Python warnings become one ``warning: ...`` line each; numpy's floating-point
     RuntimeWarnings (overflow, invalid value) are silenced: bad values are refused by the
-    checks that follow them, with their own one-line error. Deprecations are silenced;
-    PIL's DecompressionBombWarning stays (one line)."""
+    checks that follow them, with their own one-line error. Deprecations are silenced, and
+    ResourceWarnings (a file a library's import left open when Ctrl-C cut it short: a
+    line before "error: interrupted" a user can do nothing with); PIL's
+    DecompressionBombWarning stays (one line)."""
     def show(message, category, filename, lineno, file=None, line=None):
         text = " ".join(str(message).split())
         print(f"warning: {text}", file=sys.stderr)
@@ -90,6 +92,7 @@ def _one_line_warnings():
         warnings.simplefilter("default")
         warnings.filterwarnings("ignore", category=DeprecationWarning)
         warnings.filterwarnings("ignore", category=PendingDeprecationWarning)
+        warnings.filterwarnings("ignore", category=ResourceWarning)
         warnings.filterwarnings("ignore", category=RuntimeWarning)
         # ... but PIL's DecompressionBombWarning (a RuntimeWarning) matters: one line
         warnings.filterwarnings("default", message=r"Image size \(", category=RuntimeWarning)
