@@ -244,6 +244,7 @@ def test_a_cluster_with_token_authentication_is_one_line_that_says_so(
     token = "7f" * 32
     plain = {k: v for k, v in os.environ.items() if not k.startswith("RAY_AUTH")}
     plain["HOME"] = str(tmp_path)  # no ~/.ray/auth_token
+    plain["RAY_NUM_REDIS_GET_RETRIES"] = "2"  # Ray retries the connection for 2 s, not 20
     secured = {**plain, "RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": token}
     temp = tempfile.mkdtemp(prefix="rk-ray-", dir="/tmp")  # its sockets: short paths
     head = subprocess.Popen([sys.executable, "-c", TOKEN_CLUSTER, temp], env=secured,
