@@ -111,6 +111,7 @@ def test_force_rebakes_what_is_up_to_date(library, tmp_path):
 @pytest.mark.parametrize("extra, words", [
     (["--executor", "ray", "--max-memory", "1GB"], "--max-memory is not available with"),
     (["--max-memory", "lots"], "--max-memory takes a byte count"),
+    (["--max-memory", "1"], "--max-memory 1 is below 256 MiB"),  # failed assets by the clock
     (["--workers", "0"], "--workers must be at least 1"),
     (["--timeout", "0"], "--timeout must be a positive"),
     (["--epsilon", "0.1"], "--epsilon does not apply to"),
@@ -123,6 +124,21 @@ def test_bad_arguments_are_one_line(library, tmp_path, capsys, extra, words):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], err
     assert not (tmp_path / "o").exists()  # refused before anything was made
+
+
+def test_the_api_takes_max_memory_as_text_and_refuses_what_the_cli_refuses(library, tmp_path):
+    """max_memory="1GB" (the CLI's form) was a TypeError after the workers started, and -5
+    failed every asset "over --max-memory -0 MiB"."""
+    from reliefkit import batch
+    from reliefkit.errors import UsageError
+
+    report = batch(library / "b.obj", "relief", tmp_path / "out", depth_res=10,
+                   max_memory="1GB", progress=False)
+    assert [r.status for r in report.records] == ["ok"]
+    for bad in (-5, "-5MB", 0, 1.5, "lots"):
+        with pytest.raises(UsageError, match="--max-memory takes a byte count"):
+            batch(library / "b.obj", "relief", tmp_path / "o2", max_memory=bad, progress=False)
+    assert not (tmp_path / "o2").exists()
 
 
 def test_an_output_over_an_input_is_refused(library, tmp_path, capsys):

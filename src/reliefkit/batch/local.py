@@ -20,9 +20,11 @@ from collections.abc import Callable, Iterable
 from multiprocessing.connection import wait
 
 from ..errors import UsageError
+from ..units import parse_bytes
 from .task import Result, Task, failed, prepare_worker, run_task
 
 POLL_SECONDS = 0.2
+MIN_MAX_MEMORY = 256 * 2**20  # a worker holds 114-121 MiB before its first bake (measured)
 UNGUARDED_EXIT = 87  # a worker that found its parent's script calling batch as it started
 UNGUARDED_SCRIPT = ("batch ran again in each worker process as it started: a worker imports the "
                     "script that calls it, so call batch under `if __name__ == \"__main__\":` "
@@ -55,17 +57,34 @@ def check_limits(workers: int | None, timeout: float | None) -> None:
         raise UsageError(f"--timeout must be a positive number of seconds, got {timeout}")
 
 
+def memory_limit(value) -> int | None:
+    """``--max-memory`` in bytes: an int, or text such as ``2GB`` or ``512MB``
+    (`units.parse_bytes`); a limit a worker passes before baking anything (below
+    `MIN_MAX_MEMORY`) would fail assets by the clock, so it is refused up front."""
+    if value is None:
+        return None
+    limit = value if isinstance(value, int) and not isinstance(value, bool) else \
+        parse_bytes(value) if isinstance(value, str) else None
+    if limit is None or limit <= 0:
+        raise UsageError(f"--max-memory takes a byte count such as 2GB or 512MB, got {value!r}")
+    if limit < MIN_MAX_MEMORY:
+        raise UsageError(f"--max-memory {value} is below {MIN_MAX_MEMORY // 2**20} MiB: a worker "
+                         "holds about 120 MiB before it bakes anything; give at least that")
+    return limit
+
+
 class LocalExecutor:
     """Runs tasks in ``workers`` processes (default: the cores) on this machine.
 
     ``setup`` is called once in each worker before its first task (the composition root's
-    ``registry``); ``timeout`` (seconds) and ``max_memory`` (bytes) limit each asset."""
+    ``registry``); ``timeout`` (seconds) and ``max_memory`` (bytes, or text such as
+    ``"4GB"``: `memory_limit`) limit each asset."""
 
     def __init__(self, workers: int | None = None, *, timeout: float | None = None,
                  max_memory: int | None = None, setup: Callable | None = None) -> None:
         check_limits(workers, timeout)
         self.workers = workers or cores()
-        self.timeout, self.max_memory, self.setup = timeout, max_memory, setup
+        self.timeout, self.max_memory, self.setup = timeout, memory_limit(max_memory), setup
 
     def run(self, tasks: Iterable[Task], count: int,
             on_result: Callable[[Task, Result], None]) -> None:

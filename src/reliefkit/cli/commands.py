@@ -47,7 +47,7 @@ from ..scene.views import (
     turntable,
 )
 from ..shootout import load_meshes, parse_budgets, parse_kinds, parse_sizes, shootout
-from ..units import format_bytes, parse_bytes
+from ..units import format_bytes
 from ..viewer import server as view_server
 from ..viewer import site as view_site
 from ..viewer.variants import Variants
@@ -140,16 +140,10 @@ def cmd_bake(args) -> int:
 
 
 def cmd_batch(args) -> int:
-    max_memory = None
-    if args.max_memory is not None:
-        max_memory = parse_bytes(args.max_memory)
-        if not max_memory:
-            raise UsageError(f"--max-memory takes a byte count such as 2GB or 512MB, got "
-                             f"{args.max_memory!r}")
     try:
         report = batch(args.inputs, args.kind, args.out, args.executor, workers=args.workers,
                        force=args.force, export=args.export, timeout=args.timeout,
-                       max_memory=max_memory, address=args.address, sheet=args.sheet,
+                       max_memory=args.max_memory, address=args.address, sheet=args.sheet,
                        **given_options(args))
     except BatchInterrupted as stopped:
         done = stopped.report
