@@ -262,6 +262,13 @@ def test_a_cluster_with_token_authentication_is_one_line_that_says_so(
                                   "token it accepts: run with RAY_AUTH_MODE=token and the "
                                   "cluster's token in ~/.ray/auth_token (or "
                                   "RAY_AUTH_TOKEN_PATH, or RAY_AUTH_TOKEN)\n")
+        # --address auto: the line names the cluster Ray found (it said "at auto")
+        found = subprocess.run(args[:-1] + ["auto"], env={**plain, "RAY_ADDRESS": address},
+                               capture_output=True, text=True, timeout=180)
+        assert found.returncode == 1
+        assert found.stderr.startswith("error: --executor ray: the Ray cluster --address auto "
+                                       f"found at {address} asks for Ray's token "
+                                       "authentication"), found.stderr
         accepted = subprocess.run(args, env=secured, capture_output=True, text=True,
                                   timeout=180)
         assert accepted.returncode == 0, accepted.stderr

@@ -24,6 +24,7 @@ import contextlib
 import logging
 import math
 import os
+import re
 import socket
 import sys
 import tempfile
@@ -102,7 +103,6 @@ class RayExecutor:
                 raise ReliefkitError(f"--executor ray: could not start a local Ray cluster "
                                      f"({_one_line(exc)})") from None
             return True
-        where = f"the Ray cluster at {self.address}"
         with tempfile.TemporaryFile("w+b") as core_log:
             try:
                 with _native_stderr_to(core_log):
@@ -110,6 +110,7 @@ class RayExecutor:
             except (ConnectionError, RuntimeError, ValueError, ray.exceptions.RayError) as exc:
                 core_log.seek(0)
                 said = core_log.read().decode("utf-8", "replace") + str(exc)
+                where = _cluster_named(self.address, str(exc))
                 if any(word in said for word in AUTH_REFUSED):
                     raise ReliefkitError(f"--executor ray: {where} {AUTH_ADVICE}") from None
                 raise ReliefkitError(f"--executor ray: could not reach {where} "
@@ -204,6 +205,16 @@ def _native_stderr_to(sink):
     finally:
         os.dup2(saved, 2)
         os.close(saved)
+
+
+def _cluster_named(address: str, said: str) -> str:
+    """The cluster an error is about: ``auto`` with the address Ray found for it (RAY_ADDRESS
+    or the last ``ray start`` here; its error names it: ``... Ray cluster at HOST:PORT``),
+    another address as given."""
+    found = re.search(r"Ray cluster at (\S+?)\.?$", said.strip())
+    if address == "auto" and found:
+        return f"the Ray cluster --address auto found at {found.group(1)}"
+    return f"the Ray cluster at {address}"
 
 
 def _one_line(exc: Exception) -> str:
