@@ -20,6 +20,8 @@ import os
 import threading
 
 from .bake import bake as _bake
+from .batch import batch as _batch_of
+from .export import export as _export
 from .core.technique import REGISTRY, Registry
 from .gl import shaders
 from .io import rk
@@ -67,23 +69,16 @@ def _load(source, **kwargs):
     return rk.load(source, **kwargs)
 
 
-def _export(rep, path, **kwargs):
-    from .export import export  # the draw plans' modules: imported when exporting
-
-    return export(rep, path, **kwargs)
-
-
-def _batch(inputs, kind, out, executor="local", **options):
+@functools.wraps(_batch_of)  # help(reliefkit.batch) shows its parameters and docstring
+def _batch(*args, **options):
     """`reliefkit.batch.batch`, each worker given the built-ins (``setup``)."""
-    from .batch import batch  # the process pool's modules: imported when batching
-
     options.setdefault("setup", registry)
-    return batch(inputs, kind, out, executor, **options)
+    return _batch_of(*args, **options)
 
 
 bake = _with_builtins(_bake)
 batch = _with_builtins(_batch)
 load = _with_builtins(_load)
-export = _with_builtins(_export)
+export = _with_builtins(_export)  # help() on each shows the function's own parameters
 render = _with_builtins(_render)
 save = _with_builtins(rk.save)
