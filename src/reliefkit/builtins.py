@@ -21,8 +21,8 @@ import threading
 
 from .bake import bake as _bake
 from .batch import batch as _batch_of
-from .export import export as _export
 from .core.technique import REGISTRY, Registry
+from .export import export as _export
 from .gl import shaders
 from .io import rk
 from .io.gltf import representation as gltf_representation
