@@ -118,7 +118,16 @@ def test_every_job_is_checked_before_anything_is_baked(library, tmp_path):
                       "options": {"depth_res": 12}}) + "\n")
     jobs = expand_inputs([library / "m.jsonl"], "relief", {}, tmp_path / "out")
     with pytest.raises(UsageError, match=r"--depth-res does not apply to .*m\.jsonl:2 "
-                                         r"\(tables/c\.obj\) \(--as billboard-cloud\)"):
+                                         r"\(tables/c\.obj\) \(its manifest row's kind "
+                                         r"billboard-cloud\)[^;]*$"):
+        check_jobs(jobs)  # the row's own option: no word of the command line
+    # the command line's option meets a row whose kind does not take it: said so (the
+    # line said "(--as billboard-cloud)": the kind came from the row)
+    (library / "m.jsonl").write_text(
+        json.dumps({"input": "tables/c.obj", "kind": "billboard-cloud"}) + "\n")
+    jobs = expand_inputs([library / "m.jsonl"], "relief", {"depth_res": 12}, tmp_path / "out")
+    with pytest.raises(UsageError, match=r"\(its manifest row's kind billboard-cloud\).*; the "
+                                         r"command line's options go to every row"):
         check_jobs(jobs)
     jobs = expand_inputs([library / "tables"], "relief", {"depth_res": -3}, tmp_path / "out")
     with pytest.raises(UsageError,

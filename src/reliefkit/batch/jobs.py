@@ -15,7 +15,7 @@ import glob
 import io
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path, PurePosixPath
 
 from ..core.technique import baker
@@ -36,6 +36,8 @@ class Job:
     kind: str
     options: dict
     where: str
+    kind_given_by: str = "--as"  # or "its manifest row's kind" (named in messages)
+    row_options: dict | None = None  # a manifest row's own options (without the command's)
 
 
 def expand_inputs(inputs, kind: str, options: dict, out: Path) -> list[Job]:
@@ -56,7 +58,7 @@ def check_jobs(jobs: list[Job]) -> None:
     """Every job's kind and options checked as `reliefkit bake` checks them: the first bad
     one is a UsageError naming the asset and the option."""
     for job in jobs:
-        what = f"{job.where} (--as {job.kind})"
+        what = f"{job.where} ({job.kind_given_by} {job.kind})"
         try:
             _, chosen = baker(job.kind)
             if "mesh" not in chosen.sources:
@@ -65,8 +67,20 @@ def check_jobs(jobs: list[Job]) -> None:
             canonical_options(job.kind, job.options, what)
         except UsageError as exc:
             message = str(exc)
-            raise UsageError(message if job.where in message else f"{job.where}: {message}") \
-                from None
+            if job.where not in message:
+                message = f"{job.where}: {message}"
+            if job.row_options is not None and _valid(job.kind, job.row_options, what):
+                message += ("; the command line's options go to every row of a manifest: "
+                            "give one only some kinds take in those rows' options")
+            raise UsageError(message) from None
+
+
+def _valid(kind: str, options: dict, what: str) -> bool:
+    try:
+        canonical_options(kind, options, what)
+    except UsageError:
+        return False
+    return True
 
 
 def _add(jobs: dict[str, Job], job: Job) -> None:
@@ -168,7 +182,9 @@ def _manifest_jobs(path: Path, kind: str, options: dict, suffixes):
         row_options = row.get("options") or {}
         if not isinstance(row_kind, str) or not isinstance(row_options, dict):
             raise UsageError(f"{where}: kind must be a string and options a JSON object")
-        yield _job(source, root, row_kind, {**options, **row_options}, f"{where} ({name})")
+        job = replace(_job(source, root, row_kind, {**options, **row_options},
+                           f"{where} ({name})"), row_options=row_options)
+        yield replace(job, kind_given_by="its manifest row's kind") if row.get("kind") else job
 
 
 def _manifest_rows(path: Path):
