@@ -188,3 +188,25 @@ def test_an_out_that_cannot_be_made_is_a_usage_error(library, capsys):
     status = cli.main(["batch", str(library), *RELIEF, "--out", "/proc/reliefkit-batch-out"])
     err = capsys.readouterr().err
     assert status == 2 and err.count("\n") == 1 and "/proc/reliefkit-batch-out" in err, err
+
+
+def test_a_rebake_without_the_export_removes_the_stale_one(library, tmp_path, capsys):
+    """A rerun of other options without --export glb --sheet left the earlier bake's .glb
+    and thumbnails beside the new .rk (and the sheet showing the old kind) silently."""
+    out, source = tmp_path / "out", str(library / "b.obj")
+    assert cli.main(["batch", source, *RELIEF, "--out", str(out), "--export", "glb",
+                     "--sheet"]) == 0
+    (out / "mine.glb").write_bytes((out / "b.glb").read_bytes())  # not beside an asset
+    capsys.readouterr()
+    assert cli.main(["batch", source, "--as", "relief", "--depth-res", "12",
+                     "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert not (out / "b.glb").exists() and not list((out / "thumbnails").glob("*.png"))
+    assert (out / "mine.glb").exists() and (out / "sheet.png").exists()
+    assert "removed 3 file(s) an earlier bake left beside assets baked now" in printed
+    assert f"warning: {out / 'sheet.png'} and index.html are from an earlier run" in printed
+    # a skip removes nothing, and a file reliefkit did not key stays
+    (out / "b.glb").write_bytes(b"not reliefkit's")
+    assert cli.main(["batch", source, "--as", "relief", "--depth-res", "12", "--out", str(out),
+                     "--force"]) == 0
+    assert (out / "b.glb").read_bytes() == b"not reliefkit's"

@@ -44,6 +44,9 @@ class BatchReport:
     total: int = 0
     records: list[AssetRecord] = field(default_factory=list)
     seconds: float = 0.0
+    stale_removed: int = 0       # earlier bakes' .glb and thumbnails beside rebaked assets
+    wrote: tuple = ()            # files besides the outputs (sheet.png, index.html)
+    notes: list[str] = field(default_factory=list)   # lines for the end of the summary
 
     def of(self, status: str) -> list[AssetRecord]:
         return [r for r in self.records if r.status == status]
@@ -84,11 +87,15 @@ class BatchReport:
             written = format_bytes(sum(r.bytes for r in records)) if status == "ok" else "-"
             lines.append(f"{status:<8} {len(records):>7} {seconds:>9} {written:>11}")
         baked = len(self.ok)
-        rate = f", {3600 * baked / self.seconds:.0f} assets/hour" if baked and self.seconds \
+        rate = f", {3600 * baked / self.seconds:.0f} baked per hour" if baked and self.seconds \
             else ""
         lines.append(f"{len(self.records)} of {self.total} assets in {self.seconds:.1f} s"
                      f"{rate}")
         lines += [f"failed: {r.error}" for r in self.failed]
+        if self.stale_removed:
+            lines.append(f"removed {self.stale_removed} file(s) an earlier bake left beside "
+                         "assets baked now (.glb, thumbnails: they showed the old bake)")
+        lines += [f"wrote {path}" for path in self.wrote] + self.notes
         return lines
 
 

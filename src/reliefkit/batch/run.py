@@ -17,7 +17,14 @@ from .jobs import Job, check_jobs, expand_inputs
 from .key import cache_key, read_sources
 from .local import LocalExecutor
 from .report import AssetRecord, BatchInterrupted, BatchReport
-from .sheet import THUMBNAIL_SIZE, thumbnail_key, thumbnail_paths, write_sheet
+from .sheet import (
+    INDEX_NAME,
+    SHEET_NAME,
+    THUMBNAIL_SIZE,
+    thumbnail_key,
+    thumbnail_paths,
+    write_sheet,
+)
 from .task import Result, Task, make_task
 
 EXECUTORS = ("local", "ray")
@@ -62,7 +69,10 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
 
             def finished(task: Task, result: Result) -> None:
                 with _uninterrupted():  # the files and their line, or neither
-                    report.add(_committed(by_output[task.output], task, result, out))
+                    record = _committed(by_output[task.output], task, result, out)
+                    if record.status == "ok":
+                        report.stale_removed += _remove_stale(out, task, result)
+                    report.add(record)
                 advance(len(report.records))
 
             executor.run(_tasks(todo, export, sheet, report, advance), len(todo), finished)
@@ -71,7 +81,11 @@ def run_batch(inputs, kind: str, out, executor, *, force: bool = False,
         raise BatchInterrupted(report) from exc
     report.seconds = time.monotonic() - start
     if sheet:
-        write_sheet(out, report)
+        report.wrote += write_sheet(out, report)
+    elif report.ok and (out / SHEET_NAME).exists():
+        report.notes.append(f"warning: {out / SHEET_NAME} and {INDEX_NAME} are from an earlier "
+                            f"run: they do not show the {len(report.ok)} asset(s) baked now; "
+                            "rerun with --sheet")
     return report
 
 
@@ -160,6 +174,22 @@ def _tasks(jobs: list[Job], export: str | None, sheet: bool, report: BatchReport
             report.add(AssetRecord(job.where, job.output, job.kind, "failed",
                                    error=" ".join(str(exc).split())))
             advance(len(report.records))
+
+
+def _remove_stale(out: Path, task: Task, result: Result) -> int:
+    """Remove the .glb and thumbnails beside a just-baked .rk that an earlier bake made
+    (they hold another cache key) and this one did not write again: left, they showed the
+    old bake beside the new .rk. Files without a key (not reliefkit's) stay. How many."""
+    path = out / task.output
+    stale = []
+    if result.glb is None and stored_cache_key(path.with_suffix(".glb")) not in (None, task.key):
+        stale.append(path.with_suffix(".glb"))
+    if not result.thumbnails:
+        stale += [p for p in thumbnail_paths(out, task.output)
+                  if thumbnail_key(p) not in (None, task.key)]
+    for file in stale:
+        file.unlink(missing_ok=True)
+    return len(stale)
 
 
 def _committed(job: Job, task: Task, result: Result, out: Path) -> AssetRecord:

@@ -52,9 +52,10 @@ def thumbnail_key(path: Path) -> str | None:
     return key if isinstance(key, str) else None
 
 
-def write_sheet(out: Path, report: BatchReport) -> tuple[Path, Path]:
-    """sheet.png and index.html over the assets of ``report`` that have an output (baked now
-    or skipped as up to date), by output path."""
+def write_sheet(out: Path, report: BatchReport) -> tuple[Path, ...]:
+    """sheet.png (when any asset has an output) and index.html over the assets of
+    ``report`` that have one (baked now or skipped as up to date), by output path; the
+    files written."""
     from PIL import Image
 
     shown = sorted((r for r in report.records if r.status != "failed"),
@@ -69,13 +70,14 @@ def write_sheet(out: Path, report: BatchReport) -> tuple[Path, Path]:
     title = f"reliefkit batch: {len(shown)} outputs beside their meshes"
     if len(shown) > SHEET_MAX_ASSETS:
         title += f" (the first {SHEET_MAX_ASSETS}; {INDEX_NAME} lists all)"
-    sheet = out / SHEET_NAME
+    written = []
     if tiles:
-        save_image(contact_sheet(tiles, SHEET_COLUMNS, title=title), sheet)
-    index = out / INDEX_NAME
-    with atomic_path(index) as tmp:
+        written.append(out / SHEET_NAME)
+        save_image(contact_sheet(tiles, SHEET_COLUMNS, title=title), written[-1])
+    written.append(out / INDEX_NAME)
+    with atomic_path(written[-1]) as tmp:
         tmp.write_text(_index_html(out, report, shown), encoding="utf-8")
-    return sheet, index
+    return tuple(written)
 
 
 def _index_html(out: Path, report: BatchReport, shown) -> str:
