@@ -367,3 +367,16 @@ def test_bake_progress_is_plain_lines_off_a_terminal(gl, tmp_path):
     assert lines and lines[-1].startswith("baking relief: ") and "done in" in lines[-1], lines
     assert all(line.startswith("baking relief: ") for line in lines), lines
     assert "\x1b" not in out.stderr and "\r" not in out.stderr
+
+
+def test_what_a_bake_refuses_of_a_file_names_the_file(tmp_path, capsys):
+    """A flat triangle baked as a relief was 'error: the heightfield is empty ...', without
+    the file: in a library's worth of bakes, which one?"""
+    from reliefkit import cli
+
+    mesh = tmp_path / "flat.stl"
+    trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]).export(mesh)
+    assert cli.main(["bake", str(mesh), "--as", "relief", "-o", str(tmp_path / "f.rk")]) == 2
+    err = capsys.readouterr().err
+    assert err == f"error: {mesh}: the heightfield is empty (every height is 0): nothing " \
+                  "visible to render\n"

@@ -26,7 +26,7 @@ from ..compare import compare, metrics_markdown, write_comparison
 from ..core.params import ANIMATION_TIME, applicable, options_of
 from ..core.technique import baker, bakers, technique_of
 from ..demo import build_demo
-from ..errors import FormatError, MeshError, UsageError
+from ..errors import FormatError, MeshError, ReliefkitError, UsageError
 from ..export import export, export_lod
 from ..gl.context import gl_info
 from ..io.atomic import atomic_path, check_writable, written_together
@@ -114,8 +114,13 @@ def _bake_input(args, source=None):
                    if opt.name in given}
     params = applicable(given, chosen.options, f"--as {args.kind}")
     source = _bake_source(args.input) if source is None else source
-    with progress_bar(f"baking {args.kind}", 1) as advance:
-        return bake(source, args.kind, progress=advance, compress=compression, **params)
+    try:
+        with progress_bar(f"baking {args.kind}", 1) as advance:
+            return bake(source, args.kind, progress=advance, compress=compression, **params)
+    except ReliefkitError as exc:  # what the bake refuses of this input: name it
+        if str(args.input) in str(exc):
+            raise
+        raise type(exc)(f"{args.input}: {exc}") from None
 
 
 def cmd_bake(args) -> int:

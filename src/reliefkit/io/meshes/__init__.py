@@ -135,8 +135,9 @@ def load_mesh_bytes(file_name: str, data, files: Mapping[str, bytes] | None = No
     files : mapping, optional
         The files it references (.mtl, textures, glTF buffers and images) by their name
         relative to its folder, POSIX separators ("textures/wood.png"), with their bytes:
-        what `referenced_files` lists. One named outside the folder (absolute, ``..``) is
-        refused.
+        what `reliefkit.io.meshes.references.referenced_files` lists for the file on disk
+        (``{name: path.read_bytes() for name, path in referenced_files(mesh).items()}``).
+        One named outside the folder (absolute, ``..``) is refused.
     name : str, optional
         As `load_mesh`'s (default: the file name without its extension).
 
