@@ -153,15 +153,26 @@ class _PlainLines:
         self.description, self.total, self.stream = description, total, stream
         self.interval, self.eta = interval, eta
         self.start = self.last = time.monotonic()
+        self.first: tuple[float, int] | None = None  # when something was first done, and how much
 
     def advance(self, done: int, total: int | None = None) -> None:
         self.total = total if total is not None else self.total
         now = time.monotonic()
+        if done and self.first is None:
+            self.first = (now, done)
         if now - self.last >= self.interval and done < self.total:
             self.last = now
-            left = (now - self.start) * (self.total - done) / done if done else None
-            shown = f", eta {left:.0f} s" if self.eta and left is not None else ""
+            shown = f", eta {left:.0f} s" if self.eta and (left := self._left(now, done)) \
+                is not None else ""
             self._line(f"{done}/{self.total}{shown}")
+
+    def _left(self, now: float, done: int) -> float | None:
+        """Seconds left at the rate since the first item was done: the start-up before it
+        (a batch's workers starting) made the first estimate ten times too long."""
+        if self.first is None or done <= self.first[1]:
+            return None
+        since, first_done = self.first
+        return (now - since) * (self.total - done) / (done - first_done)
 
     def finish(self) -> None:
         self._line(f"{self.total}/{self.total}, done in {time.monotonic() - self.start:.1f} s")
