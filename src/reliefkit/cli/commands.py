@@ -157,7 +157,7 @@ def cmd_batch(args) -> int:
               "command to go on", file=sys.stderr)
         return EXIT_INTERRUPTED
     for line in report.summary():
-        print(line)
+        print(line, file=sys.stderr if line.startswith("warning:") else sys.stdout)
     print(f"wrote {Path(args.out) / JSONL_NAME}")
     return report.exit_status
 
