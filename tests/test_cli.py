@@ -370,13 +370,13 @@ def test_bake_progress_is_plain_lines_off_a_terminal(gl, tmp_path):
 
 
 def test_what_a_bake_refuses_of_a_file_names_the_file(tmp_path, capsys):
-    """A flat triangle baked as a relief was 'error: the heightfield is empty ...', without
-    the file: in a library's worth of bakes, which one?"""
+    """A flat triangle baked as a relief (edge-on along the default axis) was 'error: the
+    heightfield is empty ...', without the file: in a library's worth of bakes, which one?"""
     from reliefkit import cli
 
     mesh = tmp_path / "flat.stl"
     trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]).export(mesh)
     assert cli.main(["bake", str(mesh), "--as", "relief", "-o", str(tmp_path / "f.rk")]) == 2
     err = capsys.readouterr().err
-    assert err == f"error: {mesh}: the heightfield is empty (every height is 0): nothing " \
-                  "visible to render\n"
+    assert err == f"error: {mesh}: the mesh is flat across z: seen along --axis y it is " \
+                  "edge-on and covers nothing; bake it along --axis z\n"

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from reliefkit import metrics
+from reliefkit.errors import UsageError
 from reliefkit.render import render
 from reliefkit.scene.assets import make_asset
 from reliefkit.scene.mesh import RenderMesh, vertex_normals
@@ -347,3 +348,31 @@ def test_far_tolerance_is_near_over_far_for_a_frustum_and_one_for_a_box():
     box = np.diag([2.0, 0.5, 3.0, 1.0])
     box[:3, 3] = [1.0, 2.0, 3.0]
     assert far_tolerance(box, 0.01) == 0.01
+
+
+def flat_square():
+    """Two triangles in the plane z = 0.3 (a decal, a sign): flat across z."""
+    pos = np.array([[-1, -1, 0.3], [1, -1, 0.3], [1, 1, 0.3], [-1, 1, 0.3]], np.float32)
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    colors = np.tile([0.8, 0.5, 0.2, 1.0], (4, 1)).astype(np.float32)
+    return RenderMesh(pos, faces, vertex_normals(pos, faces), colors, name="sign")
+
+
+@pytest.mark.parametrize("bake", [bake_relief, bake_relief_frustum])
+def test_a_flat_mesh_bakes_along_its_normal_and_is_refused_edge_on(gl, bake):
+    """A flat mesh's box was 1e-9 deep: its heights were lost to float precision and the
+    bake was refused as "the heightfield is empty" (--axis z too), or a frustum's near plane
+    came out negative; edge-on (the default --axis y) it was the same line, saying nothing of
+    why. Now the box is at least 1/1000 of the footprint deep, and edge-on names the axis."""
+    mesh = flat_square()
+    relief = bake(mesh, depth_res=64, axis="z", safety=False)
+    scores, _ = _scores(relief, mesh, (25.0, 15.0, 2.5))
+    assert scores["iou"] > 0.97
+    with pytest.raises(UsageError, match="the mesh is flat across z: seen along --axis y it is "
+                                         "edge-on and covers nothing; bake it along --axis z"):
+        bake(mesh, depth_res=64, safety=False)
+
+
+def test_a_flat_mesh_is_refused_by_the_relief_cube_with_what_to_do(gl):
+    with pytest.raises(UsageError, match="six frusta meet .* bake it as relief --axis z"):
+        bake_relief_cube(flat_square(), depth_res=32, safety=False)

@@ -18,11 +18,32 @@ from .representation import ReliefTexture
 
 BORDER_TEXELS = 1.5      # empty margin around the footprint (the border ring must be 0)
 HEIGHT_MARGIN = 0.01     # the box bottom lies this fraction of the height below the mesh
+# A box at least this fraction of its footprint deep: a flat mesh (a decal, a sheet) seen
+# from above had a box 1e-9 deep, whose projection lost its heights to float precision
+# (refused as empty) or drew nothing.
+MIN_THICKNESS = 1e-3
 # Safety-radius tolerance of bakes (height units, Fig. 12): with 0 most texels of a bilinear
 # terrain get radius 0 (every non-planar patch bends down along some direction); 1% of the
 # box height keeps radii growing with resolution at a bounded silhouette error.
 DEFAULT_TOLERANCE = 0.01
 HEIGHTMAP_BOX = (2.0, 0.5, 2.0)  # world size (x, height, z) of a heightmap's box by default
+
+
+def flat_axis(mesh: RenderMesh) -> str | None:
+    """The world axis ('x', 'y' or 'z') a flat mesh (a decal, a sheet) is flat across; None
+    for a mesh with depth in every direction."""
+    ext = np.ptp(mesh.world_positions, axis=0)
+    flat = int(np.argmin(ext))
+    return "xyz"[flat] if ext[flat] <= 1e-6 * float(ext.max()) else None
+
+
+def check_not_edge_on(mesh: RenderMesh, axis: str) -> None:
+    """Refuse, naming the axis to bake along, a flat mesh seen edge-on along ``axis``: it
+    covers no texel, and the bake ended in "the heightfield is empty" without saying why."""
+    flat = flat_axis(mesh)
+    if flat is not None and axis.lstrip("+-") != flat:
+        raise UsageError(f"the mesh is flat across {flat}: seen along --axis {axis} it is "
+                         f"edge-on and covers nothing; bake it along --axis {flat}")
 
 
 def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, tuple[int, int]]:
@@ -38,6 +59,7 @@ def ortho_box(mesh: RenderMesh, axis: str, depth_res: int) -> tuple[np.ndarray, 
     local = mesh.world_positions @ frame.T
     lo, hi = local.min(axis=0), local.max(axis=0)
     ext = np.maximum(hi - lo, 1e-9 * max(float(np.max(hi - lo)), 1e-30))
+    ext[2] = max(ext[2], MIN_THICKNESS * max(ext[0], ext[1]))  # a flat mesh: a thin box
     texel = max(ext[0], ext[1]) / (depth_res - 2 * BORDER_TEXELS)
     size = [depth_res if ext[k] >= ext[1 - k] else
             int(min(depth_res, np.ceil(ext[k] / texel + 2 * BORDER_TEXELS))) for k in (0, 1)]
@@ -148,6 +170,7 @@ def bake_relief(mesh: RenderMesh, depth_res: int = 256, color_res: int | None = 
                 tolerance: float = DEFAULT_TOLERANCE, progress=None, ctx=None,
                 octants: bool = False) -> ReliefTexture:
     """Orthographic relief texture of ``mesh`` seen from above along ``axis`` (§3)."""
+    check_not_edge_on(mesh, axis)
     box_to_world, depth_size = ortho_box(mesh, axis, depth_res)
     color_size = _color_size(depth_size, depth_res, color_res)
     params = {"projection": "orthographic", "axis": axis, "depth_res": depth_res,

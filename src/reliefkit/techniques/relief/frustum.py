@@ -14,7 +14,14 @@ from ...bake.project import axis_frame, cube_face_frames, project_mesh
 from ...core.transforms import translation
 from ...errors import UsageError
 from ...scene.mesh import RenderMesh
-from .bake import BORDER_TEXELS, DEFAULT_TOLERANCE, bake_through
+from .bake import (
+    BORDER_TEXELS,
+    DEFAULT_TOLERANCE,
+    MIN_THICKNESS,
+    bake_through,
+    check_not_edge_on,
+    flat_axis,
+)
 from .representation import ReliefObject, ReliefTexture
 
 UNIT_FROM_NDC = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1]])
@@ -48,6 +55,7 @@ def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 3
     """
     if not 1.0 <= spread_deg <= 75.0:
         raise UsageError(f"frustum spread must be between 1 and 75 degrees, got {spread_deg}")
+    check_not_edge_on(mesh, axis)
     frame = axis_frame(axis)
     local = mesh.world_positions @ frame.T
     lo, hi = local.min(axis=0), local.max(axis=0)
@@ -62,7 +70,7 @@ def fit_reverse_frustum(mesh: RenderMesh, axis: str = "y", spread_deg: float = 3
     size = [depth_res, depth_res]
     size[1 - longest] = max(4, int(np.ceil(depth_res * tans[1 - longest] / tans[longest])))
     tans = tans * np.array([s / (s - 2 * BORDER_TEXELS) for s in size])
-    depth = hi[2] - lo[2]
+    depth = max(hi[2] - lo[2], MIN_THICKNESS * 2 * max(half[0], half[1]))  # flat: thin
     near, far = apex_distance - 0.01 * depth, apex_distance + 1.01 * depth
     box_to_world = frustum_matrix(frame.T @ apex_local, frame, tans[0], tans[1], near, far)
     return box_to_world, (size[0], size[1])
@@ -133,6 +141,11 @@ def bake_relief_cube(mesh: RenderMesh, *, depth_res: int = 128, color_res: int |
                      safety: bool | None = None, tolerance: float = DEFAULT_TOLERANCE,
                      progress=None, ctx=None, octants: bool = False) -> ReliefObject:
     """Six reverse-perspective heightfields splitting the bounding cube (§4.2, Fig. 10)."""
+    flat = flat_axis(mesh)
+    if flat is not None:  # its six pyramids meet where a flat mesh lies
+        raise UsageError(f"the mesh is flat across {flat}: a relief cube's six frusta meet at "
+                         f"its bounding cube's centre, in its plane, and none sees it; bake it "
+                         f"as relief --axis {flat}")
     size = (depth_res, depth_res)
     color_size = size if color_res is None else (color_res, color_res)
     parts = []
